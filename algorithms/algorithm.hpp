@@ -1,0 +1,51 @@
+// The interface every growth algorithm implements. The harness drives the steps, so budgets, time
+// limits, growth curves and animation frames work the same way for all of them.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "algorithms/plant.hpp"
+#include "core/params.hpp"
+#include "scenes/scene.hpp"
+#include "scenes/scene_query.hpp"
+
+namespace growbench {
+
+struct AlgorithmInfo {
+  std::string name;
+  std::string summary;
+  std::vector<ParamSpec> params;  // the table `growbench list` prints
+};
+
+class GrowthAlgorithm {
+ public:
+  virtual ~GrowthAlgorithm() = default;
+  [[nodiscard]] virtual const AlgorithmInfo& describe() const = 0;
+  // Prepares a run. `params` were validated against describe().params. The scene and query outlive
+  // the algorithm. Throws InputError for combinations of parameters and scene that cannot work.
+  virtual void start(const Scene& scene, const SceneQuery& query, const Params& params, std::uint64_t seed) = 0;
+  // Advances one growth step; returns false when growth has ended by itself.
+  virtual bool step() = 0;
+  [[nodiscard]] virtual const Plant& plant() const = 0;
+  // Called once after the last step, before meshing (e.g. to assign pipe-model radii or place leaves).
+  virtual void finish() {}
+  // Algorithm-specific figures for the trial record (e.g. attraction points left).
+  [[nodiscard]] virtual std::vector<std::pair<std::string, double>> stats() const { return {}; }
+};
+
+struct AlgorithmEntry {
+  const AlgorithmInfo& (*info)();
+  std::unique_ptr<GrowthAlgorithm> (*make)();
+};
+
+// The explicit list of algorithms (algorithms/registry.cpp). Adding one is a folder plus one line there.
+const std::vector<AlgorithmEntry>& algorithm_registry();
+// Finds an algorithm by name; InputError listing the valid names otherwise.
+const AlgorithmEntry& find_algorithm(const std::string& name);
+// Default parameters of an algorithm, with `owner` set for error messages.
+Params default_params(const AlgorithmEntry& entry);
+
+}  // namespace growbench

@@ -1,0 +1,99 @@
+#include "algorithms/plant.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+#include <xxhash.h>
+
+namespace growbench {
+
+const char* to_string(OrganKind k) {
+  switch (k) {
+    case OrganKind::Leaf: return "leaf";
+    case OrganKind::YoungLeaf: return "young_leaf";
+    case OrganKind::Flower: return "flower";
+    case OrganKind::Bud: return "bud";
+  }
+  return "?";
+}
+
+std::size_t Plant::leaf_count() const {
+  std::size_t n = 0;
+  for (const auto& o : organs) n += (o.kind == OrganKind::Leaf || o.kind == OrganKind::YoungLeaf) ? 1 : 0;
+  return n;
+}
+
+double Plant::total_length() const {
+  double len = 0.0;
+  for (const auto& n : nodes)
+    if (n.parent != kNoParent) len += glm::length(n.position - nodes[static_cast<std::size_t>(n.parent)].position);
+  return len;
+}
+
+std::string Plant::geometry_hash() const {
+  XXH3_state_t* st = XXH3_createState();
+  XXH3_64bits_reset(st);
+  auto put = [&](const auto& v) { XXH3_64bits_update(st, &v, sizeof(v)); };
+  put(nodes.size());
+  for (const auto& n : nodes) {  // field by field: no padding bytes enter the hash
+    put(n.position);
+    put(n.radius);
+    put(n.parent);
+    put(n.order);
+    put(n.shoot);
+    put(n.birth_step);
+  }
+  put(organs.size());
+  for (const auto& o : organs) {
+    put(o.position);
+    put(o.orientation);
+    put(o.size);
+    put(o.kind);
+    put(o.node);
+  }
+  put(polygons.size());
+  for (const auto& p : polygons) {
+    put(p.vertices.size());
+    for (const auto& v : p.vertices) put(v);
+  }
+  const auto h = XXH3_64bits_digest(st);
+  XXH3_freeState(st);
+  return fmt::format("{:016x}", h);
+}
+
+std::string Plant::validate() const {
+  auto finite = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    const auto& n = nodes[i];
+    if (!finite(n.position)) return fmt::format("node {} has a non-finite position", i);
+    if (!std::isfinite(n.radius) || n.radius < 0.0f) return fmt::format("node {} has radius {}", i, n.radius);
+    if (n.parent != kNoParent && (n.parent < 0 || static_cast<std::size_t>(n.parent) >= i))
+      return fmt::format("node {} has parent {} (parents must precede children)", i, n.parent);
+  }
+  for (std::size_t i = 0; i < organs.size(); ++i) {
+    const auto& o = organs[i];
+    if (!finite(o.position) || !std::isfinite(o.size) || o.size < 0.0f)
+      return fmt::format("organ {} has a non-finite position or a bad size", i);
+    if (o.node != kNoParent && (o.node < 0 || static_cast<std::size_t>(o.node) >= nodes.size()))
+      return fmt::format("organ {} refers to node {} of {}", i, o.node, nodes.size());
+  }
+  return {};
+}
+
+void assign_pipe_radii(Plant& plant, float tip_radius, float exponent) {
+  const std::size_t n = plant.nodes.size();
+  std::vector<double> sum(n, 0.0);  // sum of children's r^n
+  std::vector<bool> has_child(n, false);
+  // Parents precede children, so one backward sweep sees every child before its parent.
+  for (std::size_t k = n; k-- > 0;) {
+    auto& node = plant.nodes[k];
+    const double rn = has_child[k] ? sum[k] : std::pow(double(tip_radius), double(exponent));
+    node.radius = static_cast<float>(std::pow(rn, 1.0 / exponent));
+    if (node.parent != kNoParent) {
+      sum[static_cast<std::size_t>(node.parent)] += rn;
+      has_child[static_cast<std::size_t>(node.parent)] = true;
+    }
+  }
+}
+
+}  // namespace growbench

@@ -1,0 +1,66 @@
+// The plant every algorithm produces: a forest of nodes, leaves/flowers, and optional polygons.
+// One mesher, one set of metrics and one renderer serve all algorithms through it.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+namespace growbench {
+
+constexpr std::int32_t kNoParent = -1;
+
+struct PlantNode {
+  glm::vec3 position{0.0f};
+  float radius = 0.0f;
+  std::int32_t parent = kNoParent;  // index of the parent node, kNoParent for a root
+  std::uint16_t order = 0;          // branch order: 0 on the main axis, +1 per lateral branch
+  std::uint32_t shoot = 0;          // shoot (branch) id: nodes of one unbranched axis share it
+  std::uint32_t birth_step = 0;     // growth step at which the node appeared
+};
+
+enum class OrganKind : std::uint8_t { Leaf, YoungLeaf, Flower, Bud };
+const char* to_string(OrganKind k);
+
+// A leaf or flower. Local frame: +Z along the blade (from the stalk to the tip), +Y the upper-side
+// normal, +X across; `size` is the blade length.
+struct Organ {
+  glm::vec3 position{0.0f};
+  glm::quat orientation{1.0f, 0.0f, 0.0f, 0.0f};
+  float size = 0.0f;
+  OrganKind kind = OrganKind::Leaf;
+  std::int32_t node = kNoParent;  // the node it grows from (or kNoParent)
+};
+
+// A planar polygon (L-system { . } blocks).
+struct PlantPolygon {
+  std::vector<glm::vec3> vertices;
+};
+
+struct Plant {
+  std::vector<PlantNode> nodes;
+  std::vector<Organ> organs;
+  std::vector<PlantPolygon> polygons;
+
+  void clear() {
+    nodes.clear();
+    organs.clear();
+    polygons.clear();
+  }
+  [[nodiscard]] std::size_t leaf_count() const;
+  [[nodiscard]] double total_length() const;  // sum of segment lengths (node to parent)
+  // A hash of the canonical content (positions, radii, topology, organs, polygons) as 16 hex digits.
+  // Equal hashes mean bit-identical plants.
+  [[nodiscard]] std::string geometry_hash() const;
+  // Checks the forest's invariants (parents precede children, finite values, non-negative radii);
+  // returns an empty string when valid, otherwise the first violation.
+  [[nodiscard]] std::string validate() const;
+};
+
+// Pipe-model radii (r^n = sum of children's r^n) from tip radius r_tip; exponent n in [1, 4].
+void assign_pipe_radii(Plant& plant, float tip_radius, float exponent);
+
+}  // namespace growbench

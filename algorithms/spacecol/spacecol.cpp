@@ -1,0 +1,673 @@
+// Runions space colonization: open venation (Runions et al. 2005, trees 2007) and closed venation
+// (relative neighbourhood, 2005), in a volume, on surfaces, or held on them (the Hyphae variant).
+//
+// Cost model. Attraction points sit in a static nanoflann kd-tree built once. Each point keeps its
+// nearest node within the influence radius; nodes are only ever added, so after a step only the points
+// within the influence radius of the *new* nodes can change their nearest node or die. One radius
+// query per new node (in parallel) does all the updating; there is never a rebuild plus re-query of
+// every point per step. Points that have a node in range form the `active` list, the only points a
+// step looks at.
+//
+// Determinism. Parallel work writes to per-item slots; everything that depends on order (merging
+// query results, accumulating directions, appending nodes) runs in a fixed order (node index, then
+// query-result index), and ties between equidistant nodes go to the lower node index. The plant is
+// bit-identical for any thread count.
+#include "algorithms/spacecol/spacecol.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <nanoflann.hpp>
+#include <tbb/parallel_for.h>
+
+#include "core/random.hpp"
+
+namespace growbench {
+namespace {
+
+// ---- parameter table (what `growbench list` prints) ----
+const AlgorithmInfo kInfo = {
+    "spacecol",
+    "Runions space colonization: attraction points pull nodes; open or closed venation; free, avoid or cling",
+    {
+        {"venation", ParamType::Choice, std::string("open"), -INFINITY, INFINITY, "",
+         "open: each point pulls its nearest node; closed: every node in its relative neighbourhood", {"open", "closed"}},
+        {"points", ParamType::Choice, std::string("auto"), -INFINITY, INFINITY, "",
+         "attraction points: in the scene envelope, on the surfaces (area-weighted), or from points_file; auto = "
+         "surface when surface=cling or the scene has no envelope, else envelope",
+         {"auto", "envelope", "surface", "file"}},
+        {"points_file", ParamType::String, std::string(""), -INFINITY, INFINITY, "",
+         "text file of attraction points, one 'x y z' (or x,y,z) per line, # comments (points=file)", {}},
+        {"point_count", ParamType::Int, std::int64_t{20000}, 1, 5e7, "", "number of attraction points sampled", {}},
+        {"surface_offset", ParamType::Real, 0.01, 0, 10, "m",
+         "surface-sampled points are lifted this far along the surface normal", {}},
+        {"influence", ParamType::Real, 0.25, 1e-4, 1e3, "m", "influence radius d_i: points farther from every node are ignored", {}},
+        {"kill", ParamType::Real, 0.05, 1e-5, 1e3, "m", "kill distance d_k: a point this close to a node is removed", {}},
+        {"step", ParamType::Real, 0.02, 1e-5, 1e2, "m", "step length D between a node and its child", {}},
+        {"tropism", ParamType::Vec3, glm::dvec3(0.0), -10, 10, "",
+         "added to each normalised growth direction (e.g. 0,0.2,0 bends growth upward)", {}},
+        {"noise", ParamType::Real, 0.0, 0, 10, "", "random unit vector times this is added to each growth direction", {}},
+        {"surface", ParamType::Choice, std::string("free"), -INFINITY, INFINITY, "",
+         "free: ignore solids; avoid: push nodes out of solids; cling: hold nodes at cling_distance from the "
+         "nearest surface (the Hyphae collision vector)",
+         {"free", "avoid", "cling"}},
+        {"cling_distance", ParamType::Real, 0.01, 0, 10, "m",
+         "distance kept from the surface (cling), minimum clearance (avoid)", {}},
+        {"split", ParamType::Real, 0.1, 0, 1, "",
+         "when the pulls on a node nearly cancel (|sum| < split * count), grow two children toward the two most "
+         "opposed points instead of stalling (0: such a node stalls)", {}},
+        {"seek", ParamType::Bool, true, -INFINITY, INFINITY, "",
+         "while no attraction point is within reach, roots grow along their seed direction", {}},
+        {"tip_radius", ParamType::Real, 0.002, 1e-6, 10, "m", "radius of branch tips (pipe model)", {}},
+        {"pipe_exponent", ParamType::Real, 2.5, 1, 4, "", "pipe model exponent n: r^n = sum of children's r^n", {}},
+        {"leaves", ParamType::Choice, std::string("tips"), -INFINITY, INFINITY, "",
+         "where leaves go: none, at branch tips, every leaf_interval nodes, or both", {"none", "tips", "interval", "both"}},
+        {"leaf_interval", ParamType::Int, std::int64_t{6}, 1, 1000, "", "a leaf every k nodes along a branch (leaves=interval/both)", {}},
+        {"leaf_size", ParamType::Real, 0.05, 0, 10, "m", "leaf blade length", {}},
+    }};
+
+struct Cloud {
+  const std::vector<glm::vec3>* pts;
+  [[nodiscard]] std::size_t kdtree_get_point_count() const { return pts->size(); }
+  [[nodiscard]] float kdtree_get_pt(std::size_t i, std::size_t d) const { return (*pts)[i][static_cast<int>(d)]; }
+  template <class BBox>
+  bool kdtree_get_bbox(BBox&) const { return false; }
+};
+using PointTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Cloud>, Cloud, 3, std::uint32_t>;
+using NodeTree =
+    nanoflann::KDTreeSingleIndexDynamicAdaptor<nanoflann::L2_Simple_Adaptor<float, Cloud>, Cloud, 3, std::uint32_t>;
+
+// Collects (index, squared distance) within a radius, skipping entries a filter rejects.
+template <class Keep>
+struct CollectWithin {
+  using DistanceType = float;
+  using IndexType = std::uint32_t;
+  float radius2;
+  std::vector<std::pair<std::uint32_t, float>>* out;
+  Keep keep;
+  void init() {}
+  [[nodiscard]] std::size_t size() const { return out->size(); }
+  [[nodiscard]] bool full() const { return true; }
+  bool addPoint(float d2, std::uint32_t i) {
+    if (d2 < radius2 && keep(i)) out->emplace_back(i, d2);
+    return true;
+  }
+  [[nodiscard]] float worstDist() const { return radius2; }
+};
+template <class Keep>
+CollectWithin<Keep> collect_within(float r2, std::vector<std::pair<std::uint32_t, float>>& out, Keep keep) {
+  out.clear();
+  return CollectWithin<Keep>{r2, &out, keep};
+}
+
+glm::vec3 safe_normalize(const glm::vec3& v, const glm::vec3& fallback) {
+  const float len = glm::length(v);
+  return len > 1e-20f ? v / len : fallback;
+}
+
+enum class Surface { Free, Avoid, Cling };
+constexpr std::int32_t kNone = -1;
+constexpr float kStallFraction = 0.05f;  // a child closer than this * step to a sibling means a stalled node
+
+// The pulls of the attraction points on one node, accumulated in a fixed order.
+struct Pull {
+  glm::vec3 sum{0.0f};
+  glm::vec3 first{0.0f};     // the first pull seen
+  glm::vec3 opposite{0.0f};  // the pull most opposed to `first` (filled only for nearly cancelling nodes)
+  float min_dot = 2.0f;
+  std::uint32_t count = 0;
+};
+
+class SpaceColonization final : public GrowthAlgorithm {
+ public:
+  const AlgorithmInfo& describe() const override { return kInfo; }
+
+  void start(const Scene& scene, const SceneQuery& query, const Params& p, std::uint64_t seed) override {
+    scene_ = &scene;
+    query_ = &query;
+    seed_ = seed;
+    closed_ = p.text("venation") == "closed";
+    influence_ = static_cast<float>(p.real("influence"));
+    kill_ = static_cast<float>(p.real("kill"));
+    step_len_ = static_cast<float>(p.real("step"));
+    tropism_ = glm::vec3(p.vec3("tropism"));
+    noise_ = static_cast<float>(p.real("noise"));
+    cling_ = static_cast<float>(p.real("cling_distance"));
+    seek_ = p.boolean("seek");
+    split_ = static_cast<float>(p.real("split"));
+    tip_radius_ = static_cast<float>(p.real("tip_radius"));
+    pipe_exponent_ = static_cast<float>(p.real("pipe_exponent"));
+    leaves_ = p.text("leaves");
+    leaf_interval_ = static_cast<int>(p.integer("leaf_interval"));
+    leaf_size_ = static_cast<float>(p.real("leaf_size"));
+    const std::string& s = p.text("surface");
+    surface_ = s == "cling" ? Surface::Cling : s == "avoid" ? Surface::Avoid : Surface::Free;
+    if (kill_ >= influence_)
+      throw InputError(fmt::format("algorithm 'spacecol': kill ({}) must be smaller than influence ({})", kill_, influence_));
+    if (step_len_ >= influence_)
+      throw InputError(fmt::format("algorithm 'spacecol': step ({}) must be smaller than influence ({})", step_len_, influence_));
+    if (surface_ != Surface::Free && !query.has_sdf())
+      throw InputError("algorithm 'spacecol': surface=avoid/cling needs the scene's distance field");
+
+    sample_points(p);
+    tree_ = std::make_unique<PointTree>(3, cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    closest_.assign(pts_.size(), kNone);
+    closest_d2_.assign(pts_.size(), 0.0f);
+    alive_.assign(pts_.size(), 1);
+    alive_count_ = pts_.size();
+    if (closed_) node_tree_ = std::make_unique<NodeTree>(3, node_cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    step_ = 0;
+    add_due_roots();
+  }
+
+  bool step() override {
+    ++step_;
+    std::vector<std::int32_t> new_nodes;
+    if (closed_) grow_closed(new_nodes);
+    else grow_open(new_nodes);
+    if (new_nodes.empty() && seek_ && !ever_influenced_) seek(new_nodes);
+    if (!new_nodes.empty()) associate(new_nodes);
+    const bool roots_pending = add_due_roots();
+    compact_active();
+    if (alive_count_ == 0 && !roots_pending) return false;
+    return !new_nodes.empty() || roots_pending || step_ < max_start_step_;
+  }
+
+  void finish() override {
+    assign_pipe_radii(plant_, tip_radius_, pipe_exponent_);
+    place_leaves();
+  }
+
+  const Plant& plant() const override { return plant_; }
+
+  std::vector<std::pair<std::string, double>> stats() const override {
+    return {{"attraction_points", static_cast<double>(pts_.size())},
+            {"attraction_points_left", static_cast<double>(alive_count_)},
+            {"stalled_nodes", static_cast<double>(stalled_count_)}};
+  }
+
+ private:
+  // ---------- attraction points ----------
+  bool accept_point(const glm::vec3& q) const {
+    bool include_ok = true, any_include = false;
+    for (const auto& z : scene_->zones) {
+      if (z.kind == Zone::Kind::Include) {
+        any_include = true;
+        include_ok = false;
+      }
+    }
+    for (const auto& z : scene_->zones) {
+      const bool in = query_->inside_shape(z.shape, q);
+      if (in && (z.kind == Zone::Kind::Exclude || z.kind == Zone::Kind::Repel)) return false;
+      if (in && z.kind == Zone::Kind::Include) include_ok = true;
+    }
+    if (any_include && !include_ok) return false;
+    if (query_->has_sdf() && query_->signed_distance(q) < 0.0f) return false;  // never inside a solid
+    return true;
+  }
+
+  // Fills pts_ with `count` accepted candidates, generated in parallel in index order.
+  template <class Gen>
+  void sample_accepted(std::size_t count, Gen gen, const char* what) {
+    const std::size_t max_tries = 50 * count + 1000;
+    std::size_t next = 0;
+    while (pts_.size() < count && next < max_tries) {
+      const std::size_t batch = std::min<std::size_t>(max_tries - next, std::max<std::size_t>(4096, 2 * (count - pts_.size())));
+      std::vector<glm::vec3> cand(batch);
+      std::vector<std::uint8_t> ok(batch);
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, batch, 1024), [&](const auto& r) {
+        for (std::size_t i = r.begin(); i < r.end(); ++i) {
+          cand[i] = gen(next + i);
+          ok[i] = accept_point(cand[i]) ? 1 : 0;
+        }
+      });
+      for (std::size_t i = 0; i < batch && pts_.size() < count; ++i)
+        if (ok[i]) pts_.push_back(cand[i]);
+      next += batch;
+    }
+    if (pts_.empty())
+      throw InputError(fmt::format("algorithm 'spacecol': no attraction point could be placed {} of scene '{}' "
+                                   "(all candidates fell inside solids or outside the include zones)",
+                                   what, scene_->name));
+  }
+
+  void sample_points(const Params& p) {
+    std::string mode = p.text("points");
+    if (mode == "auto") mode = (surface_ == Surface::Cling || !scene_->envelope) ? "surface" : "envelope";
+    const auto count = static_cast<std::size_t>(p.integer("point_count"));
+    pts_.clear();
+    pts_.reserve(count);
+    if (mode == "envelope") {
+      if (!scene_->envelope)
+        throw InputError(fmt::format("algorithm 'spacecol': points=envelope but scene '{}' has no envelope", scene_->name));
+      const Shape& env = *scene_->envelope;
+      const Aabb b = env.bounds();
+      sample_accepted(count, [&](std::size_t i) {
+        Rng rng(seed_, 0xE1u, 4 * i);
+        for (int tries = 0; tries < 64; ++tries) {
+          glm::vec3 q;
+          if (env.kind == Shape::Kind::Sphere) q = env.center + rng.in_unit_ball() * env.radii;
+          else q = b.min + glm::vec3(rng.uniform(), rng.uniform(), rng.uniform()) * b.size();
+          if (env.kind != Shape::Kind::Mesh || query_->inside_shape(env, q)) return q;
+        }
+        return glm::vec3(std::numeric_limits<float>::quiet_NaN());
+      }, "in the envelope");
+      pts_.erase(std::remove_if(pts_.begin(), pts_.end(), [](const glm::vec3& v) { return std::isnan(v.x); }), pts_.end());
+    } else if (mode == "surface") {
+      const auto off = static_cast<float>(p.real("surface_offset"));
+      sample_accepted(count, [&](std::size_t i) {
+        const SurfaceSample s = query_->sample_surface(seed_, i);
+        return s.position + off * s.normal;
+      }, "on the surfaces");
+    } else {
+      read_points_file(p.text("points_file"));
+    }
+  }
+
+  void read_points_file(const std::string& path) {
+    if (path.empty()) throw InputError("algorithm 'spacecol': points=file needs points_file=PATH");
+    std::ifstream in(path);
+    if (!in) throw InputError(fmt::format("{}: cannot open attraction point file", path));
+    std::string line;
+    for (int ln = 1; std::getline(in, line); ++ln) {
+      std::replace(line.begin(), line.end(), ',', ' ');
+      const auto hash = line.find('#');
+      if (hash != std::string::npos) line.resize(hash);
+      if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+      std::istringstream ls(line);
+      glm::vec3 v;
+      std::string extra;
+      if (!(ls >> v.x >> v.y >> v.z) || (ls >> extra) || !std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+        throw InputError(fmt::format("{}:{}: expected three finite numbers 'x y z'", path, ln));
+      pts_.push_back(v);
+    }
+    if (pts_.empty()) throw InputError(fmt::format("{}: no attraction points in the file", path));
+  }
+
+  // ---------- nodes ----------
+  std::int32_t add_node(const glm::vec3& pos, std::int32_t parent) {
+    PlantNode n;
+    n.position = pos;
+    n.parent = parent;
+    n.birth_step = static_cast<std::uint32_t>(step_);
+    if (parent == kNone) {
+      n.shoot = next_shoot_++;
+    } else {
+      const auto& par = plant_.nodes[static_cast<std::size_t>(parent)];
+      if (first_child_[static_cast<std::size_t>(parent)] == kNone) {
+        n.shoot = par.shoot;  // the first child continues the axis
+        n.order = par.order;
+      } else {
+        n.shoot = next_shoot_++;
+        n.order = static_cast<std::uint16_t>(par.order + 1);
+      }
+    }
+    const auto idx = static_cast<std::int32_t>(plant_.nodes.size());
+    plant_.nodes.push_back(n);
+    node_pos_.push_back(pos);
+    first_child_.push_back(kNone);
+    next_sibling_.push_back(kNone);
+    stalled_.push_back(0);
+    if (parent != kNone) {
+      auto& fc = first_child_[static_cast<std::size_t>(parent)];
+      if (fc == kNone) {
+        fc = idx;
+      } else {
+        std::int32_t c = fc;
+        while (next_sibling_[static_cast<std::size_t>(c)] != kNone) c = next_sibling_[static_cast<std::size_t>(c)];
+        next_sibling_[static_cast<std::size_t>(c)] = idx;
+      }
+    }
+    return idx;
+  }
+
+  // Adds roots whose start step has come; returns whether any seed is still waiting.
+  bool add_due_roots() {
+    bool pending = false;
+    std::vector<std::int32_t> added;
+    for (std::size_t i = 0; i < scene_->seeds.size(); ++i) {
+      const Seed& s = scene_->seeds[i];
+      max_start_step_ = std::max(max_start_step_, s.start_step);
+      if (root_added_.size() < scene_->seeds.size()) root_added_.resize(scene_->seeds.size(), 0);
+      if (root_added_[i]) continue;
+      if (s.start_step <= step_) {
+        root_added_[i] = 1;
+        const std::int32_t r = add_node(s.position, kNone);
+        seek_tips_.push_back({r, glm::normalize(s.direction)});
+        added.push_back(r);
+      } else {
+        pending = true;
+      }
+    }
+    if (!added.empty()) associate(added);
+    return pending;
+  }
+
+  // Where a node grown from `from` along `dir` lands, after the surface mode has its say.
+  glm::vec3 place(const glm::vec3& from, const glm::vec3& dir) const {
+    glm::vec3 c = from + step_len_ * dir;
+    if (surface_ == Surface::Free) return c;
+    // A few fixed-point iterations: the SDF gradient is that of a trilinear field, so one push lands close.
+    for (int it = 0; it < 3; ++it) {
+      const float d = query_->signed_distance(c);
+      if (surface_ == Surface::Avoid && d >= cling_) break;
+      if (std::abs(d - cling_) < 1e-3f * step_len_) break;
+      c += (cling_ - d) * query_->gradient(c);
+    }
+    return c;
+  }
+
+  // A node is stalled when its new child would land on an existing child (the same pull again) or
+  // back on its own parent (oscillating between two points).
+  bool is_stalled_child(std::int32_t parent, const glm::vec3& pos) const {
+    const float lim2 = (kStallFraction * step_len_) * (kStallFraction * step_len_);
+    if (const std::int32_t gp = plant_.nodes[static_cast<std::size_t>(parent)].parent; gp != kNone) {
+      const glm::vec3 d = node_pos_[static_cast<std::size_t>(gp)] - pos;
+      if (glm::dot(d, d) < 0.25f * step_len_ * step_len_) return true;
+    }
+    for (std::int32_t c = first_child_[static_cast<std::size_t>(parent)]; c != kNone; c = next_sibling_[static_cast<std::size_t>(c)]) {
+      const glm::vec3 d = node_pos_[static_cast<std::size_t>(c)] - pos;
+      if (glm::dot(d, d) < lim2) return true;
+    }
+    return false;
+  }
+
+  bool cancelling(const Pull& p) const { return split_ > 0.0f && glm::length(p.sum) < split_ * static_cast<float>(p.count); }
+
+  glm::vec3 steer(glm::vec3 dir, std::size_t v, std::uint64_t salt) const {
+    dir = safe_normalize(dir + tropism_, dir);
+    if (noise_ > 0.0f) {
+      Rng rng(seed_, 0x40000000ull + v, static_cast<std::uint64_t>(step_) * 4 + salt);
+      dir = safe_normalize(dir + noise_ * rng.unit_vector(), dir);
+    }
+    return dir;
+  }
+
+  // Grows children for every influenced node (sorted by index): one along the mean pull, or two toward
+  // the most opposed pulls when they nearly cancel (the node would otherwise stall or oscillate).
+  void grow_children(const std::vector<std::int32_t>& influenced, const std::vector<Pull>& pull,
+                     std::vector<std::int32_t>& new_nodes) {
+    const glm::vec3 none(std::numeric_limits<float>::quiet_NaN());
+    std::vector<std::pair<glm::vec3, glm::vec3>> target(influenced.size(), {none, none});
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, influenced.size(), 64), [&](const auto& r) {
+      for (std::size_t k = r.begin(); k < r.end(); ++k) {
+        const auto v = static_cast<std::size_t>(influenced[k]);
+        const Pull& p = pull[k];
+        if (cancelling(p) && p.min_dot < 0.0f) {
+          target[k] = {place(node_pos_[v], steer(p.first, v, 1)), place(node_pos_[v], steer(p.opposite, v, 2))};
+          continue;
+        }
+        const glm::vec3 dir = safe_normalize(p.sum, glm::vec3(0.0f));
+        if (glm::dot(dir, dir) == 0.0f) continue;  // pulls cancel exactly and splitting is off: the node waits
+        target[k].first = place(node_pos_[v], steer(dir, v, 0));
+      }
+    });
+    for (std::size_t k = 0; k < influenced.size(); ++k) {
+      const std::int32_t v = influenced[k];
+      bool grew = false;
+      for (const glm::vec3& t : {target[k].first, target[k].second}) {
+        if (std::isnan(t.x) || is_stalled_child(v, t)) continue;
+        new_nodes.push_back(add_node(t, v));
+        grew = true;
+      }
+      if (!grew) {
+        if (!stalled_[static_cast<std::size_t>(v)]) ++stalled_count_;
+        stalled_[static_cast<std::size_t>(v)] = 1;
+      }
+    }
+  }
+
+  // Accumulates the pull of point s on node v (in the caller's fixed order).
+  void add_pull(std::vector<std::int32_t>& influenced, std::vector<Pull>& pull, std::size_t v, std::uint32_t s) {
+    if (slot_[v] == kNone) {
+      slot_[v] = static_cast<std::int32_t>(influenced.size());
+      influenced.push_back(static_cast<std::int32_t>(v));
+      pull.emplace_back();
+    }
+    Pull& p = pull[static_cast<std::size_t>(slot_[v])];
+    const glm::vec3 d = safe_normalize(pts_[s] - node_pos_[v], glm::vec3(0.0f));
+    if (p.count == 0) p.first = d;
+    p.sum += d;
+    ++p.count;
+  }
+
+  // For nearly cancelling nodes, finds the pull most opposed to the first one (second pass, same order).
+  template <class ForEachPair>
+  void find_opposites(const std::vector<std::int32_t>& influenced, std::vector<Pull>& pull, ForEachPair each) {
+    bool any = false;
+    for (const auto& p : pull) any = any || cancelling(p);
+    if (!any) return;
+    for (std::size_t k = 0; k < influenced.size(); ++k) slot_[static_cast<std::size_t>(influenced[k])] = static_cast<std::int32_t>(k);
+    each([&](std::size_t v, std::uint32_t s) {
+      if (slot_[v] == kNone) return;
+      Pull& p = pull[static_cast<std::size_t>(slot_[v])];
+      if (!cancelling(p)) return;
+      const glm::vec3 d = safe_normalize(pts_[s] - node_pos_[v], glm::vec3(0.0f));
+      const float dot = glm::dot(d, p.first);
+      if (dot < p.min_dot) {
+        p.min_dot = dot;
+        p.opposite = d;
+      }
+    });
+    for (const auto v : influenced) slot_[static_cast<std::size_t>(v)] = kNone;
+  }
+
+  void grow_open(std::vector<std::int32_t>& new_nodes) {
+    // Pull of each active point on its nearest node, accumulated in active-list order (deterministic).
+    std::vector<std::int32_t> influenced;
+    std::vector<Pull> pull;
+    slot_.resize(plant_.nodes.size(), kNone);
+    auto each = [&](auto&& f) {
+      for (const std::uint32_t s : active_) {
+        const auto v = static_cast<std::size_t>(closest_[s]);
+        if (!stalled_[v]) f(v, s);
+      }
+    };
+    each([&](std::size_t v, std::uint32_t s) { add_pull(influenced, pull, v, s); });
+    for (const auto v : influenced) slot_[static_cast<std::size_t>(v)] = kNone;
+    find_opposites(influenced, pull, each);
+    if (!influenced.empty()) ever_influenced_ = true;
+    sort_by_node(influenced, pull);
+    grow_children(influenced, pull, new_nodes);
+  }
+
+  void grow_closed(std::vector<std::int32_t>& new_nodes) {
+    // For each active point, its relative neighbourhood among the nodes within the influence radius.
+    const float r2 = influence_ * influence_, k2 = kill_ * kill_;
+    std::vector<std::vector<std::uint32_t>> rn(active_.size());
+    std::vector<std::uint8_t> dies(active_.size(), 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, active_.size(), 64), [&](const auto& r) {
+      std::vector<std::pair<std::uint32_t, float>> near;
+      for (std::size_t a = r.begin(); a < r.end(); ++a) {
+        const glm::vec3& s = pts_[active_[a]];
+        auto rs = collect_within(r2, near, [](std::uint32_t) { return true; });
+        node_tree_->findNeighbors(rs, &s.x, nanoflann::SearchParams());
+        std::sort(near.begin(), near.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+        bool all_within_kill = !near.empty();
+        for (const auto& [v, dv2] : near) {
+          bool in_rn = true;
+          for (const auto& [u, du2] : near) {
+            if (u == v || du2 >= dv2) continue;
+            const glm::vec3 uv = node_pos_[u] - node_pos_[v];
+            if (glm::dot(uv, uv) < dv2) {
+              in_rn = false;
+              break;
+            }
+          }
+          if (in_rn) {
+            rn[a].push_back(v);
+            if (dv2 >= k2) all_within_kill = false;
+          }
+        }
+        dies[a] = all_within_kill ? 1 : 0;
+      }
+    });
+    for (std::size_t a = 0; a < active_.size(); ++a)
+      if (dies[a]) kill_point(active_[a]);
+    std::vector<std::int32_t> influenced;
+    std::vector<Pull> pull;
+    slot_.resize(plant_.nodes.size(), kNone);
+    auto each = [&](auto&& f) {
+      for (std::size_t a = 0; a < active_.size(); ++a) {
+        if (dies[a]) continue;
+        for (const std::uint32_t v : rn[a])
+          if (!stalled_[v]) f(std::size_t{v}, active_[a]);
+      }
+    };
+    each([&](std::size_t v, std::uint32_t s) { add_pull(influenced, pull, v, s); });
+    for (const auto v : influenced) slot_[static_cast<std::size_t>(v)] = kNone;
+    find_opposites(influenced, pull, each);
+    if (!influenced.empty()) ever_influenced_ = true;
+    sort_by_node(influenced, pull);
+    grow_children(influenced, pull, new_nodes);
+  }
+
+  static void sort_by_node(std::vector<std::int32_t>& nodes, std::vector<Pull>& pull) {
+    std::vector<std::size_t> order(nodes.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return nodes[a] < nodes[b]; });
+    std::vector<std::int32_t> n2(nodes.size());
+    std::vector<Pull> p2(nodes.size());
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      n2[i] = nodes[order[i]];
+      p2[i] = pull[order[i]];
+    }
+    nodes.swap(n2);
+    pull.swap(p2);
+  }
+
+  // Roots that nothing reaches yet grow straight along their seed direction (the trunk of a tree
+  // below its crown).
+  void seek(std::vector<std::int32_t>& new_nodes) {
+    const Aabb b = scene_->bounds();
+    const int limit = static_cast<int>(std::ceil(2.0f * glm::length(b.size()) / step_len_)) + 1;
+    if (seek_steps_++ > limit) return;
+    for (auto& [tip, dir] : seek_tips_) {
+      const std::int32_t n = add_node(place(node_pos_[static_cast<std::size_t>(tip)], dir), tip);
+      tip = n;
+      new_nodes.push_back(n);
+    }
+  }
+
+  void kill_point(std::uint32_t s) {
+    if (alive_[s]) {
+      alive_[s] = 0;
+      --alive_count_;
+    }
+  }
+
+  // Updates nearest nodes, activations and kills for points near the given (new) nodes.
+  void associate(const std::vector<std::int32_t>& nodes) {
+    if (closed_) node_tree_->addPoints(static_cast<std::uint32_t>(node_pos_.size() - nodes.size()),
+                                       static_cast<std::uint32_t>(node_pos_.size() - 1));
+    const float r2 = influence_ * influence_, k2 = kill_ * kill_;
+    std::vector<std::vector<std::pair<std::uint32_t, float>>> found(nodes.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nodes.size(), 16), [&](const auto& r) {
+      for (std::size_t k = r.begin(); k < r.end(); ++k) {
+        const glm::vec3& q = node_pos_[static_cast<std::size_t>(nodes[k])];
+        auto rs = collect_within(r2, found[k], [this](std::uint32_t i) { return alive_[i] != 0; });
+        tree_->findNeighbors(rs, &q.x, nanoflann::SearchParams(32, 0.0f, false));
+        // nanoflann's order depends only on the tree, but sort anyway so the merge order is explicit.
+        std::sort(found[k].begin(), found[k].end());
+      }
+    });
+    for (std::size_t k = 0; k < nodes.size(); ++k) {
+      const std::int32_t v = nodes[k];
+      for (const auto& [s, d2] : found[k]) {
+        if (!alive_[s]) continue;
+        if (!closed_ && d2 < k2) {
+          kill_point(s);
+          continue;
+        }
+        if (closest_[s] == kNone) {
+          closest_[s] = v;
+          closest_d2_[s] = d2;
+          active_.push_back(s);
+        } else if (d2 < closest_d2_[s]) {  // ties keep the older (lower-index) node
+          closest_[s] = v;
+          closest_d2_[s] = d2;
+        }
+      }
+    }
+  }
+
+  void compact_active() {
+    active_.erase(std::remove_if(active_.begin(), active_.end(), [this](std::uint32_t s) { return !alive_[s]; }),
+                  active_.end());
+  }
+
+  // ---------- leaves ----------
+  void place_leaves() {
+    if (leaves_ == "none" || leaf_size_ <= 0.0f) return;
+    const bool tips = leaves_ == "tips" || leaves_ == "both", interval = leaves_ == "interval" || leaves_ == "both";
+    std::vector<int> depth(plant_.nodes.size(), 0);
+    for (std::size_t i = 0; i < plant_.nodes.size(); ++i) {
+      const auto& n = plant_.nodes[i];
+      if (n.parent != kNone) depth[i] = depth[static_cast<std::size_t>(n.parent)] + 1;
+      const bool tip = first_child_[i] == kNone && n.parent != kNone;
+      if (!((tips && tip) || (interval && n.parent != kNone && depth[i] % leaf_interval_ == 0))) continue;
+      const glm::vec3 axis =
+          safe_normalize(n.position - plant_.nodes[static_cast<std::size_t>(n.parent)].position, glm::vec3(0, 1, 0));
+      Rng rng(seed_, 0x1EAFull, i);
+      // Upper side faces away from the nearest surface when clinging, otherwise up (toward the sky).
+      glm::vec3 up = surface_ == Surface::Free ? glm::vec3(0, 1, 0) : query_->gradient(n.position);
+      // Blade: along the branch, tilted away from the axis by a random angle around it.
+      glm::vec3 side = safe_normalize(glm::cross(axis, up), safe_normalize(glm::cross(axis, glm::vec3(1, 0, 0)), glm::vec3(0, 0, 1)));
+      if (rng.uniform() < 0.5) side = -side;
+      glm::vec3 blade = safe_normalize(axis + 0.8f * side, axis);
+      glm::vec3 normal = safe_normalize(up - glm::dot(up, blade) * blade, safe_normalize(glm::cross(blade, side), up));
+      const glm::vec3 x = glm::cross(normal, blade);
+      Organ leaf;
+      leaf.position = n.position;
+      leaf.orientation = glm::quat_cast(glm::mat3(x, normal, blade));
+      leaf.size = leaf_size_ * static_cast<float>(rng.uniform(0.8, 1.2));
+      leaf.kind = tip ? OrganKind::YoungLeaf : OrganKind::Leaf;
+      leaf.node = static_cast<std::int32_t>(i);
+      plant_.organs.push_back(leaf);
+    }
+  }
+
+  // ---------- state ----------
+  const Scene* scene_ = nullptr;
+  const SceneQuery* query_ = nullptr;
+  std::uint64_t seed_ = 0;
+  bool closed_ = false, seek_ = true, ever_influenced_ = false;
+  float split_ = 0;
+  float influence_ = 0, kill_ = 0, step_len_ = 0, noise_ = 0, cling_ = 0, tip_radius_ = 0, pipe_exponent_ = 2;
+  glm::vec3 tropism_{0.0f};
+  Surface surface_ = Surface::Free;
+  std::string leaves_;
+  int leaf_interval_ = 1;
+  float leaf_size_ = 0;
+
+  std::vector<glm::vec3> pts_;
+  Cloud cloud_{&pts_};  // nanoflann keeps references to these adaptors: they live as long as the trees
+  std::unique_ptr<PointTree> tree_;
+  std::vector<std::int32_t> closest_;
+  std::vector<float> closest_d2_;
+  std::vector<std::uint8_t> alive_;
+  std::size_t alive_count_ = 0;
+  std::vector<std::uint32_t> active_;
+
+  Plant plant_;
+  std::vector<glm::vec3> node_pos_;
+  Cloud node_cloud_{&node_pos_};
+  std::unique_ptr<NodeTree> node_tree_;
+  std::vector<std::int32_t> first_child_, next_sibling_, slot_;
+  std::vector<std::uint8_t> stalled_;
+  std::size_t stalled_count_ = 0;
+  std::vector<std::uint8_t> root_added_;
+  std::vector<std::pair<std::int32_t, glm::vec3>> seek_tips_;
+  int step_ = 0, seek_steps_ = 0, max_start_step_ = 0;
+  std::uint32_t next_shoot_ = 0;
+};
+
+}  // namespace
+
+const AlgorithmInfo& spacecol_info() { return kInfo; }
+std::unique_ptr<GrowthAlgorithm> make_spacecol() { return std::make_unique<SpaceColonization>(); }
+
+}  // namespace growbench

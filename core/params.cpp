@@ -1,0 +1,277 @@
+#include "core/params.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/errors.hpp"
+
+namespace growbench {
+
+std::string_view to_string(ParamType t) {
+  switch (t) {
+    case ParamType::Int: return "int";
+    case ParamType::Real: return "real";
+    case ParamType::Bool: return "bool";
+    case ParamType::String: return "string";
+    case ParamType::Vec3: return "vec3";
+    case ParamType::Choice: return "choice";
+  }
+  return "?";
+}
+
+namespace {
+std::string fmt_num(double v) {
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  return fmt::format("{:g}", v);
+}
+}  // namespace
+
+std::string format_value(const ParamValue& v) {
+  return std::visit(
+      [](const auto& x) -> std::string {
+        using T = std::decay_t<decltype(x)>;
+        if constexpr (std::is_same_v<T, std::int64_t>) return fmt::format("{}", x);
+        else if constexpr (std::is_same_v<T, double>) return fmt_num(x);
+        else if constexpr (std::is_same_v<T, bool>) return x ? "true" : "false";
+        else if constexpr (std::is_same_v<T, std::string>) return x;
+        else return fmt::format("{},{},{}", fmt_num(x.x), fmt_num(x.y), fmt_num(x.z));
+      },
+      v);
+}
+
+std::string ParamSpec::allowed() const {
+  std::string range;
+  if (std::isfinite(min) || std::isfinite(max)) range = fmt::format(" in [{}, {}]", fmt_num(min), fmt_num(max));
+  const std::string u = unit.empty() ? "" : fmt::format(" ({})", unit);
+  switch (type) {
+    case ParamType::Int: return fmt::format("an integer{}{}", range, u);
+    case ParamType::Real: return fmt::format("a finite real number{}{}", range, u);
+    case ParamType::Bool: return "a boolean (true/false, 1/0, yes/no, on/off)";
+    case ParamType::String: return "a string";
+    case ParamType::Vec3: return fmt::format("three comma-separated numbers x,y,z each{}{}", range, u);
+    case ParamType::Choice: return fmt::format("one of {}", fmt::join(choices, ", "));
+  }
+  return "?";
+}
+
+std::string closest_match(std::string_view name, const std::vector<std::string>& candidates) {
+  auto distance = [](std::string_view a, std::string_view b) {
+    std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+      cur[0] = i;
+      for (std::size_t j = 1; j <= b.size(); ++j) {
+        const std::size_t sub = prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1);
+        cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, sub});
+      }
+      std::swap(prev, cur);
+    }
+    return prev[b.size()];
+  };
+  std::string best;
+  std::size_t best_d = std::numeric_limits<std::size_t>::max();
+  for (const auto& c : candidates) {
+    const std::size_t d = distance(name, c);
+    if (d < best_d) {
+      best_d = d;
+      best = c;
+    }
+  }
+  // Close means: at most a third of the longer name changed (and at least one edit allowed).
+  const std::size_t limit = std::max<std::size_t>(1, std::max(name.size(), best.size()) / 3);
+  return best_d <= limit ? best : std::string{};
+}
+
+Params::Params(std::string owner, const std::vector<ParamSpec>& specs)
+    : owner_(std::move(owner)), specs_(specs), set_(specs.size(), false) {
+  values_.reserve(specs_.size());
+  for (const auto& s : specs_) values_.push_back(s.default_value);
+}
+
+std::size_t Params::index_of(std::string_view key) const {
+  for (std::size_t i = 0; i < specs_.size(); ++i)
+    if (specs_[i].name == key) return i;
+  std::vector<std::string> names;
+  for (const auto& s : specs_) names.push_back(s.name);
+  const std::string near = closest_match(key, names);
+  throw InputError(fmt::format("unknown parameter '{}' for {}{}; known parameters: {}", key, owner_,
+                               near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near),
+                               fmt::join(names, ", ")));
+}
+
+void Params::check_and_store(std::size_t i, ParamValue v, std::string_view shown) {
+  const ParamSpec& s = specs_[i];
+  auto bad = [&](std::string_view why) {
+    throw InputError(fmt::format("parameter '{}' of {}: value '{}' {}; expected {}", s.name, owner_, shown,
+                                 why, s.allowed()));
+  };
+  auto check_range = [&](double x) {
+    if (!std::isfinite(x)) bad("is not finite");
+    if (x < s.min || x > s.max) bad("is out of range");
+  };
+  switch (s.type) {
+    case ParamType::Int: check_range(static_cast<double>(std::get<std::int64_t>(v))); break;
+    case ParamType::Real: check_range(std::get<double>(v)); break;
+    case ParamType::Vec3: {
+      const auto& x = std::get<glm::dvec3>(v);
+      check_range(x.x);
+      check_range(x.y);
+      check_range(x.z);
+      break;
+    }
+    case ParamType::Choice:
+      if (std::find(s.choices.begin(), s.choices.end(), std::get<std::string>(v)) == s.choices.end()) {
+        const std::string near = closest_match(std::get<std::string>(v), s.choices);
+        bad(near.empty() ? "is not a valid choice" : fmt::format("is not a valid choice (did you mean '{}'?)", near));
+      }
+      break;
+    default: break;
+  }
+  values_[i] = std::move(v);
+  set_[i] = true;
+}
+
+namespace {
+bool parse_double(std::string_view t, double& out) {
+  while (!t.empty() && t.front() == ' ') t.remove_prefix(1);
+  while (!t.empty() && t.back() == ' ') t.remove_suffix(1);
+  if (!t.empty() && t.front() == '+') t.remove_prefix(1);
+  const auto r = std::from_chars(t.data(), t.data() + t.size(), out);
+  return r.ec == std::errc{} && r.ptr == t.data() + t.size();
+}
+}  // namespace
+
+void Params::set(std::string_view key, std::string_view text) {
+  const std::size_t i = index_of(key);
+  const ParamSpec& s = specs_[i];
+  auto bad = [&]() {
+    throw InputError(fmt::format("parameter '{}' of {}: cannot read '{}'; expected {}", s.name, owner_, text,
+                                 s.allowed()));
+  };
+  switch (s.type) {
+    case ParamType::Int: {
+      std::int64_t v = 0;
+      const auto r = std::from_chars(text.data(), text.data() + text.size(), v);
+      if (r.ec != std::errc{} || r.ptr != text.data() + text.size()) {
+        double d = 0;  // accept "1e6" and "3.0" when they are whole numbers
+        if (!parse_double(text, d) || d != std::floor(d) || std::abs(d) > 9.0e15) bad();
+        v = static_cast<std::int64_t>(d);
+      }
+      check_and_store(i, v, text);
+      break;
+    }
+    case ParamType::Real: {
+      double v = 0;
+      if (!parse_double(text, v)) bad();
+      check_and_store(i, v, text);
+      break;
+    }
+    case ParamType::Bool: {
+      std::string t(text);
+      std::transform(t.begin(), t.end(), t.begin(), [](unsigned char c) { return std::tolower(c); });
+      bool v = false;
+      if (t == "true" || t == "1" || t == "yes" || t == "on") v = true;
+      else if (t == "false" || t == "0" || t == "no" || t == "off") v = false;
+      else bad();
+      check_and_store(i, v, text);
+      break;
+    }
+    case ParamType::String:
+    case ParamType::Choice: check_and_store(i, std::string(text), text); break;
+    case ParamType::Vec3: {
+      glm::dvec3 v{0.0};
+      std::string_view rest = text;
+      for (int c = 0; c < 3; ++c) {
+        const auto comma = rest.find(',');
+        if ((c < 2) != (comma != std::string_view::npos)) bad();
+        if (!parse_double(rest.substr(0, comma), v[c])) bad();
+        if (c < 2) rest.remove_prefix(comma + 1);
+      }
+      check_and_store(i, v, text);
+      break;
+    }
+  }
+}
+
+void Params::set_json(std::string_view key, const nlohmann::json& j) {
+  const std::size_t i = index_of(key);
+  const ParamSpec& s = specs_[i];
+  const std::string shown = j.dump();
+  auto bad = [&]() {
+    throw InputError(fmt::format("parameter '{}' of {}: value {} has the wrong type; expected {}", s.name, owner_,
+                                 shown, s.allowed()));
+  };
+  switch (s.type) {
+    case ParamType::Int:
+      if (j.is_number_integer()) check_and_store(i, j.get<std::int64_t>(), shown);
+      else if (j.is_number_float() && j.get<double>() == std::floor(j.get<double>()))
+        check_and_store(i, static_cast<std::int64_t>(j.get<double>()), shown);
+      else bad();
+      break;
+    case ParamType::Real:
+      if (!j.is_number()) bad();
+      check_and_store(i, j.get<double>(), shown);
+      break;
+    case ParamType::Bool:
+      if (!j.is_boolean()) bad();
+      check_and_store(i, j.get<bool>(), shown);
+      break;
+    case ParamType::String:
+    case ParamType::Choice:
+      if (!j.is_string()) bad();
+      check_and_store(i, j.get<std::string>(), shown);
+      break;
+    case ParamType::Vec3:
+      if (!j.is_array() || j.size() != 3 || !j[0].is_number() || !j[1].is_number() || !j[2].is_number()) bad();
+      check_and_store(i, glm::dvec3(j[0].get<double>(), j[1].get<double>(), j[2].get<double>()), shown);
+      break;
+  }
+}
+
+void Params::set_assignment(std::string_view a) {
+  const auto eq = a.find('=');
+  if (eq == std::string_view::npos || eq == 0)
+    throw InputError(fmt::format("'{}' for {}: expected key=value", a, owner_));
+  set(a.substr(0, eq), a.substr(eq + 1));
+}
+
+const ParamValue& Params::value(std::string_view key, ParamType expected) const {
+  const std::size_t i = index_of(key);
+  const ParamType t = specs_[i].type;
+  const bool ok = t == expected || (expected == ParamType::String && t == ParamType::Choice);
+  if (!ok)  // a programming error in an algorithm, not user input
+    throw std::logic_error(fmt::format("parameter '{}' of {} is {}, read as {}", key, owner_, to_string(t),
+                                       to_string(expected)));
+  return values_[i];
+}
+
+std::int64_t Params::integer(std::string_view key) const {
+  return std::get<std::int64_t>(value(key, ParamType::Int));
+}
+double Params::real(std::string_view key) const { return std::get<double>(value(key, ParamType::Real)); }
+bool Params::boolean(std::string_view key) const { return std::get<bool>(value(key, ParamType::Bool)); }
+const std::string& Params::text(std::string_view key) const {
+  return std::get<std::string>(value(key, ParamType::String));
+}
+glm::dvec3 Params::vec3(std::string_view key) const { return std::get<glm::dvec3>(value(key, ParamType::Vec3)); }
+bool Params::was_set(std::string_view key) const { return set_[index_of(key)]; }
+
+nlohmann::json Params::to_json() const {
+  nlohmann::json j = nlohmann::json::object();
+  for (std::size_t i = 0; i < specs_.size(); ++i) {
+    std::visit(
+        [&](const auto& x) {
+          using T = std::decay_t<decltype(x)>;
+          if constexpr (std::is_same_v<T, glm::dvec3>) j[specs_[i].name] = {x.x, x.y, x.z};
+          else j[specs_[i].name] = x;
+        },
+        values_[i]);
+  }
+  return j;
+}
+
+}  // namespace growbench

@@ -1,0 +1,21 @@
+// Writing plants: OBJ (+MTL, one group per plant part), binary little-endian PLY, and the skeleton on
+// its own (nodes as OBJ vertices, branches as `l` polylines). Every writer returns the bytes written.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "algorithms/plant.hpp"
+#include "harness/mesher.hpp"
+
+namespace growbench {
+
+// Writes PATH (OBJ) and PATH with .mtl (materials); returns the bytes of both. Throws std::runtime_error
+// naming the file when it cannot be written.
+std::uint64_t write_obj(const std::string& path, const OutputMesh& mesh);
+std::uint64_t write_ply(const std::string& path, const OutputMesh& mesh);
+// Node i is vertex i+1; each chain of plant_chains() is one `l` record. A `#r` comment before each
+// vertex gives its radius (comments are ignored by OBJ readers).
+std::uint64_t write_skeleton_obj(const std::string& path, const Plant& plant);
+
+}  // namespace growbench

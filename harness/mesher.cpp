@@ -1,0 +1,170 @@
+#include "harness/mesher.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <glm/gtc/quaternion.hpp>
+
+namespace growbench {
+
+std::vector<std::vector<std::int32_t>> plant_chains(const Plant& plant) {
+  const std::size_t n = plant.nodes.size();
+  std::vector<std::int32_t> main_child(n, kNoParent);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::int32_t p = plant.nodes[i].parent;
+    if (p == kNoParent) continue;
+    auto& mc = main_child[static_cast<std::size_t>(p)];
+    const bool same_shoot = plant.nodes[i].shoot == plant.nodes[static_cast<std::size_t>(p)].shoot;
+    if (mc == kNoParent) {
+      mc = static_cast<std::int32_t>(i);
+    } else if (same_shoot && plant.nodes[static_cast<std::size_t>(mc)].shoot != plant.nodes[static_cast<std::size_t>(p)].shoot) {
+      mc = static_cast<std::int32_t>(i);
+    }
+  }
+  std::vector<std::vector<std::int32_t>> chains;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::int32_t p = plant.nodes[i].parent;
+    const bool starts = p == kNoParent || main_child[static_cast<std::size_t>(p)] != static_cast<std::int32_t>(i);
+    if (!starts) continue;
+    std::vector<std::int32_t> chain;
+    if (p != kNoParent) chain.push_back(p);
+    for (auto c = static_cast<std::int32_t>(i); c != kNoParent; c = main_child[static_cast<std::size_t>(c)]) chain.push_back(c);
+    if (chain.size() >= 2) chains.push_back(std::move(chain));
+  }
+  return chains;
+}
+
+namespace {
+
+glm::vec3 any_perpendicular(const glm::vec3& t) {
+  const glm::vec3 h = std::abs(t.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
+  return glm::normalize(glm::cross(t, h));
+}
+
+void add_tube(OutputMesh& m, const Plant& plant, const std::vector<std::int32_t>& chain, const MesherOptions& o) {
+  // Points and radii along the chain; a side branch starts at its parent's node with its own radius.
+  std::vector<glm::vec3> pts;
+  std::vector<float> rad;
+  for (std::size_t j = 0; j < chain.size(); ++j) {
+    const auto& node = plant.nodes[static_cast<std::size_t>(chain[j])];
+    const glm::vec3 p = node.position;
+    if (!pts.empty() && glm::length(p - pts.back()) < 1e-7f) continue;  // drop zero-length segments
+    // A lateral branch (its first node's shoot differs from the parent's) starts with its own radius.
+    float r = node.radius;
+    if (j == 0 && chain.size() > 1) {
+      const auto& next = plant.nodes[static_cast<std::size_t>(chain[1])];
+      if (next.shoot != node.shoot) r = std::min(r, next.radius);
+    }
+    r = std::max(r, o.min_radius > 0.0f ? o.min_radius : 1e-4f);
+    pts.push_back(p);
+    rad.push_back(r);
+  }
+  if (pts.size() < 2) return;
+  const int sides = std::clamp(o.sides, 3, 64);
+  const auto base = static_cast<std::uint32_t>(m.positions.size());
+  glm::vec3 normal(0.0f);
+  for (std::size_t j = 0; j < pts.size(); ++j) {
+    const glm::vec3 a = pts[j == 0 ? 0 : j - 1], b = pts[j + 1 < pts.size() ? j + 1 : j];
+    const glm::vec3 t = glm::normalize(b - a);
+    // Parallel transport (projection form): keep the previous normal, made perpendicular to t.
+    glm::vec3 nrm = j == 0 ? any_perpendicular(t) : normal - glm::dot(normal, t) * t;
+    if (glm::length(nrm) < 1e-6f) nrm = any_perpendicular(t);
+    normal = glm::normalize(nrm);
+    const glm::vec3 binormal = glm::cross(t, normal);
+    for (int s = 0; s < sides; ++s) {
+      const float ang = 2.0f * std::numbers::pi_v<float> * static_cast<float>(s) / static_cast<float>(sides);
+      const glm::vec3 d = std::cos(ang) * normal + std::sin(ang) * binormal;
+      m.positions.push_back(pts[j] + rad[j] * d);
+      m.normals.push_back(d);
+    }
+  }
+  const auto S = static_cast<std::uint32_t>(sides);
+  for (std::uint32_t j = 0; j + 1 < pts.size(); ++j) {
+    for (std::uint32_t s = 0; s < S; ++s) {
+      const std::uint32_t a = base + j * S + s, b = base + j * S + (s + 1) % S;
+      const std::uint32_t c = a + S, d = b + S;
+      m.triangles.emplace_back(a, b, d);
+      m.triangles.emplace_back(a, d, c);
+    }
+  }
+  if (o.caps) {
+    for (const bool start : {true, false}) {
+      const std::size_t j = start ? 0 : pts.size() - 1;
+      const glm::vec3 t = glm::normalize(pts[start ? 1 : j] - pts[start ? 0 : j - 1]);
+      const auto centre = static_cast<std::uint32_t>(m.positions.size());
+      m.positions.push_back(pts[j]);
+      m.normals.push_back(start ? -t : t);
+      const std::uint32_t ring = base + static_cast<std::uint32_t>(j) * S;
+      for (std::uint32_t s = 0; s < S; ++s) {
+        const std::uint32_t a = ring + s, b = ring + (s + 1) % S;
+        if (start) m.triangles.emplace_back(centre, b, a);
+        else m.triangles.emplace_back(centre, a, b);
+      }
+    }
+  }
+}
+
+void add_organ(OutputMesh& m, const Organ& organ, const MesherOptions& o) {
+  const glm::mat3 r = glm::mat3_cast(organ.orientation);
+  const float L = organ.size;
+  auto emit = [&](const std::vector<glm::vec3>& local, const std::vector<glm::uvec3>& tris) {
+    const auto base = static_cast<std::uint32_t>(m.positions.size());
+    const glm::vec3 n = r * glm::vec3(0, 1, 0);
+    for (const auto& v : local) {
+      m.positions.push_back(organ.position + r * (v * L));
+      m.normals.push_back(n);
+    }
+    for (const auto& t : tris) m.triangles.push_back(t + glm::uvec3(base));
+  };
+  if (!o.leaf_mesh.triangles.empty()) {
+    emit(o.leaf_mesh.vertices, o.leaf_mesh.triangles);
+  } else if (o.leaf_shape == "quad") {
+    emit({{-0.25f, 0, 0}, {0.25f, 0, 0}, {0.25f, 0, 1}, {-0.25f, 0, 1}}, {{0, 2, 1}, {0, 3, 2}});
+  } else {
+    emit({{0, 0, 0}, {0.25f, 0, 0.4f}, {0, 0, 1}, {-0.25f, 0, 0.4f}}, {{0, 2, 1}, {0, 3, 2}});
+  }
+}
+
+}  // namespace
+
+OutputMesh mesh_plant(const Plant& plant, const MesherOptions& o) {
+  OutputMesh m;
+  auto group = [&](const char* name, const char* material, auto&& body) {
+    const auto first = static_cast<std::uint32_t>(m.triangles.size());
+    body();
+    const auto count = static_cast<std::uint32_t>(m.triangles.size()) - first;
+    if (count > 0) m.groups.push_back({name, material, first, count});
+  };
+  group("branches", "bark", [&] {
+    for (const auto& chain : plant_chains(plant)) add_tube(m, plant, chain, o);
+  });
+  group("leaves", "leaf", [&] {
+    for (const auto& organ : plant.organs)
+      if (organ.kind == OrganKind::Leaf || organ.kind == OrganKind::YoungLeaf) add_organ(m, organ, o);
+  });
+  group("flowers", "flower", [&] {
+    for (const auto& organ : plant.organs)
+      if (organ.kind == OrganKind::Flower || organ.kind == OrganKind::Bud) add_organ(m, organ, o);
+  });
+  group("polygons", "leaf", [&] {
+    for (const auto& poly : plant.polygons) {
+      if (poly.vertices.size() < 3) continue;
+      const auto base = static_cast<std::uint32_t>(m.positions.size());
+      glm::vec3 n(0.0f);  // Newell normal
+      for (std::size_t i = 0; i < poly.vertices.size(); ++i) {
+        const glm::vec3 a = poly.vertices[i], b = poly.vertices[(i + 1) % poly.vertices.size()];
+        n += glm::vec3((a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y));
+      }
+      n = glm::length(n) > 0.0f ? glm::normalize(n) : glm::vec3(0, 1, 0);
+      for (const auto& v : poly.vertices) {
+        m.positions.push_back(v);
+        m.normals.push_back(n);
+      }
+      for (std::uint32_t i = 1; i + 1 < poly.vertices.size(); ++i) m.triangles.emplace_back(base, base + i, base + i + 1);
+    }
+  });
+  return m;
+}
+
+}  // namespace growbench

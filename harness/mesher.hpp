@@ -1,0 +1,45 @@
+// One mesher for every algorithm: tubes along branches from node radii, leaves and flowers as
+// instanced shapes, L-system polygons as fans.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "algorithms/plant.hpp"
+#include "scenes/scene.hpp"
+
+namespace growbench {
+
+struct MeshGroup {
+  std::string name;      // "branches", "leaves", "flowers", "polygons"
+  std::string material;  // "bark", "leaf", "flower"
+  std::uint32_t first_triangle = 0;
+  std::uint32_t triangle_count = 0;
+};
+
+struct OutputMesh {
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals;
+  std::vector<glm::uvec3> triangles;
+  std::vector<MeshGroup> groups;
+};
+
+struct MesherOptions {
+  int sides = 6;              // tube cross-section sides (3..64)
+  bool caps = true;           // close tube ends
+  float min_radius = 0.0f;    // radii below this are raised to it (0: as given; zero-radius nodes get 1e-4 m)
+  std::string leaf_shape = "diamond";  // "diamond", "quad"; ignored when leaf_mesh has triangles
+  TriangleMesh leaf_mesh;     // optional instanced leaf: local frame as Organ (+Z blade, +Y up), unit length
+};
+
+OutputMesh mesh_plant(const Plant& plant, const MesherOptions& options = {});
+
+// Chains of nodes along which tubes run: each starts at a root or a branching point and follows the
+// main child (the one that continues the parent's shoot, else the first). Shared with the skeleton
+// exporter so polylines and tubes agree.
+std::vector<std::vector<std::int32_t>> plant_chains(const Plant& plant);
+
+}  // namespace growbench

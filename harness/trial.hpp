@@ -1,0 +1,45 @@
+// One trial: load the scene, build its query, grow a plant, mesh it, export it, and record what every
+// phase cost. The same code path serves `growbench run`, the tests and (later) suites.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+#include "harness/mesher.hpp"
+
+namespace growbench {
+
+struct TrialSpec {
+  std::string algorithm;
+  std::string scene;                      // standard name, *.json, or mesh:PATH
+  std::vector<std::string> scene_params;  // key=value
+  std::vector<std::string> params;        // algorithm key=value (--set)
+  std::uint64_t seed = 1;
+  std::vector<glm::vec3> seed_at;         // replaces the scene's seeds, each snapped to the surface
+  int max_steps = 5000;                   // the step cap for every algorithm
+  double time_limit_s = 0.0;              // 0: none; checked between steps
+  int threads = 0;                        // 0: all cores
+  float voxel_size = 0.0f;                // 0: automatic (see SceneQueryOptions)
+  std::string out_dir;                    // empty: measure but write no files
+  MesherOptions mesher;
+};
+
+struct Progress {
+  int step = 0;
+  std::size_t nodes = 0;
+  double growth_seconds = 0.0;
+};
+
+// Runs a trial. Bad input throws InputError before any growth; everything else is recorded.
+// The returned record is also written to OUT/record.json when out_dir is set.
+nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const Progress&)>& progress = {});
+
+// The build and machine this binary runs on (compiler, flags, build type, versions, CPU, cores).
+nlohmann::json run_context();
+
+}  // namespace growbench

@@ -1,0 +1,23 @@
+// Small geometric building blocks for scenes and tests.
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include "scenes/scene.hpp"
+
+namespace growbench::geom {
+
+// Closest point on triangle (a, b, c) to p (Ericson, Real-Time Collision Detection, 5.1.5).
+glm::vec3 closest_point_on_triangle(const glm::vec3& p, const glm::vec3& a, const glm::vec3& b,
+                                    const glm::vec3& c);
+
+// Closed, outward-facing primitive meshes.
+TriangleMesh make_box(const std::string& name, const glm::vec3& min, const glm::vec3& max);
+TriangleMesh make_cylinder(const std::string& name, const glm::vec3& base, const glm::vec3& top,
+                           float radius_base, float radius_top, int sides);
+TriangleMesh make_icosphere(const std::string& name, const glm::vec3& center, float radius,
+                            int subdivisions);
+
+glm::mat4 trs(const glm::vec3& translate, const glm::vec3& rotate_deg, const glm::vec3& scale);
+
+}  // namespace growbench::geom

@@ -1,0 +1,425 @@
+// Loading scenes: standard scenes by name, scene JSON files (validated, errors name the JSON path),
+// and OBJ meshes as scenes (mesh:PATH).
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+#include <tiny_obj_loader.h>
+
+#include "scenes/geometry.hpp"
+#include "scenes/scene_library.hpp"
+
+namespace growbench {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+TriangleMesh load_obj(const std::string& path) {
+  if (!fs::exists(path)) throw InputError(fmt::format("{}: no such file", path));
+  tinyobj::ObjReaderConfig cfg;
+  cfg.triangulate = true;
+  cfg.vertex_color = false;
+  cfg.mtl_search_path = fs::path(path).parent_path().string();
+  tinyobj::ObjReader reader;
+  if (!reader.ParseFromFile(path, cfg)) {
+    std::string msg = reader.Error();
+    while (!msg.empty() && (msg.back() == '\n' || msg.back() == ' ')) msg.pop_back();
+    throw InputError(fmt::format("{}: not a readable OBJ file: {}", path, msg.empty() ? "parse failed" : msg));
+  }
+  const auto& attrib = reader.GetAttrib();
+  TriangleMesh m;
+  m.name = fs::path(path).stem().string();
+  const std::size_t nv = attrib.vertices.size() / 3;
+  m.vertices.reserve(nv);
+  for (std::size_t i = 0; i < nv; ++i) {
+    const glm::vec3 v(attrib.vertices[3 * i], attrib.vertices[3 * i + 1], attrib.vertices[3 * i + 2]);
+    if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+      throw InputError(fmt::format("{}: vertex {} has a non-finite coordinate", path, i + 1));
+    m.vertices.push_back(v);
+  }
+  for (const auto& shape : reader.GetShapes()) {
+    std::size_t offset = 0;
+    for (const auto fv : shape.mesh.num_face_vertices) {
+      if (fv == 3) {
+        glm::uvec3 t;
+        for (int k = 0; k < 3; ++k) {
+          const int idx = shape.mesh.indices[offset + static_cast<std::size_t>(k)].vertex_index;
+          if (idx < 0 || static_cast<std::size_t>(idx) >= nv)
+            throw InputError(fmt::format("{}: shape '{}' has a face with vertex index {} out of range (1..{})", path,
+                                         shape.name, idx + 1, nv));
+          t[k] = static_cast<unsigned>(idx);
+        }
+        if (t.x != t.y && t.y != t.z && t.x != t.z) m.triangles.push_back(t);
+      }
+      offset += fv;
+    }
+  }
+  if (m.triangles.empty()) throw InputError(fmt::format("{}: the OBJ file has no faces", path));
+  return m;
+}
+
+void fit_scene(Scene& s, float size) {
+  Aabb b;
+  for (const auto& m : s.meshes) b.extend(m.bounds());
+  if (b.empty()) return;
+  const glm::vec3 ext = b.size();
+  const float k = size / std::max({ext.x, ext.y, ext.z, 1e-12f});
+  const glm::vec3 shift(-b.center().x, -b.min.y, -b.center().z);
+  auto f = [&](const glm::vec3& p) { return (p + shift) * k; };
+  for (auto& m : s.meshes)
+    for (auto& v : m.vertices) v = f(v);
+  for (auto& sd : s.seeds) sd.position = f(sd.position);
+  auto fit_shape = [&](Shape& sh) {
+    sh.min = f(sh.min);
+    sh.max = f(sh.max);
+    sh.center = f(sh.center);
+    sh.radii *= k;
+    for (auto& v : sh.mesh.vertices) v = f(v);
+  };
+  if (s.envelope) fit_shape(*s.envelope);
+  for (auto& z : s.zones) fit_shape(z.shape);
+  if (s.light.kind == Light::Kind::Point) s.light.position = f(s.light.position);
+  s.camera.position = f(s.camera.position);
+  s.camera.look_at = f(s.camera.look_at);
+}
+
+namespace {
+
+// Frames a scene's bounds from the front, a little above.
+Camera frame_camera(const Aabb& b) {
+  const glm::vec3 c = b.center();
+  const float r = 0.5f * glm::length(b.size());
+  return {c + glm::vec3(0.35f * r, 0.45f * r, 2.6f * r), c, 45.0f};
+}
+
+Scene mesh_scene(const std::string& path, const Params& p) {
+  Scene s;
+  s.name = fs::path(path).stem().string();
+  s.meshes.push_back(load_obj(path));
+  const auto size = static_cast<float>(p.real("size"));
+  if (size > 0.0f) fit_scene(s, size);
+  const Aabb b = s.meshes[0].bounds();
+  // Default seed: the lowest vertex (lowest index among ties), growing up.
+  const auto& v = s.meshes[0].vertices;
+  const auto low = std::min_element(v.begin(), v.end(), [](const glm::vec3& a, const glm::vec3& c) { return a.y < c.y; });
+  s.seeds.push_back({*low, {0, 1, 0}, 0});
+  if (p.boolean("ground")) {
+    const float half = 0.75f * std::max(b.size().x, b.size().z) + 0.5f;
+    auto g = geom::make_box("ground", {b.center().x - half, b.min.y - 0.1f, b.center().z - half},
+                            {b.center().x + half, b.min.y, b.center().z + half});
+    g.climbable = false;
+    s.meshes.push_back(std::move(g));
+  }
+  Shape env;
+  env.kind = Shape::Kind::Box;
+  const glm::vec3 pad = 0.1f * b.size();
+  env.min = b.min - pad;
+  env.max = b.max + pad;
+  s.envelope = env;
+  s.camera = frame_camera(b);
+  return s;
+}
+
+// A small reader that remembers the JSON path, so every error says where it is.
+class JsonScene {
+ public:
+  JsonScene(std::string file, fs::path dir) : file_(std::move(file)), dir_(std::move(dir)) {}
+
+  [[noreturn]] void fail(const std::string& path, const std::string& what) const {
+    throw InputError(fmt::format("{}: at {}: {}", file_, path.empty() ? "/" : path, what));
+  }
+
+  void only_keys(const json& j, const std::string& path, const std::vector<std::string>& keys) const {
+    if (!j.is_object()) fail(path, fmt::format("expected an object, got {}", j.type_name()));
+    for (const auto& [k, v] : j.items()) {
+      if (std::find(keys.begin(), keys.end(), k) == keys.end()) {
+        const std::string near = closest_match(k, keys);
+        fail(path + "/" + k, fmt::format("unknown key '{}'{}; expected one of {}", k,
+                                         near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near),
+                                         fmt::join(keys, ", ")));
+      }
+    }
+  }
+  const json& need(const json& j, const std::string& path, const char* key) const {
+    if (!j.contains(key)) fail(path, fmt::format("missing required key '{}'", key));
+    return j.at(key);
+  }
+  float number(const json& j, const std::string& path, float lo = -1e30f, float hi = 1e30f) const {
+    if (!j.is_number()) fail(path, fmt::format("expected a number, got {}", j.dump()));
+    const double v = j.get<double>();
+    if (!std::isfinite(v) || v < lo || v > hi) fail(path, fmt::format("expected a number in [{}, {}], got {}", lo, hi, v));
+    return static_cast<float>(v);
+  }
+  glm::vec3 vec3(const json& j, const std::string& path) const {
+    if (!j.is_array() || j.size() != 3) fail(path, fmt::format("expected an array of three numbers, got {}", j.dump()));
+    return {number(j[0], path + "/0"), number(j[1], path + "/1"), number(j[2], path + "/2")};
+  }
+  std::string string(const json& j, const std::string& path) const {
+    if (!j.is_string()) fail(path, fmt::format("expected a string, got {}", j.dump()));
+    return j.get<std::string>();
+  }
+  std::string resolve(const std::string& rel) const {
+    const fs::path p(rel);
+    return (p.is_absolute() ? p : dir_ / p).string();
+  }
+
+  TriangleMesh mesh(const json& j, const std::string& path) const {
+    only_keys(j, path, {"name", "obj", "box", "sphere", "cylinder", "transform", "climbable"});
+    TriangleMesh m;
+    const std::string name = j.contains("name") ? string(j["name"], path + "/name") : "mesh";
+    int kinds = 0;
+    if (j.contains("obj")) {
+      ++kinds;
+      const std::string f = resolve(string(j["obj"], path + "/obj"));
+      try {
+        m = load_obj(f);
+      } catch (const InputError& e) {
+        fail(path + "/obj", e.what());
+      }
+    }
+    if (j.contains("box")) {
+      ++kinds;
+      const auto& b = j["box"];
+      only_keys(b, path + "/box", {"min", "max"});
+      const glm::vec3 lo = vec3(need(b, path + "/box", "min"), path + "/box/min");
+      const glm::vec3 hi = vec3(need(b, path + "/box", "max"), path + "/box/max");
+      if (glm::any(glm::lessThanEqual(hi, lo))) fail(path + "/box", "expected max > min on every axis");
+      m = geom::make_box(name, lo, hi);
+    }
+    if (j.contains("sphere")) {
+      ++kinds;
+      const auto& s = j["sphere"];
+      only_keys(s, path + "/sphere", {"center", "radius", "subdivisions"});
+      const int sub = s.contains("subdivisions") ? static_cast<int>(number(s["subdivisions"], path + "/sphere/subdivisions", 0, 7)) : 4;
+      m = geom::make_icosphere(name, vec3(need(s, path + "/sphere", "center"), path + "/sphere/center"),
+                               number(need(s, path + "/sphere", "radius"), path + "/sphere/radius", 1e-6f), sub);
+    }
+    if (j.contains("cylinder")) {
+      ++kinds;
+      const auto& c = j["cylinder"];
+      const std::string cp = path + "/cylinder";
+      only_keys(c, cp, {"base", "top", "radius", "top_radius", "sides"});
+      const float r = number(need(c, cp, "radius"), cp + "/radius", 1e-6f);
+      const float rt = c.contains("top_radius") ? number(c["top_radius"], cp + "/top_radius", 1e-6f) : r;
+      const int sides = c.contains("sides") ? static_cast<int>(number(c["sides"], cp + "/sides", 3, 1024)) : 32;
+      const glm::vec3 base = vec3(need(c, cp, "base"), cp + "/base"), top = vec3(need(c, cp, "top"), cp + "/top");
+      if (glm::length(top - base) <= 0.0f) fail(cp, "expected top != base");
+      m = geom::make_cylinder(name, base, top, r, rt, sides);
+    }
+    if (kinds != 1) fail(path, "expected exactly one of 'obj', 'box', 'sphere', 'cylinder'");
+    m.name = name;
+    if (j.contains("transform")) {
+      const auto& t = j["transform"];
+      const std::string tp = path + "/transform";
+      only_keys(t, tp, {"translate", "rotate_deg", "scale"});
+      glm::vec3 scale(1.0f);
+      if (t.contains("scale")) {
+        if (t["scale"].is_number()) scale = glm::vec3(number(t["scale"], tp + "/scale", 1e-9f));
+        else scale = vec3(t["scale"], tp + "/scale");
+        if (glm::any(glm::equal(scale, glm::vec3(0.0f)))) fail(tp + "/scale", "expected non-zero scale factors");
+      }
+      m.transform(geom::trs(t.contains("translate") ? vec3(t["translate"], tp + "/translate") : glm::vec3(0.0f),
+                            t.contains("rotate_deg") ? vec3(t["rotate_deg"], tp + "/rotate_deg") : glm::vec3(0.0f),
+                            scale));
+    }
+    if (j.contains("climbable")) {
+      if (!j["climbable"].is_boolean()) fail(path + "/climbable", "expected true or false");
+      m.climbable = j["climbable"].get<bool>();
+    }
+    return m;
+  }
+
+  Shape shape(const json& j, const std::string& path) const {
+    Shape s;
+    const std::string type = string(need(j, path, "type"), path + "/type");
+    if (type == "box") {
+      only_keys(j, path, {"type", "min", "max"});
+      s.kind = Shape::Kind::Box;
+      s.min = vec3(need(j, path, "min"), path + "/min");
+      s.max = vec3(need(j, path, "max"), path + "/max");
+      if (glm::any(glm::lessThanEqual(s.max, s.min))) fail(path, "expected max > min on every axis");
+    } else if (type == "sphere") {
+      only_keys(j, path, {"type", "center", "radius"});
+      s.kind = Shape::Kind::Sphere;
+      s.center = vec3(need(j, path, "center"), path + "/center");
+      const auto& r = need(j, path, "radius");
+      s.radii = r.is_array() ? vec3(r, path + "/radius") : glm::vec3(number(r, path + "/radius", 1e-6f));
+      if (glm::any(glm::lessThanEqual(s.radii, glm::vec3(0.0f)))) fail(path + "/radius", "expected positive radii");
+    } else if (type == "mesh") {
+      only_keys(j, path, {"type", "obj"});
+      s.kind = Shape::Kind::Mesh;
+      try {
+        s.mesh = load_obj(resolve(string(need(j, path, "obj"), path + "/obj")));
+      } catch (const InputError& e) {
+        fail(path + "/obj", e.what());
+      }
+      if (!s.mesh.is_closed()) fail(path + "/obj", "a mesh shape must be a closed mesh");
+    } else {
+      fail(path + "/type", fmt::format("unknown shape type '{}'; expected box, sphere or mesh", type));
+    }
+    return s;
+  }
+
+  Scene scene(const json& j) const {
+    only_keys(j, "", {"schema_version", "name", "base", "base_params", "meshes", "seeds", "light", "envelope", "zones",
+                      "camera"});
+    const auto& ver = need(j, "", "schema_version");
+    if (!ver.is_number_integer() || ver.get<int>() != 1)
+      fail("/schema_version", fmt::format("expected 1 (the only scene schema so far), got {}", ver.dump()));
+    Scene s;
+    if (j.contains("base")) {
+      std::vector<std::string> params;
+      if (j.contains("base_params")) {
+        const auto& bp = j["base_params"];
+        if (!bp.is_object()) fail("/base_params", "expected an object of scene parameters");
+        for (const auto& [k, v] : bp.items())
+          params.push_back(k + "=" + (v.is_string() ? v.get<std::string>() : v.dump()));
+      }
+      std::string base = string(j["base"], "/base");
+      if (base.rfind("mesh:", 0) == 0) base = "mesh:" + resolve(base.substr(5));
+      try {
+        s = load_scene(base, params);
+      } catch (const InputError& e) {
+        fail("/base", e.what());
+      }
+    }
+    s.name = j.contains("name") ? string(j["name"], "/name") : fs::path(file_).stem().string();
+    if (j.contains("meshes")) {
+      const auto& ms = j["meshes"];
+      if (!ms.is_array()) fail("/meshes", "expected an array of meshes");
+      for (std::size_t i = 0; i < ms.size(); ++i) s.meshes.push_back(mesh(ms[i], fmt::format("/meshes/{}", i)));
+    }
+    if (s.meshes.empty()) fail("/meshes", "a scene needs at least one mesh (or a 'base')");
+    if (j.contains("seeds")) {
+      const auto& ss = j["seeds"];
+      if (!ss.is_array()) fail("/seeds", "expected an array of seeds");
+      s.seeds.clear();
+      for (std::size_t i = 0; i < ss.size(); ++i) {
+        const std::string p = fmt::format("/seeds/{}", i);
+        only_keys(ss[i], p, {"position", "direction", "start_step"});
+        Seed sd;
+        sd.position = vec3(need(ss[i], p, "position"), p + "/position");
+        if (ss[i].contains("direction")) {
+          sd.direction = vec3(ss[i]["direction"], p + "/direction");
+          if (glm::length(sd.direction) <= 0.0f) fail(p + "/direction", "expected a non-zero direction");
+          sd.direction = glm::normalize(sd.direction);
+        }
+        if (ss[i].contains("start_step")) sd.start_step = static_cast<int>(number(ss[i]["start_step"], p + "/start_step", 0, 1e9f));
+        s.seeds.push_back(sd);
+      }
+    }
+    if (s.seeds.empty()) fail("/seeds", "a scene needs at least one seed (or a 'base' that has seeds)");
+    if (j.contains("light")) {
+      const auto& l = j["light"];
+      const std::string type = string(need(l, "/light", "type"), "/light/type");
+      if (type == "sun") {
+        only_keys(l, "/light", {"type", "direction"});
+        s.light.kind = Light::Kind::Sun;
+        s.light.direction = vec3(need(l, "/light", "direction"), "/light/direction");
+        if (glm::length(s.light.direction) <= 0.0f) fail("/light/direction", "expected a non-zero direction");
+      } else if (type == "point") {
+        only_keys(l, "/light", {"type", "position"});
+        s.light.kind = Light::Kind::Point;
+        s.light.position = vec3(need(l, "/light", "position"), "/light/position");
+      } else {
+        fail("/light/type", fmt::format("unknown light type '{}'; expected sun or point", type));
+      }
+    }
+    if (j.contains("envelope")) s.envelope = shape(j["envelope"], "/envelope");
+    if (j.contains("zones")) {
+      const auto& zs = j["zones"];
+      if (!zs.is_array()) fail("/zones", "expected an array of zones");
+      for (std::size_t i = 0; i < zs.size(); ++i) {
+        const std::string p = fmt::format("/zones/{}", i);
+        only_keys(zs[i], p, {"kind", "shape", "strength"});
+        Zone z;
+        const std::string kind = string(need(zs[i], p, "kind"), p + "/kind");
+        if (kind == "attract") z.kind = Zone::Kind::Attract;
+        else if (kind == "repel") z.kind = Zone::Kind::Repel;
+        else if (kind == "include") z.kind = Zone::Kind::Include;
+        else if (kind == "exclude") z.kind = Zone::Kind::Exclude;
+        else fail(p + "/kind", fmt::format("unknown zone kind '{}'; expected attract, repel, include or exclude", kind));
+        z.shape = shape(need(zs[i], p, "shape"), p + "/shape");
+        if (zs[i].contains("strength")) z.strength = number(zs[i]["strength"], p + "/strength", 0.0f, 1e6f);
+        s.zones.push_back(std::move(z));
+      }
+    }
+    if (j.contains("camera")) {
+      const auto& c = j["camera"];
+      only_keys(c, "/camera", {"position", "look_at", "fov_deg"});
+      s.camera.position = vec3(need(c, "/camera", "position"), "/camera/position");
+      s.camera.look_at = vec3(need(c, "/camera", "look_at"), "/camera/look_at");
+      if (c.contains("fov_deg")) s.camera.fov_deg = number(c["fov_deg"], "/camera/fov_deg", 1.0f, 170.0f);
+    } else if (!j.contains("base")) {
+      s.camera = frame_camera(s.bounds());
+    }
+    return s;
+  }
+
+ private:
+  std::string file_;
+  fs::path dir_;
+};
+
+Scene json_scene(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(fmt::format("{}: cannot open scene file", path));
+  json j;
+  try {
+    j = json::parse(in);
+  } catch (const json::parse_error& e) {
+    // nlohmann reports the byte offset; turn it into line:column.
+    in.clear();
+    in.seekg(0);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::size_t line = 1, col = 1;
+    for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
+      if (text[i] == '\n') {
+        ++line;
+        col = 1;
+      } else {
+        ++col;
+      }
+    }
+    std::string msg = e.what();
+    if (const auto p = msg.find("parse error"); p != std::string::npos) msg = msg.substr(p);
+    throw InputError(fmt::format("{}:{}:{}: invalid JSON: {}", path, line, col, msg));
+  }
+  return JsonScene(path, fs::path(path).parent_path()).scene(j);
+}
+
+}  // namespace
+
+Scene load_scene(const std::string& spec, const std::vector<std::string>& assignments) {
+  Scene s;
+  if (spec.rfind("mesh:", 0) == 0) {
+    const std::string path = spec.substr(5);
+    Params p(fmt::format("scene '{}'", spec), mesh_scene_params());
+    for (const auto& a : assignments) p.set_assignment(a);
+    s = mesh_scene(path, p);
+  } else if (spec.size() > 5 && spec.substr(spec.size() - 5) == ".json") {
+    if (!assignments.empty())
+      throw InputError(fmt::format("scene '{}': scene parameters go in the file's 'base_params', not on the command line", spec));
+    s = json_scene(spec);
+  } else {
+    const auto& list = standard_scenes();
+    const auto it = std::find_if(list.begin(), list.end(), [&](const StandardScene& st) { return st.name == spec; });
+    if (it == list.end()) {
+      std::vector<std::string> names;
+      for (const auto& st : list) names.push_back(st.name);
+      const std::string near = closest_match(spec, names);
+      throw InputError(fmt::format("unknown scene '{}'{}; expected one of {}, a scene file *.json, or mesh:PATH.obj",
+                                   spec, near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near),
+                                   fmt::join(names, ", ")));
+    }
+    Params p(fmt::format("scene '{}'", spec), it->params);
+    for (const auto& a : assignments) p.set_assignment(a);
+    s = it->build(p);
+  }
+  s.source = spec;
+  return s;
+}
+
+}  // namespace growbench

@@ -1,0 +1,35 @@
+// Where scenes come from: the standard scenes built in code, scene JSON files, and any OBJ file.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/params.hpp"
+#include "scenes/scene.hpp"
+
+namespace growbench {
+
+struct StandardScene {
+  std::string name;
+  std::string summary;
+  std::vector<ParamSpec> params;
+  Scene (*build)(const Params&);
+};
+
+// The eight standard scenes: wall, facade, column, corner, pergola, boulder, trunk, envelope.
+const std::vector<StandardScene>& standard_scenes();
+// Parameters of `mesh:PATH` scenes (size, ground).
+const std::vector<ParamSpec>& mesh_scene_params();
+
+// Loads a scene from a spec: a standard scene's name, a scene JSON file (*.json), or mesh:PATH for an OBJ.
+// `assignments` are key=value scene parameters (for standard and mesh scenes). Throws InputError.
+Scene load_scene(const std::string& spec, const std::vector<std::string>& assignments = {});
+
+// Reads an OBJ file as one triangle mesh (polygons are triangulated). Throws InputError naming the file.
+TriangleMesh load_obj(const std::string& path);
+
+// Uniformly scales `scene`'s meshes (and seeds, envelope, zones, camera) so the largest extent of the
+// meshes' bounds is `size`, resting on y = 0 and centred on x = z = 0.
+void fit_scene(Scene& scene, float size);
+
+}  // namespace growbench

@@ -1,0 +1,298 @@
+#include "scenes/scene_query.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <embree3/rtcore.h>
+#include <fmt/format.h>
+
+#include "core/random.hpp"
+#include "scenes/geometry.hpp"
+#include "scenes/sdf.hpp"
+
+namespace growbench {
+
+namespace {
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+glm::vec3 face_normal(const TriangleMesh& m, std::uint32_t tri) {
+  const auto& t = m.triangles[tri];
+  const glm::vec3 n = glm::cross(m.vertices[t.y] - m.vertices[t.x], m.vertices[t.z] - m.vertices[t.x]);
+  const float len = glm::length(n);
+  return len > 0.0f ? n / len : glm::vec3(0.0f, 1.0f, 0.0f);
+}
+
+// Embree calls this from C code, so it must not throw: it prints, and callers check rtcGetDeviceError.
+void embree_error(void*, RTCError code, const char* str) {
+  fmt::print(stderr, "Embree error {}: {}\n", static_cast<int>(code), str ? str : "");
+}
+
+// One Embree scene over a list of meshes (geometry ID = index in the list).
+struct BvhScene {
+  RTCScene scene = nullptr;
+  std::vector<const TriangleMesh*> meshes;
+
+  BvhScene(RTCDevice device, std::vector<const TriangleMesh*> ms) : meshes(std::move(ms)) {
+    scene = rtcNewScene(device);
+    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
+    for (std::size_t i = 0; i < meshes.size(); ++i) {
+      const TriangleMesh& m = *meshes[i];
+      RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+      auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                             3 * sizeof(float), m.vertices.size()));
+      std::copy_n(&m.vertices[0].x, 3 * m.vertices.size(), vb);
+      auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                3 * sizeof(unsigned), m.triangles.size()));
+      std::copy_n(&m.triangles[0].x, 3 * m.triangles.size(), ib);
+      rtcCommitGeometry(g);
+      rtcAttachGeometryByID(scene, g, static_cast<unsigned>(i));
+      rtcReleaseGeometry(g);
+    }
+    rtcCommitScene(scene);
+    if (const RTCError e = rtcGetDeviceError(device); e != RTC_ERROR_NONE)
+      throw std::runtime_error(fmt::format("Embree: building the BVH failed (error {})", static_cast<int>(e)));
+  }
+  ~BvhScene() {
+    if (scene) rtcReleaseScene(scene);
+  }
+  BvhScene(const BvhScene&) = delete;
+  BvhScene& operator=(const BvhScene&) = delete;
+
+  RayHit ray(const glm::vec3& o, const glm::vec3& d, float tmin, float tmax) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh{};
+    rh.ray.org_x = o.x;
+    rh.ray.org_y = o.y;
+    rh.ray.org_z = o.z;
+    rh.ray.dir_x = d.x;
+    rh.ray.dir_y = d.y;
+    rh.ray.dir_z = d.z;
+    rh.ray.tnear = tmin;
+    rh.ray.tfar = tmax;
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(scene, &ctx, &rh);
+    RayHit r;
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return r;
+    r.hit = true;
+    r.t = rh.ray.tfar;
+    r.point = o + r.t * d;
+    r.mesh = rh.hit.geomID;
+    r.triangle = rh.hit.primID;
+    r.normal = face_normal(*meshes[r.mesh], r.triangle);
+    return r;
+  }
+
+  bool occluded(const glm::vec3& o, const glm::vec3& d, float tmin, float tmax) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRay ray{};
+    ray.org_x = o.x;
+    ray.org_y = o.y;
+    ray.org_z = o.z;
+    ray.dir_x = d.x;
+    ray.dir_y = d.y;
+    ray.dir_z = d.z;
+    ray.tnear = tmin;
+    ray.tfar = tmax;
+    ray.mask = 0xFFFFFFFFu;
+    rtcOccluded1(scene, &ctx, &ray);
+    return ray.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
+  }
+
+  // Ray parity along a fixed, irrational-ish direction (avoids grazing axis-aligned edges).
+  bool inside_by_parity(const glm::vec3& p) const {
+    const glm::vec3 d = glm::normalize(glm::vec3(0.5773f, 0.6170f, 0.5348f));
+    int crossings = 0;
+    float t = 0.0f;
+    for (int guard = 0; guard < 10000; ++guard) {
+      const RayHit h = ray(p, d, t, std::numeric_limits<float>::infinity());
+      if (!h.hit) break;
+      ++crossings;
+      t = h.t + 1e-5f * std::max(1.0f, h.t);
+    }
+    return (crossings & 1) != 0;
+  }
+};
+
+struct PointQueryState {
+  const std::vector<const TriangleMesh*>* meshes;
+  ClosestHit best;
+};
+
+bool point_query_callback(RTCPointQueryFunctionArguments* args) {
+  auto* st = static_cast<PointQueryState*>(args->userPtr);
+  const TriangleMesh& m = *(*st->meshes)[args->geomID];
+  const auto& t = m.triangles[args->primID];
+  const glm::vec3 p(args->query->x, args->query->y, args->query->z);
+  const glm::vec3 q = geom::closest_point_on_triangle(p, m.vertices[t.x], m.vertices[t.y], m.vertices[t.z]);
+  const float d = glm::length(q - p);
+  // Ties go to the lower (mesh, triangle): the answer does not depend on BVH traversal order.
+  if (d < args->query->radius ||
+      (d == st->best.distance && std::pair(args->geomID, args->primID) < std::pair(st->best.mesh, st->best.triangle))) {
+    st->best.found = true;
+    st->best.point = q;
+    st->best.distance = d;
+    st->best.mesh = args->geomID;
+    st->best.triangle = args->primID;
+    args->query->radius = d;
+    return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+struct SceneQuery::Embree {
+  RTCDevice device = nullptr;
+  std::unique_ptr<BvhScene> main;
+  std::vector<std::pair<const Shape*, std::unique_ptr<BvhScene>>> shapes;  // mesh envelopes/zones
+  Embree() {
+    device = rtcNewDevice("threads=0");
+    if (!device) throw std::runtime_error(fmt::format("Embree: cannot create a device (error {})", static_cast<int>(rtcGetDeviceError(nullptr))));
+    rtcSetDeviceErrorFunction(device, embree_error, nullptr);
+  }
+  ~Embree() {
+    shapes.clear();
+    main.reset();
+    rtcReleaseDevice(device);
+  }
+  Embree(const Embree&) = delete;
+  Embree& operator=(const Embree&) = delete;
+};
+
+SceneQuery::SceneQuery(const Scene& scene, SceneQueryOptions options)
+    : scene_(scene), options_(options), embree_(std::make_unique<Embree>()) {
+  if (scene.meshes.empty()) throw InputError(fmt::format("scene '{}' has no meshes", scene.name));
+  for (const auto& m : scene.meshes)
+    if (m.triangles.empty()) throw InputError(fmt::format("scene '{}': mesh '{}' has no triangles", scene.name, m.name));
+
+  auto t0 = std::chrono::steady_clock::now();
+  std::vector<const TriangleMesh*> ptrs;
+  for (const auto& m : scene.meshes) ptrs.push_back(&m);
+  embree_->main = std::make_unique<BvhScene>(embree_->device, ptrs);
+  auto add_shape = [&](const Shape& s) {
+    if (s.kind == Shape::Kind::Mesh)
+      embree_->shapes.emplace_back(&s, std::make_unique<BvhScene>(embree_->device, std::vector{&s.mesh}));
+  };
+  if (scene.envelope) add_shape(*scene.envelope);
+  for (const auto& z : scene.zones) add_shape(z.shape);
+  bvh_seconds_ = seconds_since(t0);
+
+  // Area CDF for surface sampling.
+  bool any_climbable = false;
+  for (const auto& m : scene.meshes) any_climbable = any_climbable || m.climbable;
+  double acc = 0.0;
+  for (std::uint32_t mi = 0; mi < scene.meshes.size(); ++mi) {
+    const auto& m = scene.meshes[mi];
+    if (any_climbable && !m.climbable) continue;
+    for (std::uint32_t ti = 0; ti < m.triangles.size(); ++ti) {
+      const auto& t = m.triangles[ti];
+      acc += 0.5 * glm::length(glm::cross(m.vertices[t.y] - m.vertices[t.x], m.vertices[t.z] - m.vertices[t.x]));
+      cdf_.push_back(acc);
+      cdf_tri_.emplace_back(mi, ti);
+    }
+  }
+  total_area_ = acc;
+
+  closed_.reserve(scene.meshes.size());
+  for (const auto& m : scene.meshes) closed_.push_back(m.is_closed());
+  Aabb b;
+  for (const auto& m : scene.meshes) b.extend(m.bounds());
+  voxel_size_ = options.voxel_size > 0.0f ? options.voxel_size : glm::length(b.size()) / 256.0f;
+  if (!(voxel_size_ > 0.0f) || !std::isfinite(voxel_size_))
+    throw InputError(fmt::format("scene '{}': cannot size the distance field (degenerate bounds)", scene.name));
+  if (options.build_sdf) {
+    t0 = std::chrono::steady_clock::now();
+    sdf_ = std::make_unique<SdfGrid>(scene.meshes, closed_, voxel_size_, options.band_voxels);
+    sdf_seconds_ = seconds_since(t0);
+  }
+}
+
+SceneQuery::~SceneQuery() = default;
+
+ClosestHit SceneQuery::closest_point(const glm::vec3& p, float max_distance) const {
+  RTCPointQuery q{};
+  q.x = p.x;
+  q.y = p.y;
+  q.z = p.z;
+  q.time = 0.0f;
+  q.radius = max_distance;
+  RTCPointQueryContext ctx;
+  rtcInitPointQueryContext(&ctx);
+  PointQueryState st{&embree_->main->meshes, {}};
+  rtcPointQuery(embree_->main->scene, &q, &ctx, point_query_callback, &st);
+  if (st.best.found) st.best.normal = face_normal(scene_.meshes[st.best.mesh], st.best.triangle);
+  return st.best;
+}
+
+RayHit SceneQuery::ray(const glm::vec3& origin, const glm::vec3& dir, float tmax, float tmin) const {
+  return embree_->main->ray(origin, dir, tmin, tmax);
+}
+
+bool SceneQuery::occluded(const glm::vec3& origin, const glm::vec3& dir, float tmax, float tmin) const {
+  return embree_->main->occluded(origin, dir, tmin, tmax);
+}
+
+bool SceneQuery::light_visible(const glm::vec3& p, float bias) const {
+  const glm::vec3 d = scene_.light.towards(p);
+  return !occluded(p, d, scene_.light.distance(p), bias);
+}
+
+float SceneQuery::signed_distance(const glm::vec3& p) const {
+  if (!sdf_) throw std::logic_error("SceneQuery: the distance field was not built");
+  const float v = sdf_->sample(p);
+  const float band = sdf_->background();
+  if (std::abs(v) < 0.999f * band) return v;
+  // Beyond the band: exact distance from Embree, sign from the level set.
+  const float d = closest_point(p).distance;
+  return v < 0.0f ? -d : d;
+}
+
+glm::vec3 SceneQuery::gradient(const glm::vec3& p) const {
+  if (!sdf_) throw std::logic_error("SceneQuery: the distance field was not built");
+  const float h = 0.5f * voxel_size_;
+  const float v = sdf_->sample(p);
+  if (std::abs(v) < 0.999f * sdf_->background() - h) {
+    const glm::vec3 g((sdf_->sample(p + glm::vec3(h, 0, 0)) - sdf_->sample(p - glm::vec3(h, 0, 0))),
+                      (sdf_->sample(p + glm::vec3(0, h, 0)) - sdf_->sample(p - glm::vec3(0, h, 0))),
+                      (sdf_->sample(p + glm::vec3(0, 0, h)) - sdf_->sample(p - glm::vec3(0, 0, h))));
+    const float len = glm::length(g);
+    if (len > 1e-12f) return g / len;
+  }
+  // Beyond the band (or a flat spot): the direction from the closest surface point.
+  const ClosestHit c = closest_point(p);
+  const glm::vec3 d = p - c.point;
+  const float len = glm::length(d);
+  if (len > 1e-12f) return (v < 0.0f ? -d : d) / len;
+  return c.normal;
+}
+
+bool SceneQuery::inside_shape(const Shape& shape, const glm::vec3& p) const {
+  if (shape.kind != Shape::Kind::Mesh) return shape.contains_analytic(p);
+  for (const auto& [s, bvh] : embree_->shapes)
+    if (s == &shape) return bvh->inside_by_parity(p);
+  throw std::logic_error("SceneQuery::inside_shape: mesh shape is not part of this scene");
+}
+
+SurfaceSample SceneQuery::sample_surface(std::uint64_t seed, std::uint64_t index) const {
+  Rng rng(seed, 0x5A3F1Eull, 3 * index);
+  const double u = rng.uniform() * total_area_;
+  auto it = std::upper_bound(cdf_.begin(), cdf_.end(), u);
+  if (it == cdf_.end()) --it;
+  const auto [mi, ti] = cdf_tri_[static_cast<std::size_t>(it - cdf_.begin())];
+  const auto& m = scene_.meshes[mi];
+  const auto& t = m.triangles[ti];
+  const double r1 = std::sqrt(rng.uniform()), r2 = rng.uniform();
+  const auto a = static_cast<float>(1.0 - r1), b = static_cast<float>(r1 * (1.0 - r2)), c = static_cast<float>(r1 * r2);
+  return {a * m.vertices[t.x] + b * m.vertices[t.y] + c * m.vertices[t.z], face_normal(m, ti), mi, ti};
+}
+
+std::size_t SceneQuery::sdf_active_voxels() const { return sdf_ ? sdf_->active_voxels() : 0; }
+
+}  // namespace growbench

@@ -1,0 +1,113 @@
+// Spatial queries on a scene, built once and safe for concurrent use from many threads.
+//
+//  * Embree BVH: closest point (rtcPointQuery, optionally bounded), ray cast, occlusion, light visibility.
+//  * OpenVDB narrow-band level set: signed distance, gradient, inside test.
+//
+// Signed distance. Each closed mesh becomes a level set (negative inside) and the scene's field is their
+// CSG union, so touching or overlapping solids need no boolean meshing. An open mesh (a lone wall quad,
+// the teapot) has no inside: it contributes an unsigned distance, so points near it are never "inside"
+// and growth is kept off it only by distance. Within the narrow band (band_voxels on each side) the
+// value is OpenVDB's trilinear sample; beyond it the magnitude is Embree's exact closest-point distance
+// and the sign is the band's (inside tiles are negative), so distances are right everywhere, not
+// clamped at the band.
+//
+// Lifetime: the query refers to the scene's meshes; the scene must outlive it.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "scenes/scene.hpp"
+
+namespace growbench {
+
+struct SceneQueryOptions {
+  float voxel_size = 0.0f;  // 0: the meshes' bounding-box diagonal / 256
+  float band_voxels = 3.0f;
+  bool build_sdf = true;    // false: only Embree (signed_distance etc. then throw)
+};
+
+struct ClosestHit {
+  bool found = false;
+  glm::vec3 point{0.0f};
+  glm::vec3 normal{0.0f};  // unit face normal of the closest triangle (outward for closed meshes)
+  float distance = std::numeric_limits<float>::infinity();
+  std::uint32_t mesh = 0, triangle = 0;
+};
+
+struct RayHit {
+  bool hit = false;
+  float t = std::numeric_limits<float>::infinity();
+  glm::vec3 point{0.0f};
+  glm::vec3 normal{0.0f};  // unit face normal (as wound; not flipped toward the ray)
+  std::uint32_t mesh = 0, triangle = 0;
+};
+
+struct SurfaceSample {
+  glm::vec3 position{0.0f};
+  glm::vec3 normal{0.0f};
+  std::uint32_t mesh = 0, triangle = 0;
+};
+
+class SdfGrid;  // OpenVDB, in sdf.cpp only
+
+class SceneQuery {
+ public:
+  explicit SceneQuery(const Scene& scene, SceneQueryOptions options = {});
+  ~SceneQuery();
+  SceneQuery(const SceneQuery&) = delete;
+  SceneQuery& operator=(const SceneQuery&) = delete;
+
+  // Closest surface point within max_distance (not found beyond it).
+  [[nodiscard]] ClosestHit closest_point(const glm::vec3& p,
+                                         float max_distance = std::numeric_limits<float>::infinity()) const;
+  // First hit along origin + t dir for t in (tmin, tmax); dir need not be normalised (t is in its units).
+  [[nodiscard]] RayHit ray(const glm::vec3& origin, const glm::vec3& dir,
+                           float tmax = std::numeric_limits<float>::infinity(), float tmin = 0.0f) const;
+  [[nodiscard]] bool occluded(const glm::vec3& origin, const glm::vec3& dir,
+                              float tmax = std::numeric_limits<float>::infinity(), float tmin = 0.0f) const;
+  // Whether p sees the scene's light (a ray towards it, offset by `bias` to leave the surface).
+  [[nodiscard]] bool light_visible(const glm::vec3& p, float bias = 1e-4f) const;
+
+  [[nodiscard]] float signed_distance(const glm::vec3& p) const;
+  // Unit gradient of the signed distance (points away from the nearest surface, outwards).
+  [[nodiscard]] glm::vec3 gradient(const glm::vec3& p) const;
+  [[nodiscard]] bool inside(const glm::vec3& p) const { return signed_distance(p) < 0.0f; }
+  // Inside a shape (envelope or zone). Boxes and ellipsoids analytically; mesh shapes by ray parity.
+  [[nodiscard]] bool inside_shape(const Shape& shape, const glm::vec3& p) const;
+
+  // Area-weighted uniform sample on the climbable meshes (all meshes if none is climbable): a pure
+  // function of (seed, index).
+  [[nodiscard]] SurfaceSample sample_surface(std::uint64_t seed, std::uint64_t index) const;
+  [[nodiscard]] double sampled_area() const { return total_area_; }
+
+  [[nodiscard]] const Scene& scene() const { return scene_; }
+  [[nodiscard]] float voxel_size() const { return voxel_size_; }
+  [[nodiscard]] float band_width() const { return voxel_size_ * options_.band_voxels; }
+  [[nodiscard]] bool has_sdf() const { return sdf_ != nullptr; }
+  [[nodiscard]] double bvh_build_seconds() const { return bvh_seconds_; }
+  [[nodiscard]] double sdf_build_seconds() const { return sdf_seconds_; }
+  [[nodiscard]] std::size_t sdf_active_voxels() const;
+  // Per mesh: whether it is closed (has an inside in the SDF).
+  [[nodiscard]] const std::vector<bool>& mesh_closed() const { return closed_; }
+
+ private:
+  struct Embree;
+  const Scene& scene_;
+  SceneQueryOptions options_;
+  std::unique_ptr<Embree> embree_;
+  std::unique_ptr<SdfGrid> sdf_;
+  std::vector<bool> closed_;
+  float voxel_size_ = 0.0f;
+  double bvh_seconds_ = 0.0, sdf_seconds_ = 0.0;
+  // Surface sampling: cumulative areas over (mesh, triangle) pairs.
+  std::vector<double> cdf_;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> cdf_tri_;
+  double total_area_ = 0.0;
+};
+
+}  // namespace growbench

@@ -1,0 +1,31 @@
+// The OpenVDB signed distance grid behind SceneQuery. Only sdf.cpp includes OpenVDB (a slow header).
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "scenes/scene.hpp"
+
+namespace growbench {
+
+class SdfGrid {
+ public:
+  // closed[i]: mesh i becomes a signed level set; otherwise an unsigned distance field.
+  SdfGrid(const std::vector<TriangleMesh>& meshes, const std::vector<bool>& closed, float voxel_size,
+          float band_voxels);
+  ~SdfGrid();
+  // Trilinear sample in world space; returns +/- band width outside the narrow band (sign kept).
+  [[nodiscard]] float sample(const glm::vec3& p) const;
+  [[nodiscard]] float background() const { return background_; }
+  [[nodiscard]] std::size_t active_voxels() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  float background_ = 0.0f;
+};
+
+}  // namespace growbench

@@ -1,0 +1,278 @@
+// The standard scenes, built in code. Every solid is its own closed mesh (the SDF is the union of their
+// level sets, so touching or overlapping parts need no boolean meshing). Solids that stand on the
+// ground reach 5 cm into it so that no faces are coplanar.
+#include <cmath>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "core/random.hpp"
+#include "scenes/geometry.hpp"
+#include "scenes/scene_library.hpp"
+
+namespace growbench {
+namespace {
+
+constexpr float kSink = 0.05f;  // how far standing solids reach below y = 0
+
+ParamSpec real_param(const char* name, double def, double lo, double hi, const char* unit, const char* doc) {
+  return ParamSpec{name, ParamType::Real, def, lo, hi, unit, doc, {}};
+}
+ParamSpec int_param(const char* name, std::int64_t def, double lo, double hi, const char* doc) {
+  return ParamSpec{name, ParamType::Int, def, lo, hi, "", doc, {}};
+}
+
+TriangleMesh ground(float half) {
+  auto g = geom::make_box("ground", {-half, -0.1f, -half}, {half, 0.0f, half});
+  g.climbable = false;
+  return g;
+}
+
+Shape box_shape(const glm::vec3& lo, const glm::vec3& hi) {
+  Shape s;
+  s.kind = Shape::Kind::Box;
+  s.min = lo;
+  s.max = hi;
+  return s;
+}
+
+Shape ellipsoid_shape(const glm::vec3& c, const glm::vec3& r) {
+  Shape s;
+  s.kind = Shape::Kind::Sphere;
+  s.center = c;
+  s.radii = r;
+  return s;
+}
+
+// n seeds spread evenly along a line from a to b (centred when n == 1).
+void seeds_along(Scene& s, int n, const glm::vec3& a, const glm::vec3& b) {
+  for (int i = 0; i < n; ++i) {
+    const float t = n == 1 ? 0.5f : static_cast<float>(i) / static_cast<float>(n - 1);
+    s.seeds.push_back({glm::mix(a, b, t), {0, 1, 0}, 0});
+  }
+}
+
+// n seeds on a circle of radius r around (cx, cz) at height y.
+void seeds_around(Scene& s, int n, float cx, float cz, float r, float y, float phase = 0.3f) {
+  for (int i = 0; i < n; ++i) {
+    const float a = phase + 2.0f * std::numbers::pi_v<float> * static_cast<float>(i) / static_cast<float>(n);
+    s.seeds.push_back({{cx + r * std::cos(a), y, cz + r * std::sin(a)}, {0, 1, 0}, 0});
+  }
+}
+
+Scene build_wall(const Params& p) {
+  const auto w = static_cast<float>(p.real("width")), h = static_cast<float>(p.real("height")),
+             t = static_cast<float>(p.real("thickness"));
+  Scene s;
+  s.name = "wall";
+  s.meshes.push_back(ground(std::max(w, h) + 1.0f));
+  s.meshes.push_back(geom::make_box("wall", {-w / 2, -kSink, -t / 2}, {w / 2, h, t / 2}));
+  seeds_along(s, static_cast<int>(p.integer("seeds")), {-w / 3, 0.02f, t / 2 + 0.03f}, {w / 3, 0.02f, t / 2 + 0.03f});
+  s.envelope = box_shape({-w / 2, 0.0f, t / 2}, {w / 2, h, t / 2 + 0.5f});
+  s.camera = {{0.0f, 0.55f * h, 1.9f * std::max(w, h) + 0.5f}, {0.0f, 0.45f * h, 0.0f}, 45.0f};
+  return s;
+}
+
+Scene build_facade(const Params& p) {
+  const auto w = static_cast<float>(p.real("width")), h = static_cast<float>(p.real("height"));
+  const int windows = static_cast<int>(p.integer("windows"));
+  const float t = 0.25f, sill = 0.35f * h, lintel = 0.75f * h, win_w = std::min(0.9f, 0.6f * w / windows);
+  Scene s;
+  s.name = "facade";
+  s.meshes.push_back(ground(std::max(w, h) + 1.0f));
+  s.meshes.push_back(geom::make_box("facade_base", {-w / 2, -kSink, -t / 2}, {w / 2, sill, t / 2}));
+  s.meshes.push_back(geom::make_box("facade_top", {-w / 2, lintel, -t / 2}, {w / 2, h, t / 2}));
+  // Piers between the window openings; the bands above overlap them slightly (no coplanar faces).
+  float x = -w / 2;
+  for (int i = 0; i <= windows; ++i) {
+    const float centre = -w / 2 + w * (static_cast<float>(i) + 0.5f) / static_cast<float>(windows);
+    const float next = i < windows ? centre - win_w / 2 : w / 2;
+    s.meshes.push_back(geom::make_box(fmt::format("facade_pier{}", i), {x, sill - 0.01f, -t / 2},
+                                      {next, lintel + 0.01f, t / 2}));
+    x = centre + win_w / 2;
+  }
+  // A ledge under the upper band.
+  s.meshes.push_back(geom::make_box("facade_ledge", {-w / 2 - 0.1f, lintel - 0.12f, t / 2 - 0.02f},
+                                    {w / 2 + 0.1f, lintel - 0.04f, t / 2 + 0.25f}));
+  seeds_along(s, static_cast<int>(p.integer("seeds")), {-w / 3, 0.02f, t / 2 + 0.03f}, {w / 3, 0.02f, t / 2 + 0.03f});
+  s.envelope = box_shape({-w / 2, 0.0f, t / 2}, {w / 2, h, t / 2 + 0.5f});
+  s.camera = {{0.0f, 0.55f * h, 1.9f * std::max(w, h) + 0.5f}, {0.0f, 0.45f * h, 0.0f}, 45.0f};
+  return s;
+}
+
+Scene build_column(const Params& p) {
+  const auto r = static_cast<float>(p.real("radius")), h = static_cast<float>(p.real("height"));
+  Scene s;
+  s.name = "column";
+  s.meshes.push_back(ground(h));
+  s.meshes.push_back(geom::make_cylinder("column", {0, -kSink, 0}, {0, h, 0}, r, r, 48));
+  seeds_around(s, static_cast<int>(p.integer("seeds")), 0.0f, 0.0f, r + 0.03f, 0.02f);
+  s.envelope = box_shape({-r - 0.4f, 0.0f, -r - 0.4f}, {r + 0.4f, h, r + 0.4f});
+  s.camera = {{0.0f, 0.55f * h, 2.2f * h}, {0.0f, 0.45f * h, 0.0f}, 40.0f};
+  return s;
+}
+
+Scene build_corner(const Params& p) {
+  const auto w = static_cast<float>(p.real("width")), h = static_cast<float>(p.real("height")),
+             o = static_cast<float>(p.real("overhang"));
+  const float t = 0.2f;
+  Scene s;
+  s.name = "corner";
+  s.meshes.push_back(ground(w + 1.0f));
+  s.meshes.push_back(geom::make_box("wall_x", {-t, -kSink, -t}, {w, h, 0.0f}));
+  s.meshes.push_back(geom::make_box("wall_z", {-t, -kSink, 0.0f - 0.01f}, {0.0f, h, w}));
+  s.meshes.push_back(geom::make_box("roof", {-t - 0.05f, h - 0.02f, -t - 0.05f}, {w, h + 0.15f, o}));
+  s.seeds.push_back({{0.04f, 0.02f, 0.04f}, {0, 1, 0}, 0});
+  const int extra = static_cast<int>(p.integer("seeds")) - 1;
+  for (int i = 0; i < extra; ++i) {
+    const float d = w * static_cast<float>(i / 2 + 1) / static_cast<float>(extra / 2 + 2);
+    s.seeds.push_back({i % 2 == 0 ? glm::vec3(d, 0.02f, 0.04f) : glm::vec3(0.04f, 0.02f, d), {0, 1, 0}, 0});
+  }
+  s.envelope = box_shape({0.0f, 0.0f, 0.0f}, {0.6f * w, h, 0.6f * w});
+  s.light.direction = {0.6f, 1.0f, 0.8f};
+  s.camera = {{1.45f * w + 1.0f, 0.6f * h, 1.45f * w + 1.0f}, {0.2f * w, 0.45f * h, 0.2f * w}, 45.0f};
+  return s;
+}
+
+Scene build_pergola(const Params& p) {
+  const auto w = static_cast<float>(p.real("width")), d = static_cast<float>(p.real("depth")),
+             h = static_cast<float>(p.real("height"));
+  const float post = 0.12f, beam = 0.15f;
+  Scene s;
+  s.name = "pergola";
+  s.meshes.push_back(ground(std::max(w, d) + 1.0f));
+  int k = 0;
+  for (const float x : {-w / 2, w / 2})
+    for (const float z : {-d / 2, d / 2})
+      s.meshes.push_back(geom::make_box(fmt::format("post{}", k++), {x - post / 2, -kSink, z - post / 2},
+                                        {x + post / 2, h + 0.01f, z + post / 2}));
+  for (const float z : {-d / 2, d / 2})
+    s.meshes.push_back(geom::make_box(fmt::format("beam{}", k++), {-w / 2 - 0.3f, h, z - post / 2},
+                                      {w / 2 + 0.3f, h + beam, z + post / 2}));
+  const int rafters = static_cast<int>(p.integer("rafters"));
+  for (int i = 0; i < rafters; ++i) {
+    const float x = -w / 2 + w * static_cast<float>(i) / static_cast<float>(rafters - 1);
+    s.meshes.push_back(geom::make_box(fmt::format("rafter{}", i), {x - 0.04f, h + beam - 0.01f, -d / 2 - 0.3f},
+                                      {x + 0.04f, h + beam + 0.1f, d / 2 + 0.3f}));
+  }
+  for (const float x : {-w / 2, w / 2})
+    for (const float z : {-d / 2, d / 2}) {
+      const glm::vec3 out = glm::normalize(glm::vec3(x, 0.0f, z));
+      s.seeds.push_back({glm::vec3(x, 0.02f, z) + out * (post / 2 + 0.05f), {0, 1, 0}, 0});
+    }
+  s.envelope = box_shape({-w / 2 - 0.3f, 0.0f, -d / 2 - 0.3f}, {w / 2 + 0.3f, h + 0.5f, d / 2 + 0.3f});
+  s.camera = {{0.9f * w + 1.5f, 0.9f * h, 1.3f * d + 2.5f}, {0.0f, 0.5f * h, 0.0f}, 45.0f};
+  return s;
+}
+
+Scene build_boulder(const Params& p) {
+  const auto r = static_cast<float>(p.real("radius")), rough = static_cast<float>(p.real("roughness"));
+  Scene s;
+  s.name = "boulder";
+  s.meshes.push_back(ground(3.0f * r + 1.0f));
+  TriangleMesh b = geom::make_icosphere("boulder", {0, 0, 0}, 1.0f, 4);
+  // Deterministic bumps: a sum of a few random plane waves along random directions.
+  Rng rng(0xB0u, 1);
+  glm::vec3 dirs[6];
+  float phases[6];
+  for (int i = 0; i < 6; ++i) {
+    dirs[i] = rng.unit_vector() * static_cast<float>(rng.uniform(1.5, 4.0));
+    phases[i] = static_cast<float>(rng.uniform(0.0, 6.283));
+  }
+  const glm::vec3 centre(0.0f, 0.75f * r, 0.0f);
+  for (auto& v : b.vertices) {
+    float bump = 0.0f;
+    for (int i = 0; i < 6; ++i) bump += std::sin(glm::dot(dirs[i], v) + phases[i]) / 6.0f;
+    v = centre + v * r * (1.0f + rough * bump) * glm::vec3(1.0f, 0.85f, 1.0f);
+  }
+  s.meshes.push_back(std::move(b));
+  seeds_around(s, static_cast<int>(p.integer("seeds")), 0.0f, 0.0f, r * 1.25f, 0.02f);
+  s.envelope = ellipsoid_shape(centre, glm::vec3(1.4f * r));
+  s.camera = {{0.0f, 1.6f * r + 0.5f, 4.5f * r + 1.0f}, {0.0f, 0.6f * r, 0.0f}, 45.0f};
+  return s;
+}
+
+Scene build_trunk(const Params& p) {
+  const auto r = static_cast<float>(p.real("radius")), h = static_cast<float>(p.real("height"));
+  Scene s;
+  s.name = "trunk";
+  s.meshes.push_back(ground(h));
+  s.meshes.push_back(geom::make_cylinder("trunk", {0, -kSink, 0}, {0, h, 0}, r, 0.6f * r, 40));
+  s.meshes.push_back(geom::make_cylinder("branch", {0, 0.55f * h, 0}, {0.4f * h, 0.85f * h, 0.05f}, 0.45f * r,
+                                         0.25f * r, 24));
+  seeds_around(s, static_cast<int>(p.integer("seeds")), 0.0f, 0.0f, r + 0.04f, 0.02f);
+  s.envelope = box_shape({-r - 0.5f, 0.0f, -r - 0.5f}, {0.4f * h + 0.5f, h, r + 0.5f});
+  s.camera = {{0.3f * h, 0.55f * h, 2.0f * h + 1.0f}, {0.15f * h, 0.45f * h, 0.0f}, 45.0f};
+  return s;
+}
+
+Scene build_envelope(const Params& p) {
+  const auto r = static_cast<float>(p.real("crown_radius")), c = static_cast<float>(p.real("crown_height"));
+  Scene s;
+  s.name = "envelope";
+  s.meshes.push_back(ground(r + 2.0f));
+  s.seeds.push_back({{0, 0, 0}, {0, 1, 0}, 0});
+  s.envelope = ellipsoid_shape({0.0f, c, 0.0f}, {r, 0.8f * r, r});
+  s.camera = {{0.0f, 0.6f * (c + r), 2.4f * (c + r)}, {0.0f, 0.5f * (c + 0.8f * r), 0.0f}, 45.0f};
+  return s;
+}
+
+}  // namespace
+
+const std::vector<StandardScene>& standard_scenes() {
+  static const std::vector<StandardScene> list = {
+      {"wall", "a 3 x 2.5 m wall standing on the ground, seeds at its foot",
+       {real_param("width", 3.0, 0.5, 50, "m", "wall width (x)"),
+        real_param("height", 2.5, 0.5, 50, "m", "wall height (y)"),
+        real_param("thickness", 0.2, 0.02, 5, "m", "wall thickness (z)"),
+        int_param("seeds", 3, 1, 64, "number of seeds along the wall's foot")},
+       build_wall},
+      {"facade", "a wall with window openings and a ledge",
+       {real_param("width", 4.0, 1, 50, "m", "facade width"), real_param("height", 3.0, 1, 50, "m", "facade height"),
+        int_param("windows", 2, 1, 16, "number of window openings"),
+        int_param("seeds", 3, 1, 64, "number of seeds along the facade's foot")},
+       build_facade},
+      {"column", "a cylindrical pillar",
+       {real_param("radius", 0.25, 0.02, 10, "m", "column radius"),
+        real_param("height", 3.0, 0.5, 50, "m", "column height"),
+        int_param("seeds", 3, 1, 64, "number of seeds around the base")},
+       build_column},
+      {"corner", "two walls meeting at a right angle under an overhanging roof",
+       {real_param("width", 3.0, 0.5, 50, "m", "length of each wall"),
+        real_param("height", 2.6, 0.5, 50, "m", "wall height"),
+        real_param("overhang", 1.2, 0, 20, "m", "how far the roof reaches out over the corner (z)"),
+        int_param("seeds", 3, 1, 64, "number of seeds (the first in the corner)")},
+       build_corner},
+      {"pergola", "four posts, two beams and rafters",
+       {real_param("width", 2.4, 0.5, 50, "m", "distance between posts along x"),
+        real_param("depth", 1.6, 0.5, 50, "m", "distance between posts along z"),
+        real_param("height", 2.4, 0.5, 50, "m", "post height"), int_param("rafters", 6, 2, 64, "number of rafters")},
+       build_pergola},
+      {"boulder", "a noisy rock on the ground",
+       {real_param("radius", 1.0, 0.1, 20, "m", "rock radius"),
+        real_param("roughness", 0.15, 0, 0.5, "", "relative bump height"),
+        int_param("seeds", 3, 1, 64, "number of seeds around the rock")},
+       build_boulder},
+      {"trunk", "a tree trunk with one branch",
+       {real_param("radius", 0.3, 0.05, 5, "m", "trunk radius at the base"),
+        real_param("height", 3.5, 0.5, 50, "m", "trunk height"),
+        int_param("seeds", 3, 1, 64, "number of seeds around the base")},
+       build_trunk},
+      {"envelope", "ground and a crown envelope, nothing to climb (free-growing trees)",
+       {real_param("crown_radius", 1.2, 0.1, 50, "m", "horizontal radius of the ellipsoidal crown"),
+        real_param("crown_height", 2.2, 0.2, 100, "m", "height of the crown's centre")},
+       build_envelope},
+  };
+  return list;
+}
+
+const std::vector<ParamSpec>& mesh_scene_params() {
+  static const std::vector<ParamSpec> specs = {
+      real_param("size", 2.0, 0.0, 1000, "m",
+                 "scale the mesh so its largest extent is this (0 keeps the file's units and placement)"),
+      ParamSpec{"ground", ParamType::Bool, false, -INFINITY, INFINITY, "", "add a ground slab under the mesh", {}},
+  };
+  return specs;
+}
+
+}  // namespace growbench
