@@ -97,7 +97,7 @@ nlohmann::json run_context() {
             {"fmt", FMT_VERSION}}}};
 }
 
-nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const Progress&)>& progress) {
+nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const Progress&)>& progress, Plant* plant_out) {
   const AlgorithmEntry& entry = find_algorithm(spec.algorithm);
   Params params = default_params(entry);
   for (const auto& a : spec.params) params.set_assignment(a);
@@ -169,6 +169,7 @@ nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const P
   const Plant& plant = algo->plant();
   if (const std::string bad = plant.validate(); !bad.empty())
     throw std::logic_error(fmt::format("algorithm '{}' produced an invalid plant: {}", spec.algorithm, bad));
+  if (plant_out) *plant_out = plant;
   rec["steps"] = steps;
   rec["stopped_by"] = stopped_by;
 

@@ -37,7 +37,9 @@ struct Progress {
 
 // Runs a trial. Bad input throws InputError before any growth; everything else is recorded.
 // The returned record is also written to OUT/record.json when out_dir is set.
-nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const Progress&)>& progress = {});
+// `plant_out`, when given, receives the grown plant (tests check invariants on it).
+nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const Progress&)>& progress = {},
+                         Plant* plant_out = nullptr);
 
 // The build and machine this binary runs on (compiler, flags, build type, versions, CPU, cores).
 nlohmann::json run_context();

@@ -118,6 +118,42 @@ TriangleMesh make_icosphere(const std::string& name, const glm::vec3& center, fl
   return m;
 }
 
+bool fill_small_holes(TriangleMesh& m, double max_boundary_fraction) {
+  if (m.is_closed()) return true;
+  std::map<std::pair<unsigned, unsigned>, int> directed;
+  for (const auto& t : m.triangles)
+    for (int i = 0; i < 3; ++i) ++directed[{t[i], t[(i + 1) % 3]}];
+  std::map<unsigned, unsigned> next;  // boundary edge a -> b (its reverse b -> a is missing)
+  for (const auto& [e, n] : directed) {
+    if (n != 1) return false;  // a repeated directed edge: not orientable as given
+    if (directed.count({e.second, e.first})) continue;
+    if (!next.emplace(e.first, e.second).second) return false;  // two boundary edges leave one vertex
+  }
+  if (static_cast<double>(next.size()) > max_boundary_fraction * static_cast<double>(directed.size())) return false;
+  TriangleMesh filled = m;
+  std::map<unsigned, bool> used;
+  for (const auto& [start, unused] : next) {
+    if (used[start]) continue;
+    std::vector<unsigned> loop;
+    for (unsigned v = start; !used[v];) {
+      used[v] = true;
+      loop.push_back(v);
+      const auto it = next.find(v);
+      if (it == next.end()) return false;
+      v = it->second;
+      if (v != start && used[v]) return false;  // a figure-eight boundary
+    }
+    glm::dvec3 c(0.0);
+    for (const auto v : loop) c += glm::dvec3(m.vertices[v]);
+    const auto centre = static_cast<unsigned>(filled.vertices.size());
+    filled.vertices.emplace_back(c / static_cast<double>(loop.size()));
+    for (std::size_t i = 0; i < loop.size(); ++i) filled.triangles.emplace_back(centre, loop[(i + 1) % loop.size()], loop[i]);
+  }
+  if (!filled.is_closed()) return false;
+  m = std::move(filled);
+  return true;
+}
+
 glm::mat4 trs(const glm::vec3& translate, const glm::vec3& rotate_deg, const glm::vec3& scale) {
   glm::mat4 m = glm::translate(glm::mat4(1.0f), translate);
   // Rotation order: Y (yaw), then X, then Z, applied to the scaled object.

@@ -18,6 +18,11 @@ TriangleMesh make_cylinder(const std::string& name, const glm::vec3& base, const
 TriangleMesh make_icosphere(const std::string& name, const glm::vec3& center, float radius,
                             int subdivisions);
 
+// Closes the holes of a nearly closed mesh (boundary edges at most `max_boundary_fraction` of all
+// edges) by fanning each boundary loop to its centroid. Returns whether the mesh is closed afterwards;
+// leaves it unchanged when the boundary is not a set of simple loops or is too large.
+bool fill_small_holes(TriangleMesh& mesh, double max_boundary_fraction = 0.01);
+
 glm::mat4 trs(const glm::vec3& translate, const glm::vec3& rotate_deg, const glm::vec3& scale);
 
 }  // namespace growbench::geom

@@ -200,8 +200,23 @@ SceneQuery::SceneQuery(const Scene& scene, SceneQueryOptions options)
   }
   total_area_ = acc;
 
-  closed_.reserve(scene.meshes.size());
-  for (const auto& m : scene.meshes) closed_.push_back(m.is_closed());
+  // Solids for the distance field: closed meshes as they are, nearly closed ones (a scan with a few
+  // small holes) with their holes filled; Embree keeps answering on the original surfaces.
+  std::vector<TriangleMesh> repaired;
+  repaired.reserve(scene.meshes.size());
+  std::vector<const TriangleMesh*> sdf_meshes;
+  for (const auto& m : scene.meshes) {
+    if (m.is_closed()) {
+      solid_.push_back(true);
+      sdf_meshes.push_back(&m);
+      continue;
+    }
+    TriangleMesh r = m;
+    const bool ok = geom::fill_small_holes(r);
+    solid_.push_back(ok);
+    repaired.push_back(ok ? std::move(r) : TriangleMesh{});
+    sdf_meshes.push_back(ok ? &repaired.back() : &m);
+  }
   Aabb b;
   for (const auto& m : scene.meshes) b.extend(m.bounds());
   voxel_size_ = options.voxel_size > 0.0f ? options.voxel_size : glm::length(b.size()) / 256.0f;
@@ -209,7 +224,7 @@ SceneQuery::SceneQuery(const Scene& scene, SceneQueryOptions options)
     throw InputError(fmt::format("scene '{}': cannot size the distance field (degenerate bounds)", scene.name));
   if (options.build_sdf) {
     t0 = std::chrono::steady_clock::now();
-    sdf_ = std::make_unique<SdfGrid>(scene.meshes, closed_, voxel_size_, options.band_voxels);
+    sdf_ = std::make_unique<SdfGrid>(sdf_meshes, solid_, voxel_size_, options.band_voxels);
     sdf_seconds_ = seconds_since(t0);
   }
 }

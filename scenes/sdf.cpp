@@ -13,7 +13,7 @@ struct SdfGrid::Impl {
   openvdb::FloatGrid::Ptr grid;
 };
 
-SdfGrid::SdfGrid(const std::vector<TriangleMesh>& meshes, const std::vector<bool>& closed, float voxel_size,
+SdfGrid::SdfGrid(const std::vector<const TriangleMesh*>& meshes, const std::vector<bool>& solid, float voxel_size,
                  float band_voxels)
     : impl_(std::make_unique<Impl>()) {
   static std::once_flag init;
@@ -21,7 +21,7 @@ SdfGrid::SdfGrid(const std::vector<TriangleMesh>& meshes, const std::vector<bool
   const auto xform = openvdb::math::Transform::createLinearTransform(voxel_size);
   background_ = voxel_size * band_voxels;
   for (std::size_t i = 0; i < meshes.size(); ++i) {
-    const auto& m = meshes[i];
+    const auto& m = *meshes[i];
     std::vector<openvdb::Vec3s> points;
     points.reserve(m.vertices.size());
     for (const auto& v : m.vertices) points.emplace_back(v.x, v.y, v.z);
@@ -30,9 +30,8 @@ SdfGrid::SdfGrid(const std::vector<TriangleMesh>& meshes, const std::vector<bool
     for (const auto& t : m.triangles) tris.emplace_back(t.x, t.y, t.z);
     const std::vector<openvdb::Vec4I> quads;
     openvdb::FloatGrid::Ptr g =
-        closed[i] ? openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*xform, points, tris, band_voxels)
-                  : openvdb::tools::meshToUnsignedDistanceField<openvdb::FloatGrid>(*xform, points, tris, quads,
-                                                                                    band_voxels);
+        solid[i] ? openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*xform, points, tris, band_voxels)
+                 : openvdb::tools::meshToUnsignedDistanceField<openvdb::FloatGrid>(*xform, points, tris, quads, band_voxels);
     if (!impl_->grid) {
       impl_->grid = g;
     } else {

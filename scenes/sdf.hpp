@@ -13,8 +13,8 @@ namespace growbench {
 
 class SdfGrid {
  public:
-  // closed[i]: mesh i becomes a signed level set; otherwise an unsigned distance field.
-  SdfGrid(const std::vector<TriangleMesh>& meshes, const std::vector<bool>& closed, float voxel_size,
+  // solid[i]: mesh i becomes a signed level set (it must be closed); otherwise an unsigned distance field.
+  SdfGrid(const std::vector<const TriangleMesh*>& meshes, const std::vector<bool>& solid, float voxel_size,
           float band_voxels);
   ~SdfGrid();
   // Trilinear sample in world space; returns +/- band width outside the narrow band (sign kept).

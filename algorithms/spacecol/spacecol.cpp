@@ -360,10 +360,12 @@ class SpaceColonization final : public GrowthAlgorithm {
     return c;
   }
 
-  // A node is stalled when its new child would land on an existing child (the same pull again) or
-  // back on its own parent (oscillating between two points).
+  // A node is stalled when its new child would land on the node itself (held back by a solid), on an
+  // existing child (the same pull again) or back on its own parent (oscillating between two points).
   bool is_stalled_child(std::int32_t parent, const glm::vec3& pos) const {
     const float lim2 = (kStallFraction * step_len_) * (kStallFraction * step_len_);
+    const glm::vec3 self = node_pos_[static_cast<std::size_t>(parent)] - pos;
+    if (glm::dot(self, self) < lim2) return true;  // pushed back onto itself (growing into a solid)
     if (const std::int32_t gp = plant_.nodes[static_cast<std::size_t>(parent)].parent; gp != kNone) {
       const glm::vec3 d = node_pos_[static_cast<std::size_t>(gp)] - pos;
       if (glm::dot(d, d) < 0.25f * step_len_ * step_len_) return true;

@@ -1,0 +1,32 @@
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <tbb/global_control.h>
+
+#include "algorithms/algorithm.hpp"
+
+namespace growbench::test {
+
+// Grows a plant with one algorithm to completion (or max_steps) with a given thread count.
+inline Plant grow(const std::string& algorithm, const Scene& scene, const SceneQuery& query,
+                  const std::vector<std::string>& sets, int threads = 0, std::uint64_t seed = 1, int max_steps = 5000,
+                  std::vector<std::pair<std::string, double>>* stats = nullptr) {
+  std::unique_ptr<tbb::global_control> gc;
+  if (threads > 0)
+    gc = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+  const AlgorithmEntry& e = find_algorithm(algorithm);
+  Params p = default_params(e);
+  for (const auto& s : sets) p.set_assignment(s);
+  auto algo = e.make();
+  algo->start(scene, query, p, seed);
+  for (int i = 0; i < max_steps && algo->step(); ++i) {
+  }
+  algo->finish();
+  if (stats) *stats = algo->stats();
+  return algo->plant();
+}
+
+}  // namespace growbench::test

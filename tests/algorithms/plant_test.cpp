@@ -1,0 +1,46 @@
+#include "algorithms/plant.hpp"
+
+#include <gtest/gtest.h>
+
+namespace growbench {
+namespace {
+
+Plant y_plant() {
+  // 0 - 1 - 2 (main axis), 1 - 3 (lateral)
+  Plant p;
+  p.nodes = {{{0, 0, 0}, 0, kNoParent, 0, 0, 0}, {{0, 1, 0}, 0, 0, 0, 0, 1}, {{0, 2, 0}, 0, 1, 0, 0, 2},
+             {{1, 2, 0}, 0, 1, 1, 1, 2}};
+  return p;
+}
+
+TEST(Plant, PipeModelRadii) {
+  Plant p = y_plant();
+  assign_pipe_radii(p, 0.01f, 2.0f);
+  EXPECT_FLOAT_EQ(p.nodes[2].radius, 0.01f);
+  EXPECT_FLOAT_EQ(p.nodes[3].radius, 0.01f);
+  EXPECT_NEAR(p.nodes[1].radius, 0.01f * std::sqrt(2.0f), 1e-7f);  // r^2 = r2^2 + r3^2
+  EXPECT_NEAR(p.nodes[0].radius, p.nodes[1].radius, 1e-7f);
+  assign_pipe_radii(p, 0.01f, 3.0f);
+  EXPECT_NEAR(p.nodes[1].radius, 0.01f * std::cbrt(2.0f), 1e-7f);
+}
+
+TEST(Plant, LengthHashAndValidation) {
+  Plant p = y_plant();
+  EXPECT_NEAR(p.total_length(), 2.0 + std::sqrt(2.0), 1e-6);
+  EXPECT_EQ(p.validate(), "");
+  const std::string h = p.geometry_hash();
+  EXPECT_EQ(h, y_plant().geometry_hash());
+  p.nodes[3].position.x = std::nextafter(1.0f, 2.0f);  // one ulp changes the hash
+  EXPECT_NE(p.geometry_hash(), h);
+  p.nodes[3].parent = 3;
+  EXPECT_NE(p.validate().find("node 3"), std::string::npos);
+  Plant q = y_plant();
+  q.nodes[2].position.y = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_NE(q.validate().find("non-finite"), std::string::npos);
+  Plant r = y_plant();
+  r.organs.push_back({{0, 0, 0}, {1, 0, 0, 0}, 0.1f, OrganKind::Leaf, 9});
+  EXPECT_NE(r.validate().find("organ 0"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace growbench

@@ -1,0 +1,103 @@
+#include "core/params.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "core/errors.hpp"
+
+namespace growbench {
+namespace {
+
+std::vector<ParamSpec> specs() {
+  return {
+      {"step", ParamType::Real, 0.02, 1e-4, 1.0, "m", "step length", {}},
+      {"count", ParamType::Int, std::int64_t{10}, 1, 100, "", "a count", {}},
+      {"flag", ParamType::Bool, false, -INFINITY, INFINITY, "", "a flag", {}},
+      {"mode", ParamType::Choice, std::string("open"), -INFINITY, INFINITY, "", "mode", {"open", "closed"}},
+      {"dir", ParamType::Vec3, glm::dvec3(0, 1, 0), -10, 10, "", "direction", {}},
+      {"file", ParamType::String, std::string(""), -INFINITY, INFINITY, "", "a path", {}},
+  };
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(Params, DefaultsAndParsing) {
+  Params p("algorithm 'x'", specs());
+  EXPECT_DOUBLE_EQ(p.real("step"), 0.02);
+  EXPECT_FALSE(p.was_set("step"));
+  p.set_assignment("step=0.5");
+  p.set("count", "42");
+  p.set("flag", "yes");
+  p.set("mode", "closed");
+  p.set("dir", "1,-2.5,3");
+  p.set("file", "a=b.txt");
+  EXPECT_DOUBLE_EQ(p.real("step"), 0.5);
+  EXPECT_TRUE(p.was_set("step"));
+  EXPECT_EQ(p.integer("count"), 42);
+  EXPECT_TRUE(p.boolean("flag"));
+  EXPECT_EQ(p.text("mode"), "closed");
+  EXPECT_EQ(p.vec3("dir"), glm::dvec3(1, -2.5, 3));
+  EXPECT_EQ(p.text("file"), "a=b.txt");
+  p.set("count", "1e1");  // whole numbers in exponent form are accepted
+  EXPECT_EQ(p.integer("count"), 10);
+}
+
+TEST(Params, UnknownKeySuggestsCloseMatch) {
+  Params p("algorithm 'x'", specs());
+  const std::string e = error_of([&] { p.set("stpe", "1"); });
+  EXPECT_NE(e.find("unknown parameter 'stpe'"), std::string::npos) << e;
+  EXPECT_NE(e.find("did you mean 'step'"), std::string::npos) << e;
+  EXPECT_NE(e.find("algorithm 'x'"), std::string::npos) << e;
+  const std::string far = error_of([&] { p.set("zzzzzzzz", "1"); });
+  EXPECT_EQ(far.find("did you mean"), std::string::npos) << far;
+}
+
+TEST(Params, WrongTypeRangeAndNonFinite) {
+  Params p("algorithm 'x'", specs());
+  std::string e = error_of([&] { p.set("step", "abc"); });
+  EXPECT_NE(e.find("'step'"), std::string::npos);
+  EXPECT_NE(e.find("'abc'"), std::string::npos);
+  EXPECT_NE(e.find("real number"), std::string::npos) << e;
+  e = error_of([&] { p.set("step", "2"); });
+  EXPECT_NE(e.find("out of range"), std::string::npos) << e;
+  EXPECT_NE(e.find("[0.0001, 1]"), std::string::npos) << e;
+  e = error_of([&] { p.set("step", "nan"); });
+  EXPECT_NE(e.find("not finite"), std::string::npos) << e;
+  e = error_of([&] { p.set("step", "inf"); });
+  EXPECT_NE(e.find("not finite"), std::string::npos) << e;
+  e = error_of([&] { p.set("count", "2.5"); });
+  EXPECT_NE(e.find("integer"), std::string::npos) << e;
+  e = error_of([&] { p.set("flag", "maybe"); });
+  EXPECT_NE(e.find("boolean"), std::string::npos) << e;
+  e = error_of([&] { p.set("mode", "clsoed"); });
+  EXPECT_NE(e.find("did you mean 'closed'"), std::string::npos) << e;
+  e = error_of([&] { p.set("dir", "1,2"); });
+  EXPECT_NE(e.find("x,y,z"), std::string::npos) << e;
+  e = error_of([&] { p.set_assignment("step"); });
+  EXPECT_NE(e.find("key=value"), std::string::npos) << e;
+  // A failed set leaves the previous value in place.
+  EXPECT_DOUBLE_EQ(p.real("step"), 0.02);
+}
+
+TEST(Params, Json) {
+  Params p("suite entry", specs());
+  p.set_json("step", nlohmann::json(0.1));
+  p.set_json("count", nlohmann::json(7));
+  p.set_json("dir", nlohmann::json::array({0, 0, 1}));
+  EXPECT_EQ(p.integer("count"), 7);
+  EXPECT_EQ(p.vec3("dir"), glm::dvec3(0, 0, 1));
+  EXPECT_NE(error_of([&] { p.set_json("count", nlohmann::json("7")); }).find("wrong type"), std::string::npos);
+  const auto j = p.to_json();
+  EXPECT_DOUBLE_EQ(j["step"].get<double>(), 0.1);
+  EXPECT_EQ(j["mode"], "open");
+}
+
+}  // namespace
+}  // namespace growbench

@@ -1,0 +1,102 @@
+// The growbench binary as a user meets it: exit codes, error messages, files written.
+#include <sys/wait.h>
+
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "test_util.hpp"
+
+namespace growbench {
+namespace {
+
+struct Result {
+  int status;
+  std::string out;
+};
+
+Result growbench(const std::string& args) {
+  const auto dir = test::temp_dir("cli_out");
+  const std::string log = (dir / "log.txt").string();
+  const int rc = std::system((std::string(GROWBENCH_BINARY) + " " + args + " > " + log + " 2>&1").c_str());
+  std::ifstream in(log);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, ss.str()};
+}
+
+TEST(Cli, HelpAndLists) {
+  auto r = growbench("--help");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_NE(r.out.find("run"), std::string::npos);
+  r = growbench("run --help");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_NE(r.out.find("--seed-at"), std::string::npos);
+  r = growbench("list");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_NE(r.out.find("influence"), std::string::npos);
+  r = growbench("scenes");
+  EXPECT_EQ(r.status, 0);
+  for (const char* s : {"wall", "facade", "column", "corner", "pergola", "boulder", "trunk", "envelope", "mesh:PATH"})
+    EXPECT_NE(r.out.find(s), std::string::npos) << s;
+}
+
+TEST(Cli, BadInputExitsTwoWithAClearMessage) {
+  auto r = growbench("run -a spacecl -s wall -o /tmp/x");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("unknown algorithm 'spacecl' (did you mean 'spacecol'?)"), std::string::npos) << r.out;
+  r = growbench("run -a spacecol -s wal -o /tmp/x");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("did you mean 'wall'"), std::string::npos) << r.out;
+  r = growbench("run -a spacecol -s wall --set stpe=0.1 -o /tmp/x");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("did you mean 'step'"), std::string::npos) << r.out;
+  r = growbench("run -a spacecol -s wall --seed-at 1,2 -o /tmp/x");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("x,y,z"), std::string::npos) << r.out;
+  r = growbench("run -a spacecol");
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.out.find("--scene"), std::string::npos) << r.out;
+}
+
+TEST(Cli, RunWritesMeshesSkeletonAndRecord) {
+  const auto dir = test::temp_dir("cli_run");
+  const auto r = growbench("run -q -a spacecol -s column --set surface=cling --set point_count=3000 --seed 3 -j 2 -o " +
+                           dir.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  for (const char* f : {"plant.obj", "plant.mtl", "plant.ply", "skeleton.obj", "record.json"})
+    EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
+  std::ifstream in(dir / "record.json");
+  const auto rec = nlohmann::json::parse(in);
+  EXPECT_EQ(rec["schema_version"], 1);
+  EXPECT_EQ(rec["status"], "ok");
+  EXPECT_EQ(rec["seed"], 3);
+  EXPECT_EQ(rec["params"]["surface"], "cling");
+  EXPECT_EQ(rec["output_bytes"]["ply"].get<std::uintmax_t>(), std::filesystem::file_size(dir / "plant.ply"));
+  for (const char* ph : {"scene_load", "query_build", "growth", "meshing", "export"}) {
+    EXPECT_TRUE(rec["phases"].contains(ph)) << ph;
+    EXPECT_GE(rec["phases"][ph]["wall_s"].get<double>(), 0.0);
+  }
+  EXPECT_GT(rec["counts"]["nodes"].get<int>(), 50);
+  EXPECT_EQ(rec["geometry_hash"].get<std::string>().size(), 16u);
+}
+
+TEST(Cli, SeedAtSnapsToTheSurface) {
+  const auto dir = test::temp_dir("cli_seedat");
+  const auto r = growbench("run -q -a spacecol -s mesh:" + test::shared_mesh("suzanne.obj") +
+                           " --seed-at 0,5,0 --set surface=cling --set point_count=2000 -o " + dir.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::ifstream in(dir / "skeleton.obj");
+  std::string line;
+  while (std::getline(in, line) && line.rfind("v ", 0) != 0) {
+  }
+  std::istringstream ls(line.substr(2));
+  float x, y, z;
+  ls >> x >> y >> z;
+  EXPECT_LT(y, 2.0f);  // snapped down from y = 5 onto the (2 m tall) mesh
+}
+
+}  // namespace
+}  // namespace growbench

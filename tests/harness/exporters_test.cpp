@@ -1,0 +1,108 @@
+#include "harness/exporters.hpp"
+
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <tiny_obj_loader.h>
+
+#include "test_util.hpp"
+
+namespace growbench {
+namespace {
+
+Plant y_plant() {
+  Plant p;
+  p.nodes = {{{0, 0, 0}, 0.05f, kNoParent, 0, 0, 0}, {{0, 1, 0}, 0.04f, 0, 0, 0, 1}, {{0, 2, 0}, 0.02f, 1, 0, 0, 2},
+             {{1, 2, 0}, 0.02f, 1, 1, 1, 2}};
+  p.organs = {{{0, 2, 0}, {1, 0, 0, 0}, 0.1f, OrganKind::Leaf, 2}, {{1, 2, 0}, {1, 0, 0, 0}, 0.1f, OrganKind::Leaf, 3}};
+  return p;
+}
+
+TEST(Mesher, ChainsAndTriangleCounts) {
+  const Plant p = y_plant();
+  const auto chains = plant_chains(p);
+  ASSERT_EQ(chains.size(), 2u);
+  EXPECT_EQ(chains[0], (std::vector<std::int32_t>{0, 1, 2}));
+  EXPECT_EQ(chains[1], (std::vector<std::int32_t>{1, 3}));
+  MesherOptions o;
+  o.sides = 6;
+  const OutputMesh m = mesh_plant(p, o);
+  // Main chain: 2 segments x 6 sides x 2 + 2 caps x 6; branch: 1 x 6 x 2 + 2 x 6; two leaves x 2.
+  EXPECT_EQ(m.triangles.size(), (24u + 12u) + (12u + 12u) + 4u);
+  ASSERT_EQ(m.groups.size(), 2u);
+  EXPECT_EQ(m.groups[0].name, "branches");
+  EXPECT_EQ(m.groups[1].triangle_count, 4u);
+  // Ring vertices sit at the node radius from the axis.
+  EXPECT_NEAR(glm::length(glm::vec2(m.positions[0].x, m.positions[0].z)), 0.05f, 1e-6f);
+  // The lateral branch starts with its own (thinner) radius at the parent node.
+  const std::size_t branch_first_ring = 3 * 6 + 2;  // after the main chain's rings and two cap centres
+  EXPECT_NEAR(glm::length(m.positions[branch_first_ring] - glm::vec3(0, 1, 0)), 0.02f, 1e-6f);
+}
+
+TEST(Exporters, ObjReadsBackWithGroupsAndMaterials) {
+  const auto dir = test::temp_dir("obj");
+  const OutputMesh m = mesh_plant(y_plant());
+  const auto bytes = write_obj((dir / "plant.obj").string(), m);
+  EXPECT_EQ(bytes, std::filesystem::file_size(dir / "plant.obj") + std::filesystem::file_size(dir / "plant.mtl"));
+  tinyobj::ObjReader r;
+  ASSERT_TRUE(r.ParseFromFile((dir / "plant.obj").string())) << r.Error();
+  EXPECT_EQ(r.GetAttrib().vertices.size(), 3 * m.positions.size());
+  ASSERT_EQ(r.GetShapes().size(), 2u);
+  EXPECT_EQ(r.GetShapes()[0].name, "branches");
+  EXPECT_EQ(r.GetShapes()[1].name, "leaves");
+  std::size_t faces = 0;
+  for (const auto& s : r.GetShapes()) faces += s.mesh.num_face_vertices.size();
+  EXPECT_EQ(faces, m.triangles.size());
+  ASSERT_EQ(r.GetMaterials().size(), 3u);
+  EXPECT_EQ(r.GetMaterials()[0].name, "bark");
+}
+
+TEST(Exporters, BinaryPlyLayout) {
+  const auto dir = test::temp_dir("ply");
+  const OutputMesh m = mesh_plant(y_plant());
+  const auto bytes = write_ply((dir / "p.ply").string(), m);
+  std::ifstream in(dir / "p.ply", std::ios::binary);
+  std::string header, line;
+  while (std::getline(in, line)) {
+    header += line + "\n";
+    if (line == "end_header") break;
+  }
+  EXPECT_NE(header.find("format binary_little_endian 1.0"), std::string::npos);
+  EXPECT_NE(header.find("element vertex " + std::to_string(m.positions.size())), std::string::npos);
+  EXPECT_NE(header.find("element face " + std::to_string(m.triangles.size())), std::string::npos);
+  EXPECT_EQ(bytes, header.size() + m.positions.size() * 24 + m.triangles.size() * 13);
+  float first[3];
+  in.read(reinterpret_cast<char*>(first), sizeof(first));
+  EXPECT_EQ(glm::vec3(first[0], first[1], first[2]), m.positions[0]);
+}
+
+TEST(Exporters, SkeletonHasNodesAndPolylines) {
+  const auto dir = test::temp_dir("skel");
+  write_skeleton_obj((dir / "s.obj").string(), y_plant());
+  std::ifstream in(dir / "s.obj");
+  std::vector<std::string> v, l, r;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("v ", 0) == 0) v.push_back(line);
+    if (line.rfind("l ", 0) == 0) l.push_back(line);
+    if (line.rfind("#r ", 0) == 0) r.push_back(line);
+  }
+  ASSERT_EQ(v.size(), 4u);
+  EXPECT_EQ(v[3], "v 1 2 0");
+  EXPECT_EQ(r[0], "#r 0.05");
+  ASSERT_EQ(l.size(), 2u);
+  EXPECT_EQ(l[0], "l 1 2 3");
+  EXPECT_EQ(l[1], "l 2 4");
+}
+
+TEST(Exporters, UnwritableDirectoryIsAClearError) {
+  try {
+    write_ply("/nonexistent-dir/x.ply", mesh_plant(y_plant()));
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent-dir/x.ply"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace growbench

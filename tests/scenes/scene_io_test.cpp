@@ -1,0 +1,126 @@
+#include <gtest/gtest.h>
+
+#include "scenes/scene_library.hpp"
+#include "test_util.hpp"
+
+namespace growbench {
+namespace {
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(StandardScenes, AllBuildWithClosedSolidsSeedsAndStableHashes) {
+  ASSERT_EQ(standard_scenes().size(), 8u);
+  for (const auto& st : standard_scenes()) {
+    const Scene s = load_scene(st.name);
+    EXPECT_EQ(s.name, st.name);
+    EXPECT_FALSE(s.seeds.empty()) << st.name;
+    EXPECT_FALSE(s.meshes.empty()) << st.name;
+    for (const auto& m : s.meshes) EXPECT_TRUE(m.is_closed()) << st.name << "/" << m.name;
+    EXPECT_EQ(s.content_hash(), load_scene(st.name).content_hash()) << st.name;
+    EXPECT_EQ(s.content_hash().size(), 16u);
+  }
+  EXPECT_NE(load_scene("wall").content_hash(), load_scene("wall", {"width=4"}).content_hash());
+  EXPECT_NE(load_scene("wall").content_hash(), load_scene("column").content_hash());
+}
+
+TEST(StandardScenes, ParametersAreValidated) {
+  EXPECT_NE(error_of([] { load_scene("wall", {"widht=2"}); }).find("did you mean 'width'"), std::string::npos);
+  EXPECT_NE(error_of([] { load_scene("wall", {"width=-2"}); }).find("out of range"), std::string::npos);
+  const std::string e = error_of([] { load_scene("wal"); });
+  EXPECT_NE(e.find("unknown scene 'wal'"), std::string::npos) << e;
+  EXPECT_NE(e.find("did you mean 'wall'"), std::string::npos) << e;
+  EXPECT_NE(e.find("envelope"), std::string::npos) << e;  // lists the valid ones
+}
+
+TEST(MeshScene, FittedToStandardSizeWithSeedAtLowestVertex) {
+  const Scene s = load_scene("mesh:" + test::shared_mesh("stanford-bunny.obj"));
+  const Aabb b = s.meshes[0].bounds();
+  const glm::vec3 e = b.size();
+  EXPECT_NEAR(std::max({e.x, e.y, e.z}), 2.0f, 1e-4f);
+  EXPECT_NEAR(b.min.y, 0.0f, 1e-5f);
+  ASSERT_EQ(s.seeds.size(), 1u);
+  EXPECT_NEAR(s.seeds[0].position.y, 0.0f, 1e-5f);
+  EXPECT_EQ(s.meshes[0].triangles.size(), 69451u);
+  const Scene raw = load_scene("mesh:" + test::shared_mesh("stanford-bunny.obj"), {"size=0"});
+  EXPECT_NEAR(raw.meshes[0].bounds().max.y, 0.187321f, 1e-5f);  // the file's own units
+  EXPECT_EQ(load_scene("mesh:" + test::shared_mesh("suzanne.obj"), {"ground=true"}).meshes.size(), 2u);
+}
+
+TEST(MeshScene, BadFilesGiveClearErrors) {
+  const auto dir = test::temp_dir("meshio");
+  std::string e = error_of([&] { load_scene("mesh:" + (dir / "missing.obj").string()); });
+  EXPECT_NE(e.find("missing.obj: no such file"), std::string::npos) << e;
+  const std::string empty = test::write_text(dir / "empty.obj", "# nothing\nv 0 0 0\n");
+  e = error_of([&] { load_scene("mesh:" + empty); });
+  EXPECT_NE(e.find("no faces"), std::string::npos) << e;
+  const std::string bad = test::write_text(dir / "bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
+  e = error_of([&] { load_scene("mesh:" + bad); });
+  EXPECT_NE(e.find("bad.obj"), std::string::npos) << e;
+}
+
+TEST(JsonScene, LoadsMeshesSeedsLightEnvelopeZonesCamera) {
+  const auto dir = test::temp_dir("jsonscene");
+  const std::string f = test::write_text(dir / "s.json", R"({
+    "schema_version": 1, "name": "mine",
+    "meshes": [{"name": "block", "box": {"min": [-1, 0, -1], "max": [1, 2, 1]}},
+               {"name": "pole", "cylinder": {"base": [3, 0, 0], "top": [3, 2, 0], "radius": 0.1},
+                "transform": {"translate": [0, 0, 1]}, "climbable": false}],
+    "seeds": [{"position": [0, 0, 1.1], "direction": [0, 2, 0], "start_step": 3}],
+    "light": {"type": "point", "position": [0, 5, 5]},
+    "envelope": {"type": "sphere", "center": [0, 1, 0], "radius": [2, 1, 2]},
+    "zones": [{"kind": "exclude", "shape": {"type": "box", "min": [0, 0, 0], "max": [1, 1, 1]}}],
+    "camera": {"position": [0, 1, 6], "look_at": [0, 1, 0], "fov_deg": 40}
+  })");
+  const Scene s = load_scene(f);
+  EXPECT_EQ(s.name, "mine");
+  ASSERT_EQ(s.meshes.size(), 2u);
+  EXPECT_FALSE(s.meshes[1].climbable);
+  EXPECT_NEAR(s.meshes[1].bounds().center().z, 1.0f, 1e-5f);
+  ASSERT_EQ(s.seeds.size(), 1u);
+  EXPECT_EQ(s.seeds[0].start_step, 3);
+  EXPECT_NEAR(s.seeds[0].direction.y, 1.0f, 1e-6f);
+  EXPECT_EQ(s.light.kind, Light::Kind::Point);
+  ASSERT_TRUE(s.envelope);
+  EXPECT_EQ(s.envelope->radii, glm::vec3(2, 1, 2));
+  ASSERT_EQ(s.zones.size(), 1u);
+  EXPECT_EQ(s.zones[0].kind, Zone::Kind::Exclude);
+  EXPECT_EQ(s.camera.fov_deg, 40.0f);
+
+  const std::string based = test::write_text(dir / "b.json", R"({"schema_version": 1, "base": "wall", "base_params": {"width": 4}})");
+  EXPECT_EQ(load_scene(based).content_hash().size(), 16u);
+  EXPECT_NEAR(load_scene(based).meshes[1].bounds().size().x, 4.0f, 1e-5f);
+}
+
+TEST(JsonScene, ErrorsNameFileAndJsonPath) {
+  const auto dir = test::temp_dir("jsonerr");
+  struct Case {
+    const char* text;
+    const char* expect;
+  } cases[] = {
+      {R"({"schema_version": 2, "meshes": []})", "at /schema_version: expected 1"},
+      {R"({"schema_version": 1, "meshes": [{"box": {"min": [0,0,0], "max": [1,"a",1]}}], "seeds": [{"position": [0,0,0]}]})",
+       "at /meshes/0/box/max/1: expected a number"},
+      {R"({"schema_version": 1, "meshes": [{"bx": {}}]})", "at /meshes/0/bx: unknown key 'bx' (did you mean 'box'?)"},
+      {R"({"schema_version": 1, "meshes": [{"box": {"min": [0,0,0], "max": [1,1,1]}}]})", "at /seeds: a scene needs at least one seed"},
+      {R"({"schema_version": 1, "meshes": [{"box": {"min": [0,0,0], "max": [1,1,1]}}], "seeds": [{"position": [0,0,0]}],
+          "light": {"type": "moon"}})", "at /light/type: unknown light type 'moon'"},
+      {R"({"schema_version": 1, "meshes": [{"obj": "nope.obj"}]})", "at /meshes/0/obj:"},
+      {"{\n  \"schema_version\": 1,\n  \"meshes\": [,]\n}", "s.json:3:"},
+  };
+  for (const auto& c : cases) {
+    const std::string f = test::write_text(dir / "s.json", c.text);
+    const std::string e = error_of([&] { load_scene(f); });
+    EXPECT_NE(e.find(c.expect), std::string::npos) << "got: " << e << "\nwanted: " << c.expect;
+    EXPECT_NE(e.find("s.json"), std::string::npos) << e;
+  }
+}
+
+}  // namespace
+}  // namespace growbench

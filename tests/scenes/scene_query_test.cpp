@@ -1,0 +1,241 @@
+#include "scenes/scene_query.hpp"
+
+#include <gtest/gtest.h>
+#include <tbb/parallel_for.h>
+
+#include "core/random.hpp"
+#include "scenes/geometry.hpp"
+#include "scenes/scene_library.hpp"
+#include "test_util.hpp"
+
+namespace growbench {
+namespace {
+
+Scene single(TriangleMesh m) {
+  Scene s;
+  s.name = "test";
+  s.meshes.push_back(std::move(m));
+  s.seeds.push_back({});
+  return s;
+}
+
+// Brute force over every triangle: the reference for Embree's closest point.
+float brute_distance(const Scene& s, const glm::vec3& p) {
+  float best = std::numeric_limits<float>::infinity();
+  for (const auto& m : s.meshes)
+    for (const auto& t : m.triangles)
+      best = std::min(best, glm::length(p - geom::closest_point_on_triangle(p, m.vertices[t.x], m.vertices[t.y], m.vertices[t.z])));
+  return best;
+}
+
+// Brute-force ray parity: the reference for inside tests.
+bool brute_inside(const TriangleMesh& m, const glm::vec3& p) {
+  const glm::vec3 d = glm::normalize(glm::vec3(0.31f, 0.77f, 0.55f));
+  int n = 0;
+  for (const auto& t : m.triangles) {
+    const glm::vec3 a = m.vertices[t.x], b = m.vertices[t.y], c = m.vertices[t.z];
+    const glm::vec3 e1 = b - a, e2 = c - a, h = glm::cross(d, e2);
+    const float det = glm::dot(e1, h);
+    if (std::abs(det) < 1e-12f) continue;
+    const float f = 1.0f / det;
+    const glm::vec3 sv = p - a;
+    const float u = f * glm::dot(sv, h);
+    if (u < 0 || u > 1) continue;
+    const glm::vec3 q = glm::cross(sv, e1);
+    const float v = f * glm::dot(d, q);
+    if (v < 0 || u + v > 1) continue;
+    if (f * glm::dot(e2, q) > 0) ++n;
+  }
+  return n % 2 == 1;
+}
+
+TEST(Geometry, ClosestPointOnTriangleRegions) {
+  const glm::vec3 a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
+  const glm::vec3 f = geom::closest_point_on_triangle({0.2f, 0.2f, 5}, a, b, c);  // face
+  EXPECT_NEAR(glm::length(f - glm::vec3(0.2f, 0.2f, 0)), 0.0f, 1e-6f);
+  EXPECT_EQ(geom::closest_point_on_triangle({-1, -1, 0}, a, b, c), a);                             // vertex
+  EXPECT_EQ(geom::closest_point_on_triangle({0.5f, -2, 1}, a, b, c), glm::vec3(0.5f, 0, 0));       // edge
+  const glm::vec3 q = geom::closest_point_on_triangle({1, 1, 0}, a, b, c);                          // hypotenuse
+  EXPECT_NEAR(q.x, 0.5f, 1e-6f);
+  EXPECT_NEAR(q.y, 0.5f, 1e-6f);
+}
+
+TEST(Geometry, PrimitivesAreClosedAndOutward) {
+  for (const auto& m : {geom::make_box("b", {0, 0, 0}, {1, 2, 3}), geom::make_cylinder("c", {0, 0, 0}, {0, 2, 0}, 0.5f, 0.3f, 16),
+                        geom::make_icosphere("s", {0, 0, 0}, 1.0f, 3)}) {
+    EXPECT_TRUE(m.is_closed()) << m.name;
+    Shape s;
+    s.kind = Shape::Kind::Mesh;
+    s.mesh = m;
+    EXPECT_GT(s.volume(), 0.0) << m.name;
+    // Outward: the signed volume (divergence theorem) is positive.
+    double v = 0;
+    for (const auto& t : m.triangles)
+      v += glm::dot(glm::dvec3(m.vertices[t.x]), glm::cross(glm::dvec3(m.vertices[t.y]), glm::dvec3(m.vertices[t.z])));
+    EXPECT_GT(v, 0.0) << m.name;
+  }
+  Shape box;
+  box.kind = Shape::Kind::Mesh;
+  box.mesh = geom::make_box("b", {0, 0, 0}, {1, 2, 3});
+  EXPECT_NEAR(box.volume(), 6.0, 1e-5);
+}
+
+TEST(Geometry, FillSmallHolesClosesAScanButNotAWall) {
+  // A finely tessellated sphere with two triangles removed: a small hole, filled.
+  TriangleMesh holed = geom::make_icosphere("s", {0, 0, 0}, 1.0f, 4);
+  holed.triangles.erase(holed.triangles.begin() + 10, holed.triangles.begin() + 12);
+  ASSERT_FALSE(holed.is_closed());
+  EXPECT_TRUE(geom::fill_small_holes(holed));
+  EXPECT_TRUE(holed.is_closed());
+  // A lone quad is all boundary: left open.
+  TriangleMesh quad;
+  quad.vertices = {{-1, 0, 0}, {1, 0, 0}, {1, 2, 0}, {-1, 2, 0}};
+  quad.triangles = {{0, 1, 2}, {0, 2, 3}};
+  EXPECT_FALSE(geom::fill_small_holes(quad));
+  EXPECT_EQ(quad.triangles.size(), 2u);
+}
+
+TEST(SceneQuery, BoxDistancesMatchAnalyticWithinAVoxel) {
+  const Scene s = single(geom::make_box("box", {-1, -1, -1}, {1, 1, 1}));
+  SceneQuery q(s, {.voxel_size = 0.02f});
+  auto analytic = [](const glm::vec3& p) {
+    const glm::vec3 d = glm::abs(p) - glm::vec3(1.0f);
+    return glm::length(glm::max(d, glm::vec3(0.0f))) + std::min(std::max(d.x, std::max(d.y, d.z)), 0.0f);
+  };
+  Rng rng(3, 0);
+  for (int i = 0; i < 2000; ++i) {
+    const glm::vec3 p(rng.uniform(-2, 2), rng.uniform(-2, 2), rng.uniform(-2, 2));
+    EXPECT_NEAR(q.signed_distance(p), analytic(p), q.voxel_size()) << p.x << "," << p.y << "," << p.z;
+    EXPECT_NEAR(q.closest_point(p).distance, std::abs(analytic(p)), 1e-5f);
+  }
+  // Plane distances in front of a face, inside and beyond the narrow band.
+  EXPECT_NEAR(q.signed_distance({0.1f, 0.2f, 1.03f}), 0.03f, 0.5f * q.voxel_size());
+  EXPECT_NEAR(q.signed_distance({0.1f, 0.2f, 1.7f}), 0.7f, 1e-5f);
+  EXPECT_NEAR(q.signed_distance({0.1f, 0.2f, 0.0f}), -0.8f, 1e-5f);  // deep inside: exact magnitude, band sign
+  EXPECT_TRUE(q.inside({0.0f, 0.0f, 0.0f}));
+  EXPECT_FALSE(q.inside({0.0f, 0.0f, 1.2f}));
+  const glm::vec3 g = q.gradient({0.1f, 0.2f, 1.03f});
+  EXPECT_NEAR(g.z, 1.0f, 1e-3f);
+  EXPECT_NEAR(q.gradient({0.1f, 0.2f, 1.7f}).z, 1.0f, 1e-5f);
+}
+
+TEST(SceneQuery, SphereDistancesMatchAnalyticWithinAVoxel) {
+  const float r = 0.8f;
+  const Scene s = single(geom::make_icosphere("sphere", {0.5f, 0.2f, -0.3f}, r, 5));
+  SceneQuery q(s, {.voxel_size = 0.015f});
+  const float sagitta = r * (1.0f - std::cos(0.5f * 0.0275f));  // icosphere level 5 flattening
+  Rng rng(4, 0);
+  for (int i = 0; i < 2000; ++i) {
+    const glm::vec3 p = glm::vec3(0.5f, 0.2f, -0.3f) + glm::vec3(rng.uniform(-1.5, 1.5), rng.uniform(-1.5, 1.5), rng.uniform(-1.5, 1.5));
+    const float analytic = glm::length(p - glm::vec3(0.5f, 0.2f, -0.3f)) - r;
+    EXPECT_NEAR(q.signed_distance(p), analytic, q.voxel_size() + sagitta);
+    if (std::abs(analytic) > q.voxel_size() + sagitta) {
+      EXPECT_EQ(q.inside(p), analytic < 0.0f) << "at " << analytic;
+    }
+  }
+}
+
+TEST(SceneQuery, ClosestPointEqualsBruteForceOnStandardScenes) {
+  for (const char* name : {"wall", "facade", "pergola", "boulder", "trunk"}) {
+    const Scene s = load_scene(name);
+    SceneQuery q(s, {.build_sdf = false});
+    const Aabb b = s.bounds();
+    Rng rng(5, 0);
+    for (int i = 0; i < 300; ++i) {
+      const glm::vec3 p = b.min + glm::vec3(rng.uniform(), rng.uniform(), rng.uniform()) * b.size();
+      const ClosestHit h = q.closest_point(p);
+      ASSERT_TRUE(h.found);
+      EXPECT_NEAR(h.distance, brute_distance(s, p), 1e-5f) << name;
+      EXPECT_NEAR(glm::length(h.point - p), h.distance, 1e-5f);
+      // Bounded query: found exactly when within the radius.
+      EXPECT_EQ(q.closest_point(p, 0.3f).found, h.distance < 0.3f) << name;
+    }
+  }
+}
+
+TEST(SceneQuery, ConcurrentQueriesAgreeWithSerial) {
+  const Scene s = load_scene("boulder");
+  SceneQuery q(s);
+  std::vector<glm::vec3> pts(4000);
+  Rng rng(6, 0);
+  for (auto& p : pts) p = glm::vec3(rng.uniform(-2, 2), rng.uniform(0, 2), rng.uniform(-2, 2));
+  std::vector<float> serial(pts.size()), parallel(pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) serial[i] = q.signed_distance(pts[i]) + q.closest_point(pts[i]).distance;
+  tbb::parallel_for(std::size_t{0}, pts.size(), [&](std::size_t i) {
+    parallel[i] = q.signed_distance(pts[i]) + q.closest_point(pts[i]).distance;
+  });
+  EXPECT_EQ(serial, parallel);
+}
+
+TEST(SceneQuery, OcclusionBehindAWall) {
+  const Scene s = load_scene("wall");  // wall in z in [-0.1, 0.1], x in [-1.5, 1.5], y in [0, 2.5]
+  SceneQuery q(s, {.build_sdf = false});
+  EXPECT_TRUE(q.occluded({0, 1, 1}, {0, 0, -1}));
+  EXPECT_FALSE(q.occluded({0, 1, 1}, {0, 0, 1}));
+  EXPECT_FALSE(q.occluded({0, 1, 1}, {0, 0, -1}, 0.5f));  // stops short of the wall
+  const RayHit h = q.ray({0, 1, 1}, {0, 0, -1});
+  ASSERT_TRUE(h.hit);
+  EXPECT_NEAR(h.t, 0.9f, 1e-5f);
+  EXPECT_NEAR(h.normal.z, 1.0f, 1e-6f);
+  // The default sun shines from the front (+z): the front face is lit, the back is in shadow.
+  EXPECT_TRUE(q.light_visible({0, 1, 0.15f}));
+  EXPECT_FALSE(q.light_visible({0, 1, -0.15f}));
+}
+
+TEST(SceneQuery, InsideOutsideOfTheBunnyMatchesRayParity) {
+  const Scene s = load_scene("mesh:" + test::shared_mesh("stanford-bunny.obj"));
+  EXPECT_FALSE(s.meshes[0].is_closed()) << "the scan keeps a few small holes (223 boundary edges)";
+  SceneQuery q(s);
+  ASSERT_TRUE(q.mesh_solid()[0]) << "its small holes are filled for the distance field";
+  const Aabb b = s.meshes[0].bounds();
+  Rng rng(7, 0);
+  int inside = 0, checked = 0;
+  for (int i = 0; i < 600; ++i) {
+    const glm::vec3 p = b.min + glm::vec3(rng.uniform(), rng.uniform(), rng.uniform()) * b.size();
+    const float d = q.signed_distance(p);
+    if (std::abs(d) < 2.0f * q.voxel_size()) continue;  // too close to the surface to call
+    ++checked;
+    const bool ref = brute_inside(s.meshes[0], p);
+    EXPECT_EQ(d < 0.0f, ref) << "at " << p.x << "," << p.y << "," << p.z << " d=" << d;
+    inside += ref ? 1 : 0;
+  }
+  EXPECT_GT(checked, 400);
+  EXPECT_GT(inside, 50);  // the test really visits the inside
+}
+
+TEST(SceneQuery, OpenMeshHasNoInside) {
+  TriangleMesh quad;
+  quad.name = "quad";
+  quad.vertices = {{-1, 0, 0}, {1, 0, 0}, {1, 2, 0}, {-1, 2, 0}};
+  quad.triangles = {{0, 1, 2}, {0, 2, 3}};
+  const Scene s = single(quad);
+  SceneQuery q(s, {.voxel_size = 0.02f});
+  EXPECT_FALSE(q.mesh_solid()[0]);
+  for (const float z : {-0.5f, -0.03f, -0.001f, 0.001f, 0.03f, 0.5f}) {
+    EXPECT_FALSE(q.inside({0, 1, z})) << z;
+    EXPECT_NEAR(q.signed_distance({0, 1, z}), std::abs(z), q.voxel_size()) << z;
+  }
+}
+
+TEST(SceneQuery, SurfaceSamplesAreAreaWeightedAndOnClimbableMeshes) {
+  const Scene s = load_scene("wall");
+  SceneQuery q(s, {.build_sdf = false});
+  // The ground is not climbable: every sample lies on the wall box. Area of the faces:
+  // front/back 3 x 2.55 each, sides 0.2 x 2.55 each, top and bottom 3 x 0.2 each.
+  const double front = 3.0 * 2.55, side = 0.2 * 2.55, top = 3.0 * 0.2;
+  const double total = 2 * front + 2 * side + 2 * top;
+  EXPECT_NEAR(q.sampled_area(), total, 1e-3);
+  int front_hits = 0;
+  const int n = 40000;
+  for (int i = 0; i < n; ++i) {
+    const SurfaceSample sm = q.sample_surface(9, static_cast<std::uint64_t>(i));
+    ASSERT_EQ(s.meshes[sm.mesh].name, "wall");
+    if (std::abs(sm.position.z - 0.1f) < 1e-5f) ++front_hits;
+    EXPECT_NEAR(q.closest_point(sm.position).distance, 0.0f, 1e-4f);
+  }
+  const double expected = front / total;
+  EXPECT_NEAR(front_hits / double(n), expected, 5 * std::sqrt(expected * (1 - expected) / n));
+}
+
+}  // namespace
+}  // namespace growbench
