@@ -20,7 +20,12 @@
 #include <sstream>
 
 #include <fmt/format.h>
+// GCC 12 reports a false -Wmaybe-uninitialized inside nanoflann's dynamic index (root_bbox of trees it
+// copies before building them); the warning is about the library's header, so it is silenced here only.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include <nanoflann.hpp>
+#pragma GCC diagnostic pop
 #include <tbb/parallel_for.h>
 
 #include "core/random.hpp"
