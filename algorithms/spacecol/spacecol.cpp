@@ -195,7 +195,8 @@ class SpaceColonization final : public GrowthAlgorithm {
   std::vector<std::pair<std::string, double>> stats() const override {
     return {{"attraction_points", static_cast<double>(pts_.size())},
             {"attraction_points_left", static_cast<double>(alive_count_)},
-            {"stalled_nodes", static_cast<double>(stalled_count_)}};
+            {"stalled_nodes", static_cast<double>(stalled_count_)},
+            {"tree_rebuilds", static_cast<double>(tree_builds_)}};
   }
 
  private:
@@ -681,6 +682,7 @@ class SpaceColonization final : public GrowthAlgorithm {
       (near ? near_pts_ : far_pts_).push_back(pts_[i]);
     }
     far_stale_ = near_dead_ = 0;
+    ++tree_builds_;
     far_tree_ = std::make_unique<PointTree>(3, far_cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(16));
     near_tree_ = std::make_unique<PointTree>(3, near_cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(16));
   }
@@ -738,7 +740,7 @@ class SpaceColonization final : public GrowthAlgorithm {
   std::vector<std::uint32_t> far_ids_, near_ids_;
   Cloud far_cloud_{&far_pts_}, near_cloud_{&near_pts_};  // nanoflann keeps references to these adaptors
   std::unique_ptr<PointTree> far_tree_, near_tree_;
-  std::size_t far_stale_ = 0, near_dead_ = 0;
+  std::size_t far_stale_ = 0, near_dead_ = 0, tree_builds_ = 0;
   float tau_ = 0;
   std::vector<std::int32_t> closest_;
   std::vector<float> closest_d2_;
