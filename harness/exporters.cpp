@@ -3,9 +3,12 @@
 #include <bit>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
+#include <sstream>
 
 #include <fmt/format.h>
+#include <tiny_gltf.h>
 
 namespace growbench {
 namespace {
@@ -78,6 +81,92 @@ std::uint64_t write_ply(const std::string& path, const OutputMesh& m) {
     put(idx, sizeof(idx));
   }
   return write_buffer(path, b);
+}
+
+std::uint64_t write_glb(const std::string& path, const OutputMesh& m) {
+  tinygltf::Model model;
+  model.asset.version = "2.0";
+  model.asset.generator = "growbench";
+  tinygltf::Buffer buffer;
+  auto append = [&](const void* p, std::size_t n) {
+    const auto off = buffer.data.size();
+    buffer.data.insert(buffer.data.end(), static_cast<const unsigned char*>(p), static_cast<const unsigned char*>(p) + n);
+    while (buffer.data.size() % 4 != 0) buffer.data.push_back(0);
+    return off;
+  };
+  auto view = [&](std::size_t offset, std::size_t length, int target) {
+    tinygltf::BufferView v;
+    v.buffer = 0;
+    v.byteOffset = offset;
+    v.byteLength = length;
+    v.target = target;
+    model.bufferViews.push_back(v);
+    return static_cast<int>(model.bufferViews.size() - 1);
+  };
+  const std::size_t nv = m.positions.size();
+  const int pos_view = view(append(m.positions.data(), nv * sizeof(glm::vec3)), nv * sizeof(glm::vec3), TINYGLTF_TARGET_ARRAY_BUFFER);
+  const int nrm_view = view(append(m.normals.data(), nv * sizeof(glm::vec3)), nv * sizeof(glm::vec3), TINYGLTF_TARGET_ARRAY_BUFFER);
+  Aabb b;
+  for (const auto& p : m.positions) b.extend(p);
+  tinygltf::Accessor pos;
+  pos.bufferView = pos_view;
+  pos.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+  pos.count = nv;
+  pos.type = TINYGLTF_TYPE_VEC3;
+  if (nv > 0) {
+    pos.minValues = {b.min.x, b.min.y, b.min.z};
+    pos.maxValues = {b.max.x, b.max.y, b.max.z};
+  }
+  model.accessors.push_back(pos);
+  tinygltf::Accessor nrm = pos;
+  nrm.bufferView = nrm_view;
+  nrm.minValues.clear();
+  nrm.maxValues.clear();
+  model.accessors.push_back(nrm);
+  const std::map<std::string, std::vector<double>> colours = {
+      {"bark", {0.36, 0.25, 0.17, 1.0}}, {"leaf", {0.22, 0.50, 0.16, 1.0}}, {"flower", {0.92, 0.85, 0.95, 1.0}}};
+  tinygltf::Mesh mesh;
+  mesh.name = "plant";
+  for (const auto& g : m.groups) {
+    const std::size_t bytes = std::size_t{g.triangle_count} * sizeof(glm::uvec3);
+    const int idx_view = view(append(&m.triangles[g.first_triangle], bytes), bytes, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+    tinygltf::Accessor idx;
+    idx.bufferView = idx_view;
+    idx.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+    idx.count = std::size_t{g.triangle_count} * 3;
+    idx.type = TINYGLTF_TYPE_SCALAR;
+    model.accessors.push_back(idx);
+    tinygltf::Material mat;
+    mat.name = g.material;
+    const auto c = colours.find(g.material);
+    if (c != colours.end()) mat.pbrMetallicRoughness.baseColorFactor = c->second;
+    mat.pbrMetallicRoughness.metallicFactor = 0.0;
+    mat.doubleSided = g.material != "bark";
+    model.materials.push_back(mat);
+    tinygltf::Primitive prim;
+    prim.attributes["POSITION"] = 0;
+    prim.attributes["NORMAL"] = 1;
+    prim.indices = static_cast<int>(model.accessors.size() - 1);
+    prim.material = static_cast<int>(model.materials.size() - 1);
+    prim.mode = TINYGLTF_MODE_TRIANGLES;
+    mesh.primitives.push_back(prim);
+  }
+  model.buffers.push_back(std::move(buffer));
+  model.meshes.push_back(mesh);
+  tinygltf::Node node;
+  node.mesh = 0;
+  node.name = "plant";
+  model.nodes.push_back(node);
+  tinygltf::Scene scene;
+  scene.nodes = {0};
+  model.scenes.push_back(scene);
+  model.defaultScene = 0;
+  std::ostringstream out;
+  tinygltf::TinyGLTF writer;
+  if (!writer.WriteGltfSceneToStream(&model, out, false, true))
+    throw std::runtime_error(fmt::format("{}: glTF serialisation failed", path));
+  const std::string data = out.str();
+  return write_file(path, data.data(), data.size());
 }
 
 std::uint64_t write_skeleton_obj(const std::string& path, const Plant& plant) {

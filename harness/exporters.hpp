@@ -19,3 +19,9 @@ std::uint64_t write_ply(const std::string& path, const OutputMesh& mesh);
 std::uint64_t write_skeleton_obj(const std::string& path, const Plant& plant);
 
 }  // namespace growbench
+
+namespace growbench {
+// Binary glTF 2.0 (.glb) written with tinygltf: one mesh with a primitive (and material) per group,
+// float positions and normals, uint32 indices.
+std::uint64_t write_glb(const std::string& path, const OutputMesh& mesh);
+}  // namespace growbench

@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
@@ -10,6 +11,7 @@
 
 #include "algorithms/algorithm.hpp"
 #include "core/errors.hpp"
+#include "harness/suite.hpp"
 #include "harness/trial.hpp"
 #include "scenes/scene_library.hpp"
 
@@ -68,6 +70,20 @@ int main(int argc, char** argv) {
   bool quiet = false;
   run->add_flag("-q,--quiet", quiet, "no progress line");
 
+  auto* suite_cmd = app.add_subcommand(
+      "suite", "Run a suite: algorithms x scenes x seeds x sweeps x repetitions, each trial in its own process");
+  std::string suite_file, suite_out, shard;
+  bool resume = false, suite_quiet = false;
+  suite_cmd->add_option("file", suite_file, "suite file (e.g. bench/suites/quick.json)")->required();
+  suite_cmd->add_option("-o,--out", suite_out, "results directory (default: out/suites/NAME)");
+  suite_cmd->add_flag("--resume", resume, "continue an interrupted run in --out, skipping finished trials");
+  suite_cmd->add_option("--shard", shard, "run only shard I of N (I/N, 0-based): a deterministic slice of the cells");
+  suite_cmd->add_flag("-q,--quiet", suite_quiet, "no progress lines");
+
+  auto* summary_cmd = app.add_subcommand("summary", "Print the tables of a results file: per scene, cell by metric");
+  std::string results_file;
+  summary_cmd->add_option("results", results_file, "results.json written by `growbench suite`")->required();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -93,6 +109,47 @@ int main(int argc, char** argv) {
       print_param_table(gb::mesh_scene_params());
       fmt::print("FILE.json\n  a scene file (schema_version 1): meshes, seeds, light, envelope, zones, camera; see "
                  "scenes/README.md\n");
+      return 0;
+    }
+    if (*suite_cmd) {
+      const gb::Suite suite = gb::load_suite(suite_file);
+      gb::SuiteRunOptions o;
+      o.out_dir = suite_out;
+      o.resume = resume;
+      o.quiet = suite_quiet;
+      if (!shard.empty()) {
+        const auto slash = shard.find('/');
+        try {
+          if (slash == std::string::npos) throw std::invalid_argument("no slash");
+          o.shard_index = std::stoi(shard.substr(0, slash));
+          o.shard_count = std::stoi(shard.substr(slash + 1));
+        } catch (const std::exception&) {
+          throw gb::InputError(fmt::format("--shard '{}': expected I/N with 0 <= I < N", shard));
+        }
+        if (o.shard_count < 1 || o.shard_index < 0 || o.shard_index >= o.shard_count)
+          throw gb::InputError(fmt::format("--shard '{}': expected I/N with 0 <= I < N", shard));
+      }
+      fmt::print("suite {}: {} cells x {} repetitions (+{} warm-up)\n", suite.name, suite.configs.size(),
+                 suite.repetitions, suite.warmup);
+      const std::string path = gb::run_suite(suite, o);
+      std::ifstream in(path);
+      const auto results = nlohmann::json::parse(in);
+      fmt::print("{}", gb::summarize_results(results));
+      fmt::print("\nwrote {} and results.csv beside it\n", path);
+      return 0;
+    }
+    if (*summary_cmd) {
+      std::ifstream in(results_file);
+      if (!in) throw gb::InputError(fmt::format("{}: cannot open results file", results_file));
+      nlohmann::json results;
+      try {
+        results = nlohmann::json::parse(in);
+      } catch (const nlohmann::json::exception& e) {
+        throw gb::InputError(fmt::format("{}: not valid JSON: {}", results_file, e.what()));
+      }
+      if (!results.contains("trials") || results.value("kind", "") != "growbench-results")
+        throw gb::InputError(fmt::format("{}: not a growbench results file (no kind/trials)", results_file));
+      fmt::print("{}", gb::summarize_results(results));
       return 0;
     }
     if (*run) {
@@ -126,7 +183,7 @@ int main(int argc, char** argv) {
                  ph["scene_load"]["wall_s"].get<double>(), ph["query_build"]["wall_s"].get<double>(),
                  ph["growth"]["wall_s"].get<double>(), ph["meshing"]["wall_s"].get<double>(),
                  ph["export"]["wall_s"].get<double>(), rec["peak_rss_bytes"].get<double>() / (1024.0 * 1024.0));
-      fmt::print("  wrote {}/plant.obj, plant.ply, skeleton.obj, record.json (geometry hash {})\n", out_dir,
+      fmt::print("  wrote {}/plant.obj, plant.ply, plant.glb, skeleton.obj, record.json (geometry hash {})\n", out_dir,
                  rec["geometry_hash"].get<std::string>());
       return 0;
     }

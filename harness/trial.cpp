@@ -1,8 +1,11 @@
 #include "harness/trial.hpp"
 
+#include <signal.h>
 #include <sys/resource.h>
 
 #include <chrono>
+#include <csignal>
+#include <cstdio>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -10,23 +13,23 @@
 
 #include <embree3/rtcore_config.h>
 #include <fmt/format.h>
+#include <openvdb/version.h>
 #include <tbb/global_control.h>
 #include <tbb/version.h>
 
 #include "algorithms/algorithm.hpp"
 #include "core/errors.hpp"
+#include "harness/alloc_counter.hpp"
 #include "harness/exporters.hpp"
+#include "harness/metrics.hpp"
 #include "scenes/scene_library.hpp"
 #include "scenes/scene_query.hpp"
 
 #ifndef GROWBENCH_GIT_COMMIT
 #define GROWBENCH_GIT_COMMIT "unknown"
 #endif
-#ifndef GROWBENCH_BUILD_TYPE
-#define GROWBENCH_BUILD_TYPE "unknown"
-#endif
-#ifndef GROWBENCH_CXX_FLAGS
-#define GROWBENCH_CXX_FLAGS ""
+#ifndef GROWBENCH_SOURCE_DIR
+#define GROWBENCH_SOURCE_DIR ""
 #endif
 
 namespace growbench {
@@ -38,10 +41,21 @@ double cpu_seconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
-std::uint64_t peak_rss_bytes() {
-  rusage ru{};
-  getrusage(RUSAGE_SELF, &ru);
-  return static_cast<std::uint64_t>(ru.ru_maxrss) * 1024u;
+std::uint64_t status_kb(const char* key) {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  const std::size_t n = std::strlen(key);
+  while (std::getline(in, line))
+    if (line.compare(0, n, key) == 0 && line.size() > n && line[n] == ':') return std::stoull(line.substr(n + 1));
+  return 0;
+}
+
+// Resets the kernel's peak-RSS mark (VmHWM) to the current RSS, so each phase's peak is its own.
+bool reset_peak_rss() {
+  FILE* f = std::fopen("/proc/self/clear_refs", "w");
+  if (!f) return false;
+  const bool ok = std::fputs("5", f) >= 0;
+  return std::fclose(f) == 0 && ok;
 }
 
 class PhaseTimer {
@@ -49,12 +63,20 @@ class PhaseTimer {
   explicit PhaseTimer(nlohmann::json& phases) : phases_(phases) {}
   template <class F>
   auto run(const char* name, F&& f) {
+    const bool reset = reset_peak_rss();
+    const AllocStats a0 = alloc_stats();
     const auto w0 = std::chrono::steady_clock::now();
     const double c0 = cpu_seconds();
     auto record = [&] {
-      phases_[name] = {{"wall_s", std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count()},
-                       {"cpu_s", cpu_seconds() - c0},
-                       {"peak_rss_bytes", peak_rss_bytes()}};
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+      const double cpu = cpu_seconds() - c0;
+      const AllocStats a1 = alloc_stats();
+      phases_[name] = {{"wall_s", wall},
+                       {"cpu_s", cpu},
+                       {"peak_rss_bytes", status_kb("VmHWM") * 1024u},
+                       {"peak_rss_reset", reset},
+                       {"alloc_count", a1.count - a0.count},
+                       {"alloc_bytes", a1.bytes - a0.bytes}};
     };
     if constexpr (std::is_void_v<decltype(f())>) {
       f();
@@ -78,23 +100,127 @@ std::string cpu_model() {
   return "unknown";
 }
 
+std::string run_command(const std::string& cmd) {
+  std::string out;
+  if (FILE* p = popen(cmd.c_str(), "r")) {
+    char buf[256];
+    while (std::fgets(buf, sizeof(buf), p)) out += buf;
+    pclose(p);
+  }
+  while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
+  return out;
+}
+
+// A growth curve that keeps at most 2 * kCurveCap points: when full, every other point is dropped and
+// the sampling interval doubles (deterministic for a given run).
+constexpr std::size_t kCurveCap = 256;
+struct Curve {
+  int every = 1;
+  std::vector<int> steps;
+  std::vector<std::size_t> nodes, organs;
+  std::vector<double> wall_s;
+  void add(int step, std::size_t n, std::size_t o, double t) {
+    if (step % every != 0) return;
+    steps.push_back(step);
+    nodes.push_back(n);
+    organs.push_back(o);
+    wall_s.push_back(t);
+    if (steps.size() >= 2 * kCurveCap) {
+      auto halve = [](auto& v) {
+        std::size_t w = 0;
+        for (std::size_t i = 1; i < v.size(); i += 2) v[w++] = v[i];
+        v.resize(w);
+      };
+      halve(steps);
+      halve(nodes);
+      halve(organs);
+      halve(wall_s);
+      every *= 2;
+    }
+  }
+};
+
+void inject_fault(const std::string& fault) {
+  if (fault.empty()) return;
+  if (fault == "crash") std::raise(SIGSEGV);
+  if (fault == "hang")
+    for (;;) std::this_thread::sleep_for(std::chrono::seconds(1));
+  if (fault == "oom") {
+    std::vector<std::unique_ptr<char[]>> hog;
+    for (;;) {
+      hog.emplace_back(new char[64 << 20]);
+      std::fill_n(hog.back().get(), 64 << 20, 1);
+    }
+  }
+  if (fault == "throw") throw std::runtime_error("injected internal error");
+  throw InputError(fmt::format("unknown fault '{}'; expected crash, hang, oom or throw", fault));
+}
+
 }  // namespace
 
 nlohmann::json run_context() {
   const std::time_t now = std::time(nullptr);
   char date[32];
   std::strftime(date, sizeof(date), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-  return {{"growbench_commit", GROWBENCH_GIT_COMMIT},
+  // The commit the binary was configured at; the source tree's current state when it is reachable.
+  std::string commit = GROWBENCH_GIT_COMMIT;
+  std::string dirty = "unknown";
+  if (std::filesystem::exists(std::string(GROWBENCH_SOURCE_DIR) + "/.git")) {
+    const std::string c = run_command(fmt::format("git -C '{}' rev-parse --short=12 HEAD 2>/dev/null", GROWBENCH_SOURCE_DIR));
+    if (!c.empty()) commit = c;
+    dirty = run_command(fmt::format("git -C '{}' status --porcelain --untracked-files=no 2>/dev/null", GROWBENCH_SOURCE_DIR)).empty()
+                ? "false"
+                : "true";
+  }
+  return {{"growbench_commit", commit},
+          {"dirty", dirty},
+          {"configured_commit", GROWBENCH_GIT_COMMIT},
           {"build_type", GROWBENCH_BUILD_TYPE},
-          {"compiler", fmt::format("{} {}", "g++", __VERSION__)},
+          {"compiler", fmt::format("g++ {}", __VERSION__)},
           {"cxx_flags", GROWBENCH_CXX_FLAGS},
           {"cpu_model", cpu_model()},
           {"hardware_threads", std::thread::hardware_concurrency()},
           {"date", date},
+          {"alloc_counting", alloc_counting_enabled()},
           {"dependencies",
            {{"embree", fmt::format("{}.{}.{}", RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH)},
+            {"openvdb", OPENVDB_LIBRARY_VERSION_STRING},
             {"tbb", TBB_VERSION_STRING},
             {"fmt", FMT_VERSION}}}};
+}
+
+nlohmann::json to_json(const TrialSpec& s) {
+  nlohmann::json seeds = nlohmann::json::array();
+  for (const auto& p : s.seed_at) seeds.push_back({p.x, p.y, p.z});
+  return {{"algorithm", s.algorithm},       {"scene", s.scene},
+          {"scene_params", s.scene_params}, {"params", s.params},
+          {"seed", s.seed},                 {"seed_at", seeds},
+          {"max_steps", s.max_steps},       {"time_limit_s", s.time_limit_s},
+          {"threads", s.threads},           {"voxel_size", s.voxel_size},
+          {"sides", s.mesher.sides},        {"budget_nodes", s.budget_nodes},
+          {"budget_length_m", s.budget_length_m}, {"metrics", s.metrics},
+          {"fault", s.fault}};
+}
+
+TrialSpec trial_spec_from_json(const nlohmann::json& j) {
+  TrialSpec s;
+  s.algorithm = j.at("algorithm").get<std::string>();
+  s.scene = j.at("scene").get<std::string>();
+  s.scene_params = j.value("scene_params", std::vector<std::string>{});
+  s.params = j.value("params", std::vector<std::string>{});
+  s.seed = j.value("seed", std::uint64_t{1});
+  for (const auto& p : j.value("seed_at", nlohmann::json::array()))
+    s.seed_at.emplace_back(p[0].get<float>(), p[1].get<float>(), p[2].get<float>());
+  s.max_steps = j.value("max_steps", 5000);
+  s.time_limit_s = j.value("time_limit_s", 0.0);
+  s.threads = j.value("threads", 0);
+  s.voxel_size = j.value("voxel_size", 0.0f);
+  s.mesher.sides = j.value("sides", 6);
+  s.budget_nodes = j.value("budget_nodes", std::size_t{0});
+  s.budget_length_m = j.value("budget_length_m", 0.0);
+  s.metrics = j.value("metrics", true);
+  s.fault = j.value("fault", std::string{});
+  return s;
 }
 
 nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const Progress&)>& progress, Plant* plant_out) {
@@ -145,11 +271,13 @@ nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const P
   std::unique_ptr<GrowthAlgorithm> algo = entry.make();
   int steps = 0;
   std::string stopped_by = "finished";
-  nlohmann::json curve = nlohmann::json::array();
+  Curve curve;
   timer.run("growth", [&] {
+    inject_fault(spec.fault);
     algo->start(scene, *query, params, spec.seed);
     const auto t0 = std::chrono::steady_clock::now();
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+    curve.add(0, algo->plant().nodes.size(), algo->plant().organs.size(), elapsed());
     while (true) {
       if (steps >= spec.max_steps) {
         stopped_by = "max_steps";
@@ -159,9 +287,20 @@ nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const P
         stopped_by = "time_limit";
         break;
       }
+      const Plant& p = algo->plant();
+      if (spec.budget_nodes > 0 && p.nodes.size() >= spec.budget_nodes) {
+        stopped_by = "budget_nodes";
+        break;
+      }
+      if (spec.budget_length_m > 0.0 && p.total_length() >= spec.budget_length_m) {
+        stopped_by = "budget_length";
+        break;
+      }
       const bool more = algo->step();
       ++steps;
-      if (progress) progress({steps, algo->plant().nodes.size(), elapsed()});
+      const double t = elapsed();
+      curve.add(steps, algo->plant().nodes.size(), algo->plant().organs.size(), t);
+      if (progress) progress({steps, algo->plant().nodes.size(), t});
       if (!more) break;
     }
     algo->finish();
@@ -172,6 +311,11 @@ nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const P
   if (plant_out) *plant_out = plant;
   rec["steps"] = steps;
   rec["stopped_by"] = stopped_by;
+  rec["curve"] = {{"every", curve.every},
+                  {"step", curve.steps},
+                  {"nodes", curve.nodes},
+                  {"organs", curve.organs},
+                  {"wall_s", curve.wall_s}};
 
   OutputMesh mesh = timer.run("meshing", [&] { return mesh_plant(plant, spec.mesher); });
 
@@ -182,8 +326,10 @@ nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const P
     const std::filesystem::path d(spec.out_dir);
     bytes["obj"] = write_obj((d / "plant.obj").string(), mesh);
     bytes["ply"] = write_ply((d / "plant.ply").string(), mesh);
+    bytes["glb"] = write_glb((d / "plant.glb").string(), mesh);
     bytes["skeleton_obj"] = write_skeleton_obj((d / "skeleton.obj").string(), plant);
   });
+  if (spec.metrics) rec["metrics"] = timer.run("metrics", [&] { return compute_metrics(plant, *query); });
 
   std::size_t segments = 0;
   for (const auto& n : plant.nodes) segments += n.parent != kNoParent ? 1 : 0;
@@ -197,15 +343,27 @@ nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const P
   nlohmann::json stats = nlohmann::json::object();
   for (const auto& [k, v] : algo->stats()) stats[k] = v;
   rec["algorithm_stats"] = stats;
-  rec["peak_rss_bytes"] = peak_rss_bytes();
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  rec["peak_rss_bytes"] = static_cast<std::uint64_t>(ru.ru_maxrss) * 1024u;  // whole process, never reset
   rec["status"] = "ok";
-  rec["context"] = run_context();
+  if (spec.context) rec["context"] = run_context();
 
   if (!spec.out_dir.empty()) {
     const std::string path = (std::filesystem::path(spec.out_dir) / "record.json").string();
     const std::string text = rec.dump(2) + "\n";
     std::ofstream(path + ".tmp") << text;
     std::filesystem::rename(path + ".tmp", path);
+  }
+  if (spec.skip_teardown) {
+    struct Kept {
+      Scene scene;
+      std::unique_ptr<SceneQuery> query;
+      std::unique_ptr<GrowthAlgorithm> algo;
+      OutputMesh mesh;
+    };
+    // Deliberately never freed: the process exits next and the kernel reclaims it all at once.
+    [[maybe_unused]] auto* kept = new Kept{std::move(scene), std::move(query), std::move(algo), std::move(mesh)};
   }
   return rec;
 }

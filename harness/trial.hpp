@@ -27,6 +27,18 @@ struct TrialSpec {
   float voxel_size = 0.0f;                // 0: automatic (see SceneQueryOptions)
   std::string out_dir;                    // empty: measure but write no files
   MesherOptions mesher;
+  // Comparable budgets across algorithms: stop once the plant has this many nodes / this much branch
+  // length (0: no budget). Checked after every step.
+  std::size_t budget_nodes = 0;
+  double budget_length_m = 0.0;
+  bool metrics = true;                    // compute the quality metrics (harness/metrics.hpp)
+  bool context = true;                    // add run_context() to the record (suites record it once instead)
+  // Leave the trial's big objects (scene, query, plant, mesh) allocated at the end: for a forked suite
+  // child that exits right after, freeing them would only add time the kernel spends again at exit.
+  bool skip_teardown = false;
+  // For testing the harness only: "crash" (SIGSEGV), "hang", "oom" (allocate until refused) at the
+  // start of growth, "throw" (an internal error). Empty in real use.
+  std::string fault;
 };
 
 struct Progress {
@@ -41,7 +53,12 @@ struct Progress {
 nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const Progress&)>& progress = {},
                          Plant* plant_out = nullptr);
 
-// The build and machine this binary runs on (compiler, flags, build type, versions, CPU, cores).
+// The build and machine this binary runs on (commit and dirty flag, compiler, flags, build type,
+// dependency versions, CPU model, cores, date).
 nlohmann::json run_context();
+
+// Serialises / reads a TrialSpec (suites hand them to child processes and store them in results).
+nlohmann::json to_json(const TrialSpec& spec);
+TrialSpec trial_spec_from_json(const nlohmann::json& j);
 
 }  // namespace growbench

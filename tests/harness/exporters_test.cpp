@@ -1,9 +1,11 @@
 #include "harness/exporters.hpp"
 
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
 #include <gtest/gtest.h>
+#include <tiny_gltf.h>
 #include <tiny_obj_loader.h>
 
 #include "test_util.hpp"
@@ -75,6 +77,30 @@ TEST(Exporters, BinaryPlyLayout) {
   float first[3];
   in.read(reinterpret_cast<char*>(first), sizeof(first));
   EXPECT_EQ(glm::vec3(first[0], first[1], first[2]), m.positions[0]);
+}
+
+TEST(Exporters, GlbReadsBackWithTinyGltf) {
+  const auto dir = test::temp_dir("glb");
+  const OutputMesh m = mesh_plant(y_plant());
+  const auto bytes = write_glb((dir / "p.glb").string(), m);
+  EXPECT_EQ(bytes, std::filesystem::file_size(dir / "p.glb"));
+  tinygltf::Model model;
+  tinygltf::TinyGLTF loader;
+  std::string err, warn;
+  ASSERT_TRUE(loader.LoadBinaryFromFile(&model, &err, &warn, (dir / "p.glb").string())) << err;
+  ASSERT_EQ(model.meshes.size(), 1u);
+  ASSERT_EQ(model.meshes[0].primitives.size(), m.groups.size());
+  const auto& pos = model.accessors[static_cast<std::size_t>(model.meshes[0].primitives[0].attributes.at("POSITION"))];
+  EXPECT_EQ(pos.count, m.positions.size());
+  std::size_t indices = 0;
+  for (const auto& p : model.meshes[0].primitives) indices += model.accessors[static_cast<std::size_t>(p.indices)].count;
+  EXPECT_EQ(indices, 3 * m.triangles.size());
+  EXPECT_EQ(model.materials[0].name, "bark");
+  // The first vertex survives the round trip bit for bit.
+  const auto& view = model.bufferViews[static_cast<std::size_t>(pos.bufferView)];
+  glm::vec3 first;
+  std::memcpy(&first, model.buffers[0].data.data() + view.byteOffset, sizeof(first));
+  EXPECT_EQ(first, m.positions[0]);
 }
 
 TEST(Exporters, SkeletonHasNodesAndPolylines) {

@@ -1,0 +1,560 @@
+#include "harness/suite.hpp"
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <new>
+#include <set>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <xxhash.h>
+
+#include "algorithms/algorithm.hpp"
+#include "core/errors.hpp"
+#include "harness/process.hpp"
+#include "scenes/scene_library.hpp"
+
+namespace growbench {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(fmt::format("{}: cannot open", path));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void write_atomic(const fs::path& path, const std::string& text) {
+  const fs::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    out << text;
+    out.flush();
+    if (!out) throw std::runtime_error(fmt::format("{}: write failed", tmp.string()));
+  }
+  fs::rename(tmp, path);
+}
+
+std::string value_text(const json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); }
+
+std::string safe_name(std::string s) {
+  for (auto& c : s)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.' || c == '=' || c == ','))
+      c = '_';
+  return s;
+}
+
+class SuiteReader {
+ public:
+  explicit SuiteReader(std::string file) : file_(std::move(file)), dir_(fs::path(file_).parent_path()) {}
+  [[noreturn]] void fail(const std::string& path, const std::string& what) const {
+    throw InputError(fmt::format("{}: at {}: {}", file_, path.empty() ? "/" : path, what));
+  }
+  void only_keys(const json& j, const std::string& path, const std::vector<std::string>& keys) const {
+    if (!j.is_object()) fail(path, fmt::format("expected an object, got {}", j.type_name()));
+    for (const auto& [k, v] : j.items())
+      if (std::find(keys.begin(), keys.end(), k) == keys.end()) {
+        const std::string near = closest_match(k, keys);
+        fail(path + "/" + k, fmt::format("unknown key '{}'{}; expected one of {}", k,
+                                         near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near), fmt::join(keys, ", ")));
+      }
+  }
+  double number(const json& j, const std::string& path, double lo, double hi) const {
+    if (!j.is_number() || j.get<double>() < lo || j.get<double>() > hi)
+      fail(path, fmt::format("expected a number in [{}, {}], got {}", lo, hi, j.dump()));
+    return j.get<double>();
+  }
+  // Scene specs in suites: mesh:PATH and *.json are relative to the suite file.
+  std::string scene_spec(const std::string& spec) const {
+    if (spec.rfind("mesh:", 0) == 0) {
+      const fs::path p(spec.substr(5));
+      return "mesh:" + (p.is_absolute() ? p : dir_ / p).lexically_normal().string();
+    }
+    if (spec.size() > 5 && spec.substr(spec.size() - 5) == ".json") {
+      const fs::path p(spec);
+      return (p.is_absolute() ? p : dir_ / p).lexically_normal().string();
+    }
+    return spec;
+  }
+
+  Suite read() const {
+    const std::string text = read_text(file_);
+    json j;
+    try {
+      j = json::parse(text);
+    } catch (const json::parse_error& e) {
+      std::size_t line = 1, col = 1;
+      for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
+        if (text[i] == '\n') {
+          ++line;
+          col = 1;
+        } else {
+          ++col;
+        }
+      }
+      throw InputError(fmt::format("{}:{}:{}: invalid JSON", file_, line, col));
+    }
+    only_keys(j, "", {"schema_version", "name", "description", "repetitions", "warmup", "threads", "timeout_s",
+                      "memory_limit_mb", "max_steps", "seeds", "budget", "scenes", "algorithms"});
+    if (!j.contains("schema_version") || j["schema_version"] != 1) fail("/schema_version", "expected 1");
+    Suite s;
+    s.file = file_;
+    s.hash = fmt::format("{:016x}", XXH3_64bits(text.data(), text.size()));
+    s.name = j.value("name", fs::path(file_).stem().string());
+    s.description = j.value("description", "");
+    if (j.contains("repetitions")) s.repetitions = static_cast<int>(number(j["repetitions"], "/repetitions", 1, 1000));
+    if (j.contains("warmup")) s.warmup = static_cast<int>(number(j["warmup"], "/warmup", 0, 100));
+    if (j.contains("timeout_s")) s.timeout_s = number(j["timeout_s"], "/timeout_s", 0.001, 1e6);
+    if (j.contains("memory_limit_mb"))
+      s.memory_limit_bytes = static_cast<std::uint64_t>(number(j["memory_limit_mb"], "/memory_limit_mb", 64, 1e7)) << 20;
+    const int threads = j.contains("threads") ? static_cast<int>(number(j["threads"], "/threads", 0, 1024)) : 0;
+    const int max_steps = j.contains("max_steps") ? static_cast<int>(number(j["max_steps"], "/max_steps", 0, 1e9)) : 5000;
+    std::vector<std::uint64_t> seeds = {1};
+    if (j.contains("seeds")) {
+      if (!j["seeds"].is_array() || j["seeds"].empty()) fail("/seeds", "expected a non-empty array of seeds");
+      seeds.clear();
+      for (std::size_t i = 0; i < j["seeds"].size(); ++i)
+        seeds.push_back(static_cast<std::uint64_t>(number(j["seeds"][i], fmt::format("/seeds/{}", i), 0, 9e15)));
+    }
+    std::size_t budget_nodes = 0;
+    double budget_length = 0.0;
+    if (j.contains("budget")) {
+      only_keys(j["budget"], "/budget", {"nodes", "length_m"});
+      if (j["budget"].contains("nodes")) budget_nodes = static_cast<std::size_t>(number(j["budget"]["nodes"], "/budget/nodes", 0, 1e12));
+      if (j["budget"].contains("length_m")) budget_length = number(j["budget"]["length_m"], "/budget/length_m", 0, 1e12);
+    }
+
+    struct SceneEntry {
+      std::string spec, name;
+      std::vector<std::string> params;
+    };
+    std::vector<SceneEntry> scenes;
+    if (!j.contains("scenes") || !j["scenes"].is_array() || j["scenes"].empty()) fail("/scenes", "expected a non-empty array of scenes");
+    for (std::size_t i = 0; i < j["scenes"].size(); ++i) {
+      const auto& e = j["scenes"][i];
+      const std::string path = fmt::format("/scenes/{}", i);
+      SceneEntry se;
+      if (e.is_string()) {
+        se.spec = scene_spec(e.get<std::string>());
+      } else {
+        only_keys(e, path, {"scene", "params", "name"});
+        if (!e.contains("scene") || !e["scene"].is_string()) fail(path + "/scene", "expected the scene's name or path");
+        se.spec = scene_spec(e["scene"].get<std::string>());
+        if (e.contains("params")) {
+          if (!e["params"].is_object()) fail(path + "/params", "expected an object of scene parameters");
+          for (const auto& [k, v] : e["params"].items()) se.params.push_back(k + "=" + value_text(v));
+        }
+        if (e.contains("name")) se.name = e["name"].get<std::string>();
+      }
+      try {
+        const Scene sc = load_scene(se.spec, se.params);
+        if (se.name.empty()) se.name = sc.name;
+      } catch (const InputError& err) {
+        fail(path, err.what());
+      }
+      scenes.push_back(std::move(se));
+    }
+
+    struct AlgoEntry {
+      std::string label, name, fault;
+      std::vector<std::string> params;
+      std::vector<std::pair<std::string, std::vector<json>>> sweep;
+    };
+    std::vector<AlgoEntry> algos;
+    if (!j.contains("algorithms") || !j["algorithms"].is_array() || j["algorithms"].empty())
+      fail("/algorithms", "expected a non-empty array of algorithm entries");
+    std::set<std::string> labels;
+    for (std::size_t i = 0; i < j["algorithms"].size(); ++i) {
+      const auto& e = j["algorithms"][i];
+      const std::string path = fmt::format("/algorithms/{}", i);
+      AlgoEntry a;
+      if (e.is_string()) {
+        a.name = e.get<std::string>();
+      } else {
+        only_keys(e, path, {"name", "label", "params", "sweep", "fault"});
+        if (!e.contains("name") || !e["name"].is_string()) fail(path + "/name", "expected the algorithm's name");
+        a.name = e["name"].get<std::string>();
+        a.label = e.value("label", "");
+        a.fault = e.value("fault", "");
+      }
+      const AlgorithmEntry* entry = nullptr;
+      try {
+        entry = &find_algorithm(a.name);
+      } catch (const InputError& err) {
+        fail(path + "/name", err.what());
+      }
+      if (a.label.empty()) a.label = a.name;
+      if (!labels.insert(a.label).second) fail(path + "/label", fmt::format("label '{}' is used twice; give each entry its own", a.label));
+      Params p = default_params(*entry);
+      if (e.is_object() && e.contains("params")) {
+        if (!e["params"].is_object()) fail(path + "/params", "expected an object of parameters");
+        for (const auto& [k, v] : e["params"].items()) {
+          try {
+            p.set_json(k, v);
+          } catch (const InputError& err) {
+            fail(path + "/params/" + k, err.what());
+          }
+          a.params.push_back(k + "=" + value_text(v));
+        }
+      }
+      if (e.is_object() && e.contains("sweep")) {
+        if (!e["sweep"].is_object()) fail(path + "/sweep", "expected an object: parameter -> array of values");
+        for (const auto& [k, vals] : e["sweep"].items()) {
+          if (!vals.is_array() || vals.empty()) fail(path + "/sweep/" + k, "expected a non-empty array of values");
+          for (std::size_t v = 0; v < vals.size(); ++v) {
+            try {
+              Params q = p;
+              q.set_json(k, vals[v]);
+            } catch (const InputError& err) {
+              fail(fmt::format("{}/sweep/{}/{}", path, k, v), err.what());
+            }
+          }
+          a.sweep.emplace_back(k, std::vector<json>(vals.begin(), vals.end()));
+        }
+      }
+      algos.push_back(std::move(a));
+    }
+
+    // Cells. Order: for each scene, seed and sweep point, every algorithm entry in turn (interleaved).
+    std::size_t max_points = 1;
+    for (const auto& a : algos) {
+      std::size_t n = 1;
+      for (const auto& [k, v] : a.sweep) n *= v.size();
+      max_points = std::max(max_points, n);
+    }
+    std::set<std::string> ids;
+    for (const auto& sc : scenes)
+      for (const auto seed : seeds)
+        for (std::size_t point = 0; point < max_points; ++point)
+          for (const auto& a : algos) {
+            std::size_t n = 1;
+            for (const auto& [k, v] : a.sweep) n *= v.size();
+            if (point >= n) continue;
+            SuiteConfig c;
+            c.label = a.label;
+            c.scene_name = sc.name;
+            c.spec.algorithm = a.name;
+            c.spec.scene = sc.spec;
+            c.spec.scene_params = sc.params;
+            c.spec.params = a.params;
+            c.spec.seed = seed;
+            c.spec.threads = threads;
+            c.spec.max_steps = max_steps;
+            c.spec.budget_nodes = budget_nodes;
+            c.spec.budget_length_m = budget_length;
+            c.spec.fault = a.fault;
+            std::size_t rest = point;
+            std::vector<std::string> parts;
+            for (const auto& [k, v] : a.sweep) {
+              const json& val = v[rest % v.size()];
+              rest /= v.size();
+              c.sweep[k] = val;
+              c.spec.params.push_back(k + "=" + value_text(val));
+              parts.push_back(k + "=" + value_text(val));
+            }
+            c.id = fmt::format("{}/{}/s{}{}{}", safe_name(a.label), safe_name(sc.name), seed, parts.empty() ? "" : "/",
+                               safe_name(fmt::format("{}", fmt::join(parts, ","))));
+            if (!ids.insert(c.id).second)
+              fail("/scenes", fmt::format("two cells share the id '{}' (give the scenes distinct 'name's)", c.id));
+            s.configs.push_back(std::move(c));
+          }
+    return s;
+  }
+
+ private:
+  std::string file_;
+  fs::path dir_;
+};
+
+// Exit codes of a trial child.
+constexpr int kExitOk = 0, kExitInvalid = 2, kExitOom = 3, kExitError = 4;
+
+std::string signal_name(int sig) {
+  const char* d = strsignal(sig);
+  return fmt::format("signal {} ({})", sig, d ? d : "?");
+}
+
+std::string csv_row(const std::vector<std::string>& cells) {
+  std::string row;
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    std::string c = cells[i];
+    if (c.find_first_of(",\"\n") != std::string::npos) {
+      std::string q = "\"";
+      for (const char ch : c) q += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+      c = q + "\"";
+    }
+    row += (i ? "," : "") + c;
+  }
+  return row;
+}
+
+const std::vector<std::string> kPhases = {"scene_load", "query_build", "growth", "meshing", "export", "metrics"};
+
+std::string results_csv(const json& results) {
+  std::vector<std::string> head = {"id", "label", "algorithm", "scene", "seed", "sweep", "repetition", "status"};
+  for (const auto& ph : kPhases) {
+    head.push_back(ph + "_wall_s");
+    head.push_back(ph + "_cpu_s");
+    head.push_back(ph + "_peak_rss_bytes");
+    head.push_back(ph + "_alloc_count");
+  }
+  for (const auto& k : {"child_wall_s", "child_max_rss_bytes", "harness_overhead_s", "nodes", "leaves", "total_length_m",
+                        "obj_bytes", "ply_bytes", "glb_bytes", "coverage", "attached_fraction", "penetration_nodes",
+                        "geometry_hash"})
+    head.emplace_back(k);
+  std::string out = csv_row(head) + "\n";
+  auto num = [](const json& j, const char* k) { return j.contains(k) ? j[k].dump() : std::string(); };
+  for (const auto& t : results["trials"]) {
+    for (const auto& s : t["samples"]) {
+      std::vector<std::string> row = {t["id"], t["label"], t["algorithm"], t["scene"], t["seed"].dump(),
+                                      t["sweep"].dump(), s["repetition"].dump(), s["status"]};
+      for (const auto& ph : kPhases) {
+        const json p = s.contains("phases") && s["phases"].contains(ph) ? s["phases"][ph] : json::object();
+        row.push_back(num(p, "wall_s"));
+        row.push_back(num(p, "cpu_s"));
+        row.push_back(num(p, "peak_rss_bytes"));
+        row.push_back(num(p, "alloc_count"));
+      }
+      const bool ok = s["status"] == "ok";
+      const json m = ok && t.contains("metrics") ? t["metrics"] : json::object();
+      const json b = ok && t.contains("output_bytes") ? t["output_bytes"] : json::object();
+      row.push_back(num(s, "child_wall_s"));
+      row.push_back(num(s, "child_max_rss_bytes"));
+      row.push_back(num(s, "harness_overhead_s"));
+      row.push_back(ok && t.contains("counts") ? t["counts"]["nodes"].dump() : "");
+      row.push_back(ok && t.contains("counts") ? t["counts"]["leaves"].dump() : "");
+      row.push_back(ok ? num(t, "total_length_m") : "");
+      row.push_back(num(b, "obj"));
+      row.push_back(num(b, "ply"));
+      row.push_back(num(b, "glb"));
+      row.push_back(num(m, "coverage"));
+      row.push_back(num(m, "attached_fraction"));
+      row.push_back(num(m, "penetration_nodes"));
+      row.push_back(ok && t.contains("geometry_hash") ? t["geometry_hash"].get<std::string>() : "");
+      out += csv_row(row) + "\n";
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+Suite load_suite(const std::string& path) {
+  if (!fs::exists(path)) throw InputError(fmt::format("{}: no such suite file", path));
+  return SuiteReader(path).read();
+}
+
+std::string run_suite(const Suite& suite, const SuiteRunOptions& o) {
+  const fs::path out = o.out_dir.empty() ? fs::path("out/suites") / suite.name : fs::path(o.out_dir);
+  const fs::path results_path = out / "results.json";
+  fs::create_directories(out / "trials");
+
+  json results;
+  if (fs::exists(results_path)) {
+    if (!o.resume)
+      throw InputError(fmt::format("{} already holds results: pass --resume to continue that run, or another --out",
+                                   results_path.string()));
+    try {
+      results = json::parse(read_text(results_path.string()));
+    } catch (const json::exception& e) {
+      throw InputError(fmt::format("{}: cannot resume, the file is not valid results JSON ({})", results_path.string(), e.what()));
+    }
+    if (results.value("suite_hash", "") != suite.hash)
+      throw InputError(fmt::format("{}: cannot resume, it was written for a different version of {}", results_path.string(), suite.file));
+  } else {
+    results = {{"schema_version", 1},
+               {"kind", "growbench-results"},
+               {"suite", {{"name", suite.name}, {"file", suite.file}, {"description", suite.description}}},
+               {"suite_hash", suite.hash},
+               {"repetitions", suite.repetitions},
+               {"shard", {{"index", o.shard_index}, {"count", o.shard_count}}},
+               {"trials", json::array()}};
+  }
+  // The context is taken in the parent before any trial (no threads started here).
+  json ctx = run_context();
+  ctx["suite_file_hash"] = suite.hash;
+  results["context"] = ctx;
+
+  // Index the trials already recorded, and create entries for every cell of this shard.
+  std::map<std::string, std::size_t> index;
+  for (std::size_t i = 0; i < results["trials"].size(); ++i) index[results["trials"][i]["id"]] = i;
+  std::vector<const SuiteConfig*> cells;
+  for (std::size_t i = 0; i < suite.configs.size(); ++i) {
+    if (static_cast<int>(i % static_cast<std::size_t>(o.shard_count)) != o.shard_index) continue;
+    const SuiteConfig& c = suite.configs[i];
+    cells.push_back(&c);
+    if (index.count(c.id)) continue;
+    index[c.id] = results["trials"].size();
+    results["trials"].push_back({{"id", c.id},
+                                 {"label", c.label},
+                                 {"algorithm", c.spec.algorithm},
+                                 {"scene", c.scene_name},
+                                 {"scene_spec", c.spec.scene},
+                                 {"seed", c.spec.seed},
+                                 {"sweep", c.sweep},
+                                 {"spec", to_json(c.spec)},
+                                 {"status", "pending"},
+                                 {"samples", json::array()}});
+  }
+
+  // Jobs: warm-ups, then repetitions, each pass over the interleaved cells.
+  struct Job {
+    const SuiteConfig* cell;
+    int repetition;  // -1: warm-up
+  };
+  std::vector<Job> jobs;
+  if (!cells.empty())
+    for (int w = 0; w < suite.warmup; ++w) jobs.push_back({cells.front(), -1});
+  for (int r = 0; r < suite.repetitions; ++r)
+    for (const auto* c : cells) {
+      bool done = false;
+      for (const auto& s : results["trials"][index[c->id]]["samples"]) done = done || s["repetition"] == r;
+      if (!done) jobs.push_back({c, r});
+    }
+  if (o.resume && jobs.size() == static_cast<std::size_t>(cells.empty() ? 0 : suite.warmup)) jobs.clear();
+
+  const bool tty = isatty(STDERR_FILENO) != 0 && !o.quiet;
+  const auto t_start = std::chrono::steady_clock::now();
+  double busy = 0.0;
+  for (std::size_t jn = 0; jn < jobs.size(); ++jn) {
+    const Job& job = jobs[jn];
+    const SuiteConfig& c = *job.cell;
+    const fs::path dir = out / "trials" / c.id;
+    fs::create_directories(dir);
+    if (!o.quiet) {
+      const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+      const double eta = jn > 0 ? el / static_cast<double>(jn) * static_cast<double>(jobs.size() - jn) : 0.0;
+      const std::string what = job.repetition < 0 ? "warm-up" : fmt::format("rep {}/{}", job.repetition + 1, suite.repetitions);
+      const std::string line = fmt::format("[{}/{}] {} ({}){}", jn + 1, jobs.size(), c.id, what,
+                                           jn > 0 ? fmt::format(", ETA {:.0f} s", eta) : std::string());
+      if (tty) fmt::print(stderr, "\r{:<100}", line.substr(0, 100));
+      else fmt::print(stderr, "{}\n", line);
+    }
+    const fs::path rec_path = dir / "record.json", err_path = dir / "error.txt";
+    fs::remove(rec_path);
+    fs::remove(err_path);
+    TrialSpec spec = c.spec;
+    spec.out_dir = dir.string();
+    spec.context = false;       // recorded once for the whole suite
+    spec.skip_teardown = true;  // the child exits right after
+    const auto t0 = std::chrono::steady_clock::now();
+    const ChildResult cr = run_forked(
+        [&]() -> int {
+          auto write_error = [&](const std::string& msg) { std::ofstream(err_path) << msg; };
+          const auto started = std::chrono::steady_clock::now();
+          try {
+            run_trial(spec);
+            // steady_clock is CLOCK_MONOTONIC: comparable with the parent's clock.
+            std::ofstream(dir / "timing.txt") << std::chrono::duration<double>(started.time_since_epoch()).count() << " "
+                                              << std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+            return kExitOk;
+          } catch (const InputError& e) {
+            write_error(e.what());
+            return kExitInvalid;
+          } catch (const std::bad_alloc&) {
+            write_error("out of memory (allocation refused under the address-space limit)");
+            return kExitOom;
+          } catch (const std::exception& e) {
+            write_error(e.what());
+            return kExitError;
+          }
+        },
+        {suite.timeout_s, suite.memory_limit_bytes}, (dir / "log.txt").string());
+
+    json sample = {{"repetition", job.repetition},
+                   {"child_wall_s", cr.wall_s},
+                   {"child_user_s", cr.user_s},
+                   {"child_system_s", cr.system_s},
+                   {"child_max_rss_bytes", cr.max_rss_bytes}};
+    std::string status, message;
+    json rec;
+    if (cr.timed_out) {
+      status = "timeout";
+      message = fmt::format("killed after {} s", suite.timeout_s);
+    } else if (cr.signal != 0) {
+      // SIGKILL that we did not send is the kernel's OOM killer.
+      status = cr.signal == SIGKILL ? "out_of_memory" : "crashed";
+      message = signal_name(cr.signal);
+    } else if (cr.exit_code == kExitOk && fs::exists(rec_path)) {
+      rec = json::parse(read_text(rec_path.string()));
+      status = "ok";
+    } else {
+      message = fs::exists(err_path) ? read_text(err_path.string()) : fmt::format("exit code {}", cr.exit_code);
+      status = cr.exit_code == kExitInvalid ? "invalid_input" : cr.exit_code == kExitOom ? "out_of_memory" : "crashed";
+    }
+    sample["status"] = status;
+    if (!message.empty()) sample["message"] = message;
+    if (job.repetition < 0) {  // a warm-up: measured, not kept
+      busy += cr.wall_s;
+      continue;
+    }
+    json& t = results["trials"][index[c.id]];
+    if (status == "ok") {
+      sample["phases"] = rec["phases"];
+      double inside = 0.0;
+      for (const auto& [k, v] : rec["phases"].items()) inside += v["wall_s"].get<double>();
+      sample["steps"] = rec["steps"];
+      const json deterministic = {{"geometry_hash", rec["geometry_hash"]}, {"counts", rec["counts"]},
+                                  {"output_bytes", rec["output_bytes"]}};
+      if (!t.contains("geometry_hash")) {
+        for (const char* k : {"geometry_hash", "counts", "output_bytes", "metrics", "total_length_m", "steps", "stopped_by",
+                              "curve", "params", "algorithm_stats", "threads"})
+          if (rec.contains(k)) t[k] = rec[k];
+        t["scene_hash"] = rec["scene"]["hash"];
+        json alloc = json::object();
+        for (const auto& [k, v] : rec["phases"].items()) alloc[k] = {{"count", v["alloc_count"]}, {"bytes", v["alloc_bytes"]}};
+        t["alloc"] = alloc;
+      } else if (t["geometry_hash"] != rec["geometry_hash"] || t["counts"] != rec["counts"]) {
+        t["nondeterministic"] = true;  // the same cell grew a different plant: report it loudly
+      }
+      const auto t1 = std::chrono::steady_clock::now();
+      sample["harness_overhead_s"] = std::chrono::duration<double>(t1 - t0).count() - inside;
+      // Where the time outside the phases goes: fork to child start, child bookkeeping (record JSON,
+      // files), and child exit to reaping (the kernel freeing the trial's memory).
+      std::ifstream tin(dir / "timing.txt");
+      double started = 0.0, finished = 0.0;
+      if (tin >> started >> finished) {
+        const double t0s = std::chrono::duration<double>(t0.time_since_epoch()).count();
+        sample["launch_s"] = started - t0s;
+        sample["child_bookkeeping_s"] = finished - started - inside;
+        sample["exit_s"] = t0s + cr.wall_s - finished;
+      }
+    }
+    t["samples"].push_back(sample);
+    std::string st = "ok";
+    for (const auto& s : t["samples"])
+      if (s["status"] != "ok") st = s["status"];
+    t["status"] = st;
+    if (st != "ok") {
+      for (const auto& s : t["samples"])
+        if (s["status"] != "ok" && s.contains("message")) t["message"] = s["message"];
+    }
+    // Results after every trial, atomically: an interrupted suite loses at most the trial in flight.
+    write_atomic(results_path, results.dump(1) + "\n");
+    write_atomic(out / "results.csv", results_csv(results));
+    if (job.repetition >= 0 && status == "ok") {
+      // Overhead includes writing the results: patch it in now that they are written.
+      const auto t2 = std::chrono::steady_clock::now();
+      double inside = 0.0;
+      for (const auto& [k, v] : rec["phases"].items()) inside += v["wall_s"].get<double>();
+      t["samples"].back()["harness_overhead_s"] = std::chrono::duration<double>(t2 - t0).count() - inside;
+    }
+  }
+  write_atomic(results_path, results.dump(1) + "\n");
+  write_atomic(out / "results.csv", results_csv(results));
+  if (tty) fmt::print(stderr, "\r{:<100}\r", "");
+  return results_path.string();
+}
+
+}  // namespace growbench

@@ -1,0 +1,51 @@
+// Suites: a matrix of algorithms x scenes x seeds x parameter sweeps x repetitions, each trial run in
+// its own (forked) process with a timeout and an address-space limit, results written atomically after
+// every trial so that an interrupted suite can be resumed without losing any.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "harness/trial.hpp"
+
+namespace growbench {
+
+struct SuiteConfig {  // one cell of the matrix (run `repetitions` times)
+  std::string id;     // label/scene/seed/sweep, unique in the suite; also the trial's folder name
+  std::string label;  // the algorithm entry's label (the algorithm's name unless the suite gives one)
+  std::string scene_name;  // the scene's display name (its own name unless the suite gives one)
+  nlohmann::json sweep = nlohmann::json::object();  // the swept parameters' values for this cell
+  TrialSpec spec;
+};
+
+struct Suite {
+  std::string name, file, hash, description;
+  int repetitions = 3;
+  int warmup = 1;
+  double timeout_s = 600.0;
+  std::uint64_t memory_limit_bytes = 16ull << 30;
+  std::vector<SuiteConfig> configs;  // in run order: interleaved across algorithm entries
+};
+
+// Reads and validates a suite file: every algorithm, scene and parameter (and every swept value) is
+// checked before anything runs; an error names the file and the JSON path.
+Suite load_suite(const std::string& path);
+
+struct SuiteRunOptions {
+  std::string out_dir;  // default: out/suites/NAME
+  bool resume = false;
+  int shard_index = 0, shard_count = 1;  // run configs with (index % count) == shard_index
+  bool quiet = false;
+};
+
+// Runs the suite and returns the path of results.json. Throws InputError if results already exist
+// and resume is off.
+std::string run_suite(const Suite& suite, const SuiteRunOptions& options);
+
+// The summary table of a results file (median and 95% interval of timings, warnings on noise).
+std::string summarize_results(const nlohmann::json& results);
+
+}  // namespace growbench

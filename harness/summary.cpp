@@ -1,0 +1,135 @@
+// `growbench summary`: per scene, a table of algorithm cells by metric, with medians and distribution-
+// free 95% intervals for timings, and warnings where the repetitions are too noisy to trust.
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include <fmt/format.h>
+
+#include "harness/suite.hpp"
+
+namespace growbench {
+namespace {
+
+using nlohmann::json;
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n == 0 ? NAN : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
+}
+
+// Distribution-free confidence interval for the median from order statistics: the widest-coverage
+// pair (x_(l), x_(n+1-l)) with binomial coverage >= 95%. Below 6 samples no pair reaches 95%: the
+// interval is then the full range and `exact` is false.
+std::pair<double, double> median_ci(std::vector<double> v, bool& exact) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  exact = false;
+  if (n == 0) return {NAN, NAN};
+  // P(l <= B(n, 1/2) <= n - l) for l = 1, 2, ...
+  auto coverage = [&](std::size_t l) {
+    double p = 0.0;
+    for (std::size_t k = l; k + l <= n; ++k) p += std::exp(std::lgamma(n + 1.0) - std::lgamma(k + 1.0) - std::lgamma(n - k + 1.0) - n * std::log(2.0));
+    return p;
+  };
+  std::size_t best = 0;
+  for (std::size_t l = 1; 2 * l <= n; ++l)
+    if (coverage(l) >= 0.95) best = l;
+  if (best == 0) return {v.front(), v.back()};
+  exact = true;
+  return {v[best - 1], v[n - best]};
+}
+
+std::string si_bytes(double b) {
+  if (!std::isfinite(b)) return "-";
+  const char* u[] = {"B", "KiB", "MiB", "GiB"};
+  int i = 0;
+  while (b >= 1024.0 && i < 3) {
+    b /= 1024.0;
+    ++i;
+  }
+  return fmt::format("{:.1f} {}", b, u[i]);
+}
+
+std::string seconds(double s) {
+  if (!std::isfinite(s)) return "-";
+  return s < 1.0 ? fmt::format("{:.1f} ms", s * 1e3) : fmt::format("{:.2f} s", s);
+}
+
+}  // namespace
+
+std::string summarize_results(const json& results) {
+  std::string out;
+  const json ctx = results.value("context", json::object());
+  out += fmt::format("suite {} | commit {}{} | {} | {} hardware threads | {}\n",
+                     results["suite"].value("name", "?"), ctx.value("growbench_commit", "?"),
+                     ctx.value("dirty", "") == "true" ? " (dirty)" : "", ctx.value("cpu_model", "?"),
+                     ctx.value("hardware_threads", 0), ctx.value("date", "?"));
+  std::vector<std::string> scene_order;
+  std::map<std::string, std::vector<const json*>> by_scene;
+  for (const auto& t : results["trials"]) {
+    const std::string sc = t["scene"];
+    if (!by_scene.count(sc)) scene_order.push_back(sc);
+    by_scene[sc].push_back(&t);
+  }
+  std::vector<std::string> warnings;
+  for (const auto& sc : scene_order) {
+    out += fmt::format("\n== scene {}\n", sc);
+    out += fmt::format("{:<40} {:>6} {:>24} {:>10} {:>11} {:>8} {:>9} {:>10} {:>8} {:>8} {:>8}\n", "cell", "status",
+                       "growth median [95% CI]", "total", "peak RSS", "nodes", "length m", "PLY", "cover", "attach",
+                       "inside");
+    for (const json* tp : by_scene[sc]) {
+      const json& t = *tp;
+      std::string cell = t["id"].get<std::string>();
+      const auto slash = cell.find('/');
+      cell = t["label"].get<std::string>() + cell.substr(cell.find('/', slash + 1));  // label + /seed/sweep
+      std::vector<double> growth, total, rss;
+      for (const auto& s : t["samples"]) {
+        if (s["status"] != "ok") continue;
+        growth.push_back(s["phases"]["growth"]["wall_s"].get<double>());
+        double tot = 0.0;
+        for (const auto& [k, v] : s["phases"].items())
+          if (k != "metrics") tot += v["wall_s"].get<double>();
+        total.push_back(tot);
+        rss.push_back(s["phases"]["growth"]["peak_rss_bytes"].get<double>());
+      }
+      bool exact = false;
+      const auto [lo, hi] = median_ci(growth, exact);
+      const double med = median(growth);
+      const std::string ci = growth.empty() ? "-" : fmt::format("{} [{}{}, {}]", seconds(med), exact ? "" : "~", seconds(lo), seconds(hi));
+      const json m = t.value("metrics", json::object());
+      auto metric = [&](const char* k) { return m.contains(k) ? fmt::format("{:.3f}", m[k].get<double>()) : std::string("-"); };
+      out += fmt::format("{:<40} {:>6} {:>24} {:>10} {:>11} {:>8} {:>9} {:>10} {:>8} {:>8} {:>8}\n", cell.substr(0, 40),
+                         t.value("status", "?"), ci, seconds(median(total)), si_bytes(median(rss)),
+                         t.contains("counts") ? std::to_string(t["counts"]["nodes"].get<long>()) : "-",
+                         t.contains("total_length_m") ? fmt::format("{:.2f}", t["total_length_m"].get<double>()) : "-",
+                         t.contains("output_bytes") && t["output_bytes"].contains("ply") ? si_bytes(t["output_bytes"]["ply"].get<double>()) : "-",
+                         metric("coverage"), metric("attached_fraction"), metric("penetration_nodes"));
+      if (growth.size() >= 2) {
+        double mean = 0.0, var = 0.0;
+        for (const double g : growth) mean += g;
+        mean /= static_cast<double>(growth.size());
+        for (const double g : growth) var += (g - mean) * (g - mean);
+        const double cv = std::sqrt(var / static_cast<double>(growth.size() - 1)) / mean;
+        const double spread = std::max(std::abs(lo - med), std::abs(hi - med)) / med;
+        const double min_v = *std::min_element(growth.begin(), growth.end()), max_v = *std::max_element(growth.begin(), growth.end());
+        const double far = std::max(med - min_v, max_v - med) / med;
+        if (cv > 0.10) warnings.push_back(fmt::format("{} on {}: growth time CV {:.0f}% > 10%", cell, sc, 100 * cv));
+        if (far > 0.50) warnings.push_back(fmt::format("{} on {}: a repetition is {:.0f}% from the median (> 50%)", cell, sc, 100 * far));
+        (void)spread;
+      }
+      if (t.value("nondeterministic", false)) warnings.push_back(fmt::format("{} on {}: repetitions grew different plants", cell, sc));
+      if (t.value("status", "ok") != "ok")
+        warnings.push_back(fmt::format("{} on {}: {} ({})", cell, sc, t.value("status", "?"), t.value("message", "")));
+    }
+  }
+  out += "\nIntervals: distribution-free 95% CI of the median from order statistics ('~': fewer than 6 repetitions, full range shown).\n";
+  if (!warnings.empty()) {
+    out += "\nWarnings:\n";
+    for (const auto& w : warnings) out += "  ! " + w + "\n";
+  }
+  return out;
+}
+
+}  // namespace growbench

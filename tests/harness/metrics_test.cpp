@@ -1,0 +1,117 @@
+#include "harness/metrics.hpp"
+
+#include <gtest/gtest.h>
+#include <glm/gtc/quaternion.hpp>
+
+#include "scenes/geometry.hpp"
+#include "scenes/scene_library.hpp"
+
+namespace growbench {
+namespace {
+
+Scene with_mesh(TriangleMesh m) {
+  Scene s;
+  s.name = "t";
+  s.meshes.push_back(std::move(m));
+  s.seeds.push_back({});
+  return s;
+}
+
+TriangleMesh unit_quad() {  // the square [0,1] x [0,1] at z = 0, open
+  TriangleMesh q;
+  q.name = "quad";
+  q.vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  q.triangles = {{0, 1, 2}, {0, 2, 3}};
+  return q;
+}
+
+Plant chain(std::vector<glm::vec3> pts, float radius = 0.01f) {
+  Plant p;
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    p.nodes.push_back({pts[i], radius, i == 0 ? kNoParent : static_cast<std::int32_t>(i - 1), 0, 0, 0});
+  return p;
+}
+
+TEST(Metrics, SegmentDistance) {
+  EXPECT_NEAR(segment_distance({0, 0, 0}, {1, 0, 0}, {0.5f, 1, -1}, {0.5f, 1, 1}), 1.0f, 1e-6f);  // skew, crossing above
+  EXPECT_NEAR(segment_distance({0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0}), 1.0f, 1e-6f);         // collinear gap
+  EXPECT_NEAR(segment_distance({0, 0, 0}, {1, 0, 0}, {0, 0.5f, 0}, {1, 0.5f, 0}), 0.5f, 1e-6f);   // parallel
+  EXPECT_NEAR(segment_distance({0, 0, 0}, {0, 0, 0}, {1, 1, 0}, {1, 1, 0}), std::sqrt(2.0f), 1e-6f);
+}
+
+TEST(Metrics, CountsLengthOrderDepthBox) {
+  Plant p = chain({{0, 0, 0}, {0, 1, 0}, {0, 2, 0}});
+  p.nodes.push_back({{1, 1, 0}, 0.01f, 1, 1, 1, 0});
+  const Scene s = with_mesh(unit_quad());
+  SceneQuery q(s, {.build_sdf = false});
+  const auto m = compute_metrics(p, q);
+  EXPECT_EQ(m["nodes"], 4);
+  EXPECT_EQ(m["segments"], 3);
+  EXPECT_NEAR(m["total_length_m"].get<double>(), 3.0, 1e-6);
+  EXPECT_EQ(m["max_branch_order"], 1);
+  EXPECT_EQ(m["max_depth"], 2);
+  EXPECT_EQ(m["bbox_max"][1], 2.0);
+}
+
+TEST(Metrics, CoverageOfAStripAcrossAQuad) {
+  // A segment along y = 0.5 covers the strip |y - 0.5| <= d of the unit square: a fraction 2d.
+  const Scene s = with_mesh(unit_quad());
+  SceneQuery q(s, {.build_sdf = false});
+  MetricOptions o;
+  o.coverage_distance = 0.1f;
+  o.coverage_samples = 20000;
+  const auto m = compute_metrics(chain({{-1, 0.5f, 0}, {0.5f, 0.5f, 0}, {2, 0.5f, 0}}), q, o);
+  EXPECT_NEAR(m["coverage"].get<double>(), 0.2, 5 * std::sqrt(0.2 * 0.8 / 20000));
+}
+
+TEST(Metrics, AdhesionAndPenetration) {
+  // A 2 m box: top face at y = 1. Nodes at 0.01, 0.03, 0.1 above it, and one inside.
+  const Scene s = with_mesh(geom::make_box("box", {-1, -1, -1}, {1, 1, 1}));
+  SceneQuery q(s);
+  const Plant p = chain({{0, 1.01f, 0}, {0, 1.03f, 0}, {0, 1.1f, 0}, {0, 0.5f, 0}});
+  const auto m = compute_metrics(p, q);
+  EXPECT_NEAR(m["adhesion_mean_m"].get<double>(), (0.01 + 0.03 + 0.1 + 0.5) / 4.0, 1e-5);
+  EXPECT_NEAR(m["adhesion_median_m"].get<double>(), 0.065, 1e-5);
+  EXPECT_NEAR(m["attached_fraction"].get<double>(), 0.25, 1e-9);  // only 0.01 is within 0.02
+  EXPECT_NEAR(m["penetration_nodes"].get<double>(), 0.25, 1e-9);
+  // Segment samples at 1/4, 1/2, 3/4: those of the last segment (1.1 -> 0.5) sit at y = 0.95, 0.8, 0.65,
+  // all inside; the first two segments stay above the box.
+  EXPECT_NEAR(m["penetration_samples"].get<double>(), 3.0 / 9.0, 1e-9);
+}
+
+TEST(Metrics, SelfIntersectionOfCrossingBranches) {
+  const Scene s = with_mesh(unit_quad());
+  SceneQuery q(s, {.build_sdf = false});
+  Plant p = chain({{-1, 0, 0}, {0, 0, 0}, {1, 0, 0}}, 0.02f);
+  const Plant other = chain({{0, -1, 0.01f}, {0, 1, 0.01f}}, 0.02f);  // crosses 1 cm above, radii sum 4 cm
+  for (auto n : other.nodes) {
+    if (n.parent != kNoParent) n.parent += 3;
+    p.nodes.push_back(n);
+  }
+  auto m = compute_metrics(p, q);
+  EXPECT_EQ(m["self_intersections"], 2);  // the crossing segment meets both segments of the first chain
+  EXPECT_NEAR(m["self_intersection_fraction"].get<double>(), 1.0, 1e-9);
+  for (auto& n : p.nodes)
+    if (n.position.z > 0.0f) n.position.z = 0.5f;  // lift the second branch clear
+  m = compute_metrics(p, q);
+  EXPECT_EQ(m["self_intersections"], 0);
+  // A straight chain never intersects itself (neighbours are excluded even at a thick radius).
+  EXPECT_EQ(compute_metrics(chain({{0, 0, 0}, {0, 0.01f, 0}, {0, 0.02f, 0}, {0, 0.03f, 0}}, 0.5f), q)["self_intersections"], 0);
+}
+
+TEST(Metrics, LeafOverlapAndLightExposure) {
+  const Scene wall = load_scene("wall");  // sun from the front (+z); the wall fills z in [-0.1, 0.1]
+  SceneQuery q(wall);
+  Plant p = chain({{0, 0.5f, 0.3f}, {0, 1, 0.3f}});
+  const glm::quat up(1, 0, 0, 0);
+  p.organs = {{{0, 1, 0.3f}, up, 0.1f, OrganKind::Leaf, 1},
+              {{0, 1, 0.32f}, up, 0.1f, OrganKind::Leaf, 1},     // overlaps the first
+              {{0, 1, -0.4f}, up, 0.1f, OrganKind::Leaf, 1}};    // behind the wall: shaded, alone
+  const auto m = compute_metrics(p, q);
+  EXPECT_NEAR(m["leaf_overlap"].get<double>(), 2.0 / 3.0, 1e-9);
+  EXPECT_NEAR(m["leaf_light_exposure"].get<double>(), 2.0 / 3.0, 1e-9);
+  EXPECT_EQ(m["leaves"], 3);
+}
+
+}  // namespace
+}  // namespace growbench

@@ -1,0 +1,198 @@
+// Suites through the growbench binary, as a user runs them (the suite forks its trials; running it
+// inside this multi-threaded test process would fork a process with live TBB threads).
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <chrono>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "test_util.hpp"
+
+extern char** environ;
+
+namespace growbench {
+namespace {
+
+using nlohmann::json;
+
+struct Result {
+  int status;
+  std::string out;
+};
+
+Result growbench(const std::string& args) {
+  const auto log = test::temp_dir("suite_log") / "log.txt";
+  const int rc = std::system((std::string(GROWBENCH_BINARY) + " " + args + " > " + log.string() + " 2>&1").c_str());
+  std::ifstream in(log);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, ss.str()};
+}
+
+json read_json(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  return json::parse(in);
+}
+
+std::string suite_file(const std::filesystem::path& dir, const json& extra) {
+  json s = {{"schema_version", 1}, {"name", "t"}, {"repetitions", 1}, {"warmup", 0}, {"threads", 2},
+            {"scenes", {"column"}}};
+  s.update(extra);
+  return test::write_text(dir / "suite.json", s.dump(2));
+}
+
+const json kSmall = {{"point_count", 1500}, {"surface", "avoid"}};
+
+TEST(Suite, ValidationNamesFileAndPathBeforeAnythingRuns) {
+  const auto dir = test::temp_dir("suite_valid");
+  struct Case {
+    json algorithms;
+    const char* expect;
+  } cases[] = {
+      {json::array({{{"name", "spacecl"}}}), "at /algorithms/0/name: unknown algorithm 'spacecl' (did you mean 'spacecol'?)"},
+      {json::array({{{"name", "spacecol"}, {"params", {{"point_cont", 5}}}}}),
+       "at /algorithms/0/params/point_cont: unknown parameter 'point_cont'"},
+      {json::array({{{"name", "spacecol"}, {"sweep", {{"step", {0.01, -1}}}}}}), "at /algorithms/0/sweep/step/1:"},
+      {json::array({{{"name", "spacecol"}, {"parms", json::object()}}}), "did you mean 'params'"},
+  };
+  for (const auto& c : cases) {
+    const auto r = growbench("suite -q -o " + (dir / "out").string() + " " + suite_file(dir, {{"algorithms", c.algorithms}}));
+    EXPECT_EQ(r.status, 2) << r.out;
+    EXPECT_NE(r.out.find(c.expect), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("suite.json"), std::string::npos) << r.out;
+    EXPECT_FALSE(std::filesystem::exists(dir / "out" / "results.json"));
+  }
+  const auto r = growbench("suite -q " + suite_file(dir, {{"scenes", {"colum"}}, {"algorithms", {"spacecol"}}}));
+  EXPECT_NE(r.out.find("at /scenes/0: unknown scene 'colum'"), std::string::npos) << r.out;
+}
+
+TEST(Suite, CrashHangMemoryHogAndInvalidInputAreRecordedWhileOthersSucceed) {
+  const auto dir = test::temp_dir("suite_isolation");
+  const json algos = json::array({
+      {{"name", "spacecol"}, {"label", "good"}, {"params", kSmall}},
+      {{"name", "spacecol"}, {"label", "crash"}, {"params", kSmall}, {"fault", "crash"}},
+      {{"name", "spacecol"}, {"label", "hang"}, {"params", kSmall}, {"fault", "hang"}},
+      {{"name", "spacecol"}, {"label", "hog"}, {"params", kSmall}, {"fault", "oom"}},
+      {{"name", "spacecol"}, {"label", "bad"}, {"params", {{"kill", 0.5}, {"influence", 0.3}}}},
+      {{"name", "spacecol"}, {"label", "good2"}, {"params", kSmall}},
+  });
+  const auto r = growbench("suite -q -o " + (dir / "out").string() + " " +
+                           suite_file(dir, {{"algorithms", algos}, {"timeout_s", 8}, {"memory_limit_mb", 1024}}));
+  ASSERT_EQ(r.status, 0) << r.out;
+  const json res = read_json(dir / "out" / "results.json");
+  std::map<std::string, json> by_label;
+  for (const auto& t : res["trials"]) by_label[t["label"]] = t;
+  EXPECT_EQ(by_label["good"]["status"], "ok");
+  EXPECT_EQ(by_label["good2"]["status"], "ok");
+  EXPECT_EQ(by_label["crash"]["status"], "crashed");
+  EXPECT_NE(by_label["crash"]["message"].get<std::string>().find("signal 11"), std::string::npos);
+  EXPECT_EQ(by_label["hang"]["status"], "timeout");
+  EXPECT_EQ(by_label["hog"]["status"], "out_of_memory");
+  EXPECT_EQ(by_label["bad"]["status"], "invalid_input");
+  EXPECT_NE(by_label["bad"]["message"].get<std::string>().find("kill (0.5) must be smaller than influence"), std::string::npos);
+  EXPECT_NE(r.out.find("Warnings"), std::string::npos);  // the summary says so
+}
+
+TEST(Suite, AllocationCountsAndPlantsRepeatAcrossRuns) {
+  const auto dir = test::temp_dir("suite_alloc");
+  const auto r = growbench("suite -q -o " + (dir / "out").string() + " " +
+                           suite_file(dir, {{"repetitions", 3}, {"algorithms", {{{"name", "spacecol"}, {"params", kSmall}}}}}));
+  ASSERT_EQ(r.status, 0) << r.out;
+  const json t = read_json(dir / "out" / "results.json")["trials"][0];
+  ASSERT_EQ(t["samples"].size(), 3u);
+  EXPECT_FALSE(t.value("nondeterministic", false));
+  for (const char* ph : {"scene_load", "growth", "meshing", "metrics"}) {
+    const auto& s = t["samples"];
+    EXPECT_EQ(s[0]["phases"][ph]["alloc_count"], s[1]["phases"][ph]["alloc_count"]) << ph;
+    EXPECT_EQ(s[0]["phases"][ph]["alloc_bytes"], s[2]["phases"][ph]["alloc_bytes"]) << ph;
+    EXPECT_GT(s[0]["phases"][ph]["alloc_count"].get<long>(), 0) << ph;
+  }
+  const auto csv_lines = [&] {
+    std::ifstream in(dir / "out" / "results.csv");
+    int n = 0;
+    for (std::string l; std::getline(in, l);) ++n;
+    return n;
+  }();
+  EXPECT_EQ(csv_lines, 1 + 3);
+}
+
+TEST(Suite, ResumeAfterKillLosesNothing) {
+  const auto dir = test::temp_dir("suite_resume");
+  const json algos = json::array({{{"name", "spacecol"}, {"label", "a"}, {"params", kSmall}},
+                                   {{"name", "spacecol"}, {"label", "b"}, {"params", kSmall}}});
+  const std::string file = suite_file(dir, {{"repetitions", 4}, {"algorithms", algos}, {"scenes", {"column", "wall"}}});
+  const std::string out = (dir / "out").string();
+  std::vector<std::string> args = {GROWBENCH_BINARY, "suite", "-q", "-o", out, file};
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, GROWBENCH_BINARY, nullptr, nullptr, argv.data(), environ), 0);
+  // Kill -9 once a few trials are recorded.
+  json before;
+  for (int i = 0; i < 600; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    try {
+      before = read_json(dir / "out" / "results.json");
+      int samples = 0;
+      for (const auto& t : before["trials"]) samples += static_cast<int>(t["samples"].size());
+      if (samples >= 3) break;
+    } catch (...) {
+    }
+  }
+  kill(pid, SIGKILL);
+  waitpid(pid, nullptr, 0);
+  before = read_json(dir / "out" / "results.json");  // still valid JSON: written atomically
+  int done_before = 0;
+  for (const auto& t : before["trials"]) done_before += static_cast<int>(t["samples"].size());
+  ASSERT_GE(done_before, 3);
+  ASSERT_LT(done_before, 16) << "the suite finished before it could be killed";
+  const auto again = growbench("suite -q -o " + out + " " + file);
+  EXPECT_EQ(again.status, 2) << "refuses to overwrite results without --resume: " << again.out;
+  const auto r = growbench("suite -q --resume -o " + out + " " + file);
+  ASSERT_EQ(r.status, 0) << r.out;
+  const json after = read_json(dir / "out" / "results.json");
+  int done_after = 0;
+  for (const auto& t : after["trials"]) {
+    done_after += static_cast<int>(t["samples"].size());
+    EXPECT_EQ(t["status"], "ok");
+  }
+  EXPECT_EQ(done_after, 16);
+  // The samples recorded before the kill are still there, unchanged.
+  for (std::size_t i = 0; i < before["trials"].size(); ++i)
+    for (std::size_t k = 0; k < before["trials"][i]["samples"].size(); ++k)
+      EXPECT_EQ(before["trials"][i]["samples"][k], after["trials"][i]["samples"][k]);
+}
+
+TEST(Suite, QuickSuiteEndToEndAndSummary) {
+  const auto dir = test::temp_dir("suite_quick");
+  const std::string out = (dir / "out").string();
+  const auto r = growbench("suite -q -o " + out + " " + std::string(GROWBENCH_SOURCE_DIR) + "/bench/suites/quick.json");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const json res = read_json(dir / "out" / "results.json");
+  EXPECT_EQ(res["schema_version"], 1);
+  for (const char* k : {"growbench_commit", "dirty", "compiler", "cxx_flags", "build_type", "cpu_model", "hardware_threads",
+                        "dependencies", "date", "suite_file_hash"})
+    EXPECT_TRUE(res["context"].contains(k)) << k;
+  ASSERT_GE(res["trials"].size(), 3u);
+  for (const auto& t : res["trials"]) {
+    EXPECT_EQ(t["status"], "ok") << t["id"];
+    for (const char* k : {"geometry_hash", "metrics", "output_bytes", "alloc", "curve", "scene_hash"})
+      EXPECT_TRUE(t.contains(k)) << k;
+    for (const char* f : {"obj", "ply", "glb", "skeleton_obj"}) EXPECT_GT(t["output_bytes"][f].get<long>(), 0) << f;
+  }
+  const auto s = growbench("summary " + out + "/results.json");
+  EXPECT_EQ(s.status, 0);
+  EXPECT_NE(s.out.find("== scene wall"), std::string::npos) << s.out;
+  EXPECT_NE(s.out.find("growth median [95% CI]"), std::string::npos) << s.out;
+  EXPECT_EQ(growbench("summary /nonexistent.json").status, 2);
+}
+
+}  // namespace
+}  // namespace growbench
