@@ -170,6 +170,13 @@ class SuiteReader {
       std::string label, name, fault;
       std::vector<std::string> params;
       std::vector<std::pair<std::string, std::vector<json>>> sweep;
+      std::vector<json> points;  // explicit sweep points (instead of a product)
+      [[nodiscard]] std::size_t count() const {
+        if (!points.empty()) return points.size();
+        std::size_t n = 1;
+        for (const auto& [k, v] : sweep) n *= v.size();
+        return n;
+      }
     };
     std::vector<AlgoEntry> algos;
     if (!j.contains("algorithms") || !j["algorithms"].is_array() || j["algorithms"].empty())
@@ -209,18 +216,36 @@ class SuiteReader {
         }
       }
       if (e.is_object() && e.contains("sweep")) {
-        if (!e["sweep"].is_object()) fail(path + "/sweep", "expected an object: parameter -> array of values");
-        for (const auto& [k, vals] : e["sweep"].items()) {
-          if (!vals.is_array() || vals.empty()) fail(path + "/sweep/" + k, "expected a non-empty array of values");
-          for (std::size_t v = 0; v < vals.size(); ++v) {
-            try {
-              Params q = p;
-              q.set_json(k, vals[v]);
-            } catch (const InputError& err) {
-              fail(fmt::format("{}/sweep/{}/{}", path, k, v), err.what());
+        const json& sw = e["sweep"];
+        if (sw.is_object()) {  // parameter -> values: the cartesian product
+          for (const auto& [k, vals] : sw.items()) {
+            if (!vals.is_array() || vals.empty()) fail(path + "/sweep/" + k, "expected a non-empty array of values");
+            for (std::size_t v = 0; v < vals.size(); ++v) {
+              try {
+                Params q = p;
+                q.set_json(k, vals[v]);
+              } catch (const InputError& err) {
+                fail(fmt::format("{}/sweep/{}/{}", path, k, v), err.what());
+              }
             }
+            a.sweep.emplace_back(k, std::vector<json>(vals.begin(), vals.end()));
           }
-          a.sweep.emplace_back(k, std::vector<json>(vals.begin(), vals.end()));
+        } else if (sw.is_array() && !sw.empty()) {  // an explicit list of points: {parameter: value, ...}
+          for (std::size_t v = 0; v < sw.size(); ++v) {
+            const std::string pp = fmt::format("{}/sweep/{}", path, v);
+            if (!sw[v].is_object() || sw[v].empty()) fail(pp, "expected an object of parameter values");
+            Params q = p;
+            for (const auto& [k, val] : sw[v].items()) {
+              try {
+                q.set_json(k, val);
+              } catch (const InputError& err) {
+                fail(pp + "/" + k, err.what());
+              }
+            }
+            a.points.push_back(sw[v]);
+          }
+        } else {
+          fail(path + "/sweep", "expected an object (parameter -> array of values) or an array of parameter objects");
         }
       }
       algos.push_back(std::move(a));
@@ -228,19 +253,13 @@ class SuiteReader {
 
     // Cells. Order: for each scene, seed and sweep point, every algorithm entry in turn (interleaved).
     std::size_t max_points = 1;
-    for (const auto& a : algos) {
-      std::size_t n = 1;
-      for (const auto& [k, v] : a.sweep) n *= v.size();
-      max_points = std::max(max_points, n);
-    }
+    for (const auto& a : algos) max_points = std::max(max_points, a.count());
     std::set<std::string> ids;
     for (const auto& sc : scenes)
       for (const auto seed : seeds)
         for (std::size_t point = 0; point < max_points; ++point)
           for (const auto& a : algos) {
-            std::size_t n = 1;
-            for (const auto& [k, v] : a.sweep) n *= v.size();
-            if (point >= n) continue;
+            if (point >= a.count()) continue;
             SuiteConfig c;
             c.label = a.label;
             c.scene_name = sc.name;
@@ -256,12 +275,18 @@ class SuiteReader {
             c.spec.fault = a.fault;
             std::size_t rest = point;
             std::vector<std::string> parts;
-            for (const auto& [k, v] : a.sweep) {
-              const json& val = v[rest % v.size()];
-              rest /= v.size();
+            auto assign = [&](const std::string& k, const json& val) {
               c.sweep[k] = val;
               c.spec.params.push_back(k + "=" + value_text(val));
               parts.push_back(k + "=" + value_text(val));
+            };
+            if (!a.points.empty()) {
+              for (const auto& [k, val] : a.points[point].items()) assign(k, val);
+            } else {
+              for (const auto& [k, v] : a.sweep) {
+                assign(k, v[rest % v.size()]);
+                rest /= v.size();
+              }
             }
             c.id = fmt::format("{}/{}/s{}{}{}", safe_name(a.label), safe_name(sc.name), seed, parts.empty() ? "" : "/",
                                safe_name(fmt::format("{}", fmt::join(parts, ","))));

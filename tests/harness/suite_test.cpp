@@ -72,6 +72,25 @@ TEST(Suite, ValidationNamesFileAndPathBeforeAnythingRuns) {
   EXPECT_NE(r.out.find("at /scenes/0: unknown scene 'colum'"), std::string::npos) << r.out;
 }
 
+TEST(Suite, SweepsMakeOneCellPerPoint) {
+  const auto dir = test::temp_dir("suite_sweep");
+  const json algos = json::array({{{"name", "spacecol"}, {"label", "grid"}, {"params", kSmall},
+                                   {"sweep", {{"step", {0.02, 0.04}}, {"kill", {0.05, 0.08}}}}},
+                                  {{"name", "spacecol"}, {"label", "list"}, {"params", kSmall},
+                                   {"sweep", json::array({{{"step", 0.02}, {"kill", 0.05}}, {{"step", 0.04}, {"kill", 0.1}}})}}});
+  const auto r = growbench("suite -q -o " + (dir / "out").string() + " " + suite_file(dir, {{"algorithms", algos}}));
+  ASSERT_EQ(r.status, 0) << r.out;
+  const json res = read_json(dir / "out" / "results.json");
+  std::vector<std::string> ids;
+  for (const auto& t : res["trials"]) ids.push_back(t["id"]);
+  // The product gives 4 cells, the list 2; cells interleave the two entries.
+  ASSERT_EQ(ids.size(), 6u);
+  EXPECT_EQ(ids[0], "grid/column/s1/kill=0.05,step=0.02");  // parameters in key order
+  EXPECT_EQ(ids[1], "list/column/s1/kill=0.05,step=0.02");
+  EXPECT_EQ(res["trials"][1]["params"]["kill"], 0.05);
+  EXPECT_EQ(res["trials"][3]["params"]["kill"], 0.1);
+}
+
 TEST(Suite, CrashHangMemoryHogAndInvalidInputAreRecordedWhileOthersSucceed) {
   const auto dir = test::temp_dir("suite_isolation");
   const json algos = json::array({
