@@ -18,6 +18,7 @@
 
 #include "algorithms/algorithm.hpp"
 #include "core/errors.hpp"
+#include "core/json_util.hpp"
 #include "harness/process.hpp"
 #include "scenes/scene_library.hpp"
 
@@ -55,21 +56,9 @@ std::string safe_name(std::string s) {
   return s;
 }
 
-class SuiteReader {
+class SuiteReader : public JsonPathReader {
  public:
-  explicit SuiteReader(std::string file) : file_(std::move(file)), dir_(fs::path(file_).parent_path()) {}
-  [[noreturn]] void fail(const std::string& path, const std::string& what) const {
-    throw InputError(fmt::format("{}: at {}: {}", file_, path.empty() ? "/" : path, what));
-  }
-  void only_keys(const json& j, const std::string& path, const std::vector<std::string>& keys) const {
-    if (!j.is_object()) fail(path, fmt::format("expected an object, got {}", j.type_name()));
-    for (const auto& [k, v] : j.items())
-      if (std::find(keys.begin(), keys.end(), k) == keys.end()) {
-        const std::string near = closest_match(k, keys);
-        fail(path + "/" + k, fmt::format("unknown key '{}'{}; expected one of {}", k,
-                                         near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near), fmt::join(keys, ", ")));
-      }
-  }
+  explicit SuiteReader(const std::string& file) : JsonPathReader(file), dir_(fs::path(file).parent_path()) {}
   double number(const json& j, const std::string& path, double lo, double hi) const {
     if (!j.is_number() || j.get<double>() < lo || j.get<double>() > hi)
       fail(path, fmt::format("expected a number in [{}, {}], got {}", lo, hi, j.dump()));
@@ -89,29 +78,15 @@ class SuiteReader {
   }
 
   Suite read() const {
-    const std::string text = read_text(file_);
-    json j;
-    try {
-      j = json::parse(text);
-    } catch (const json::parse_error& e) {
-      std::size_t line = 1, col = 1;
-      for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
-        if (text[i] == '\n') {
-          ++line;
-          col = 1;
-        } else {
-          ++col;
-        }
-      }
-      throw InputError(fmt::format("{}:{}:{}: invalid JSON", file_, line, col));
-    }
+    const std::string text = read_text(file());
+    const json j = parse_json_file_text(file(), text);
     only_keys(j, "", {"schema_version", "name", "description", "repetitions", "warmup", "threads", "timeout_s",
                       "memory_limit_mb", "max_steps", "seeds", "budget", "scenes", "algorithms"});
     if (!j.contains("schema_version") || j["schema_version"] != 1) fail("/schema_version", "expected 1");
     Suite s;
-    s.file = file_;
+    s.file = file();
     s.hash = fmt::format("{:016x}", XXH3_64bits(text.data(), text.size()));
-    s.name = j.value("name", fs::path(file_).stem().string());
+    s.name = j.value("name", fs::path(file()).stem().string());
     s.description = j.value("description", "");
     if (j.contains("repetitions")) s.repetitions = static_cast<int>(number(j["repetitions"], "/repetitions", 1, 1000));
     if (j.contains("warmup")) s.warmup = static_cast<int>(number(j["warmup"], "/warmup", 0, 100));
@@ -298,7 +273,6 @@ class SuiteReader {
   }
 
  private:
-  std::string file_;
   fs::path dir_;
 };
 

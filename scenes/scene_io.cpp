@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <tiny_obj_loader.h>
 
+#include "core/json_util.hpp"
 #include "scenes/geometry.hpp"
 #include "scenes/scene_library.hpp"
 
@@ -123,25 +124,9 @@ Scene mesh_scene(const std::string& path, const Params& p) {
 }
 
 // A small reader that remembers the JSON path, so every error says where it is.
-class JsonScene {
+class JsonScene : public JsonPathReader {
  public:
-  JsonScene(std::string file, fs::path dir) : file_(std::move(file)), dir_(std::move(dir)) {}
-
-  [[noreturn]] void fail(const std::string& path, const std::string& what) const {
-    throw InputError(fmt::format("{}: at {}: {}", file_, path.empty() ? "/" : path, what));
-  }
-
-  void only_keys(const json& j, const std::string& path, const std::vector<std::string>& keys) const {
-    if (!j.is_object()) fail(path, fmt::format("expected an object, got {}", j.type_name()));
-    for (const auto& [k, v] : j.items()) {
-      if (std::find(keys.begin(), keys.end(), k) == keys.end()) {
-        const std::string near = closest_match(k, keys);
-        fail(path + "/" + k, fmt::format("unknown key '{}'{}; expected one of {}", k,
-                                         near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near),
-                                         fmt::join(keys, ", ")));
-      }
-    }
-  }
+  JsonScene(std::string file, fs::path dir) : JsonPathReader(std::move(file)), dir_(std::move(dir)) {}
   const json& need(const json& j, const std::string& path, const char* key) const {
     if (!j.contains(key)) fail(path, fmt::format("missing required key '{}'", key));
     return j.at(key);
@@ -285,7 +270,7 @@ class JsonScene {
         fail("/base", e.what());
       }
     }
-    s.name = j.contains("name") ? string(j["name"], "/name") : fs::path(file_).stem().string();
+    s.name = j.contains("name") ? string(j["name"], "/name") : fs::path(file()).stem().string();
     if (j.contains("meshes")) {
       const auto& ms = j["meshes"];
       if (!ms.is_array()) fail("/meshes", "expected an array of meshes");
@@ -359,34 +344,14 @@ class JsonScene {
   }
 
  private:
-  std::string file_;
   fs::path dir_;
 };
 
 Scene json_scene(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw InputError(fmt::format("{}: cannot open scene file", path));
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::parse_error& e) {
-    // nlohmann reports the byte offset; turn it into line:column.
-    in.clear();
-    in.seekg(0);
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    std::size_t line = 1, col = 1;
-    for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
-      if (text[i] == '\n') {
-        ++line;
-        col = 1;
-      } else {
-        ++col;
-      }
-    }
-    std::string msg = e.what();
-    if (const auto p = msg.find("parse error"); p != std::string::npos) msg = msg.substr(p);
-    throw InputError(fmt::format("{}:{}:{}: invalid JSON: {}", path, line, col, msg));
-  }
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const json j = parse_json_file_text(path, text);
   return JsonScene(path, fs::path(path).parent_path()).scene(j);
 }
 

@@ -1,9 +1,13 @@
 #pragma once
 
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -29,6 +33,31 @@ inline std::filesystem::path temp_dir(const std::string& name) {
 inline std::string write_text(const std::filesystem::path& p, const std::string& text) {
   std::ofstream(p) << text;
   return p.string();
+}
+
+// The message of the InputError that f throws, or "(no error)".
+inline std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+struct CommandResult {
+  int status;       // exit status, -1 if it did not exit normally
+  std::string out;  // stdout and stderr together
+};
+
+// Runs the growbench binary with `args` (a shell command line), as a user would.
+inline CommandResult run_growbench(const std::string& args) {
+  const auto log = temp_dir("cmd") / "log.txt";
+  const int rc = std::system((std::string(GROWBENCH_BINARY) + " " + args + " > " + log.string() + " 2>&1").c_str());
+  std::ifstream in(log);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, ss.str()};
 }
 
 }  // namespace growbench::test

@@ -499,21 +499,13 @@ class SpaceColonization final : public GrowthAlgorithm {
 
   void grow_open(std::vector<std::int32_t>& new_nodes) {
     // Pull of each active point on its nearest node, accumulated in active-list order (deterministic).
-    std::vector<std::int32_t> influenced;
-    std::vector<Pull> pull;
-    slot_.resize(plant_.nodes.size(), kNone);
     auto each = [&](auto&& f) {
       for (const std::uint32_t s : active_) {
         const auto v = static_cast<std::size_t>(closest_[s]);
         if (!stalled_[v]) f(v, s);
       }
     };
-    each([&](std::size_t v, std::uint32_t s) { add_pull(influenced, pull, v, s); });
-    for (const auto v : influenced) slot_[static_cast<std::size_t>(v)] = kNone;
-    find_opposites(influenced, pull, each);
-    if (!influenced.empty()) ever_influenced_ = true;
-    sort_by_node(influenced, pull);
-    grow_children(influenced, pull, new_nodes);
+    grow_from_pulls(each, new_nodes);
   }
 
   void grow_closed(std::vector<std::int32_t>& new_nodes) {
@@ -549,9 +541,6 @@ class SpaceColonization final : public GrowthAlgorithm {
     });
     for (std::size_t a = 0; a < active_.size(); ++a)
       if (dies[a]) kill_point(active_[a]);
-    std::vector<std::int32_t> influenced;
-    std::vector<Pull> pull;
-    slot_.resize(plant_.nodes.size(), kNone);
     auto each = [&](auto&& f) {
       for (std::size_t a = 0; a < active_.size(); ++a) {
         if (dies[a]) continue;
@@ -559,6 +548,16 @@ class SpaceColonization final : public GrowthAlgorithm {
           if (!stalled_[v]) f(std::size_t{v}, active_[a]);
       }
     };
+    grow_from_pulls(each, new_nodes);
+  }
+
+  // Accumulates the pulls that `each` enumerates as (node, point) pairs in a fixed order, then grows the
+  // influenced nodes' children (shared by open and closed venation).
+  template <class ForEachPair>
+  void grow_from_pulls(ForEachPair each, std::vector<std::int32_t>& new_nodes) {
+    std::vector<std::int32_t> influenced;
+    std::vector<Pull> pull;
+    slot_.resize(plant_.nodes.size(), kNone);
     each([&](std::size_t v, std::uint32_t s) { add_pull(influenced, pull, v, s); });
     for (const auto v : influenced) slot_[static_cast<std::size_t>(v)] = kNone;
     find_opposites(influenced, pull, each);

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/errors.hpp"
+#include "test_util.hpp"
 
 namespace growbench {
 namespace {
@@ -19,14 +20,7 @@ std::vector<ParamSpec> specs() {
   };
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using test::error_of;
 
 TEST(Params, DefaultsAndParsing) {
   Params p("algorithm 'x'", specs());

@@ -12,20 +12,7 @@
 namespace growbench {
 namespace {
 
-struct Result {
-  int status;
-  std::string out;
-};
-
-Result growbench(const std::string& args) {
-  const auto dir = test::temp_dir("cli_out");
-  const std::string log = (dir / "log.txt").string();
-  const int rc = std::system((std::string(GROWBENCH_BINARY) + " " + args + " > " + log + " 2>&1").c_str());
-  std::ifstream in(log);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, ss.str()};
-}
+test::CommandResult growbench(const std::string& args) { return test::run_growbench(args); }
 
 TEST(Cli, HelpAndLists) {
   auto r = growbench("--help");

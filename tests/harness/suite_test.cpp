@@ -21,19 +21,7 @@ namespace {
 
 using nlohmann::json;
 
-struct Result {
-  int status;
-  std::string out;
-};
-
-Result growbench(const std::string& args) {
-  const auto log = test::temp_dir("suite_log") / "log.txt";
-  const int rc = std::system((std::string(GROWBENCH_BINARY) + " " + args + " > " + log.string() + " 2>&1").c_str());
-  std::ifstream in(log);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, ss.str()};
-}
+test::CommandResult growbench(const std::string& args) { return test::run_growbench(args); }
 
 json read_json(const std::filesystem::path& p) {
   std::ifstream in(p);

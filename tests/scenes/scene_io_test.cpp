@@ -6,14 +6,7 @@
 namespace growbench {
 namespace {
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using test::error_of;
 
 TEST(StandardScenes, AllBuildWithClosedSolidsSeedsAndStableHashes) {
   ASSERT_EQ(standard_scenes().size(), 8u);
