@@ -13,11 +13,21 @@
 #include <chrono>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <string>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
 namespace growbench {
+
+int process_thread_count() {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("Threads:", 0) == 0) return std::stoi(line.substr(8));
+  return -1;
+}
 
 ChildResult run_forked(const std::function<int()>& body, const ChildLimits& limits, const std::string& log_path) {
   std::fflush(stdout);  // or the child would write the parent's buffered output again

@@ -29,6 +29,9 @@ struct ChildResult {
 // linker relocating OpenVDB, TBB and Embree. The caller must not have started threads (TBB, Embree)
 // before forking: only the calling thread exists in the child.
 // Throws std::runtime_error when the process cannot be started.
+// Threads in this process (from /proc/self/status).
+int process_thread_count();
+
 ChildResult run_forked(const std::function<int()>& body, const ChildLimits& limits, const std::string& log_path);
 
 }  // namespace growbench

@@ -14,6 +14,9 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <log4cplus/config.hxx>
+#include <tbb/global_control.h>
+#include <tbb/info.h>
 #include <xxhash.h>
 
 #include "algorithms/algorithm.hpp"
@@ -380,9 +383,20 @@ std::string run_suite(const Suite& suite, const SuiteRunOptions& o) {
                {"shard", {{"index", o.shard_index}, {"count", o.shard_count}}},
                {"trials", json::array()}};
   }
+  // Forking is only safe from a single-threaded parent. OpenVDB's logger, log4cplus, starts a pool of
+  // worker threads when the library loads, before main: stop it (logging still works without it).
+  log4cplus::deinitialize();
+  // TBB's one-time initialisation (hardware topology; no worker threads: those start with the first
+  // parallel algorithm) is done here once, so each forked trial inherits it instead of paying ~3 ms.
+  (void)tbb::info::default_concurrency();
+  { tbb::global_control warm(tbb::global_control::max_allowed_parallelism, tbb::info::default_concurrency()); }
   // The context is taken in the parent before any trial (no threads started here).
   json ctx = run_context();
   ctx["suite_file_hash"] = suite.hash;
+  ctx["parent_threads_at_fork"] = process_thread_count();
+  if (ctx["parent_threads_at_fork"] != 1)
+    fmt::print(stderr, "growbench: warning: {} threads in the suite process before forking trials (expected 1)\n",
+               ctx["parent_threads_at_fork"].get<int>());
   results["context"] = ctx;
 
   // Index the trials already recorded, and create entries for every cell of this shard.
@@ -454,9 +468,10 @@ std::string run_suite(const Suite& suite, const SuiteRunOptions& o) {
           const auto started = std::chrono::steady_clock::now();
           try {
             run_trial(spec);
-            // steady_clock is CLOCK_MONOTONIC: comparable with the parent's clock.
-            std::ofstream(dir / "timing.txt") << std::chrono::duration<double>(started.time_since_epoch()).count() << " "
-                                              << std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+            // steady_clock is CLOCK_MONOTONIC, comparable with the parent's clock; integer nanoseconds
+            // (a default-formatted double would keep only 6 significant digits).
+            std::ofstream(dir / "timing.txt") << started.time_since_epoch().count() << " "
+                                              << std::chrono::steady_clock::now().time_since_epoch().count();
             return kExitOk;
           } catch (const InputError& e) {
             write_error(e.what());
@@ -522,8 +537,10 @@ std::string run_suite(const Suite& suite, const SuiteRunOptions& o) {
       // Where the time outside the phases goes: fork to child start, child bookkeeping (record JSON,
       // files), and child exit to reaping (the kernel freeing the trial's memory).
       std::ifstream tin(dir / "timing.txt");
-      double started = 0.0, finished = 0.0;
-      if (tin >> started >> finished) {
+      std::int64_t started_ns = 0, finished_ns = 0;
+      if (tin >> started_ns >> finished_ns) {
+        static_assert(std::is_same_v<std::chrono::steady_clock::duration, std::chrono::nanoseconds>);
+        const double started = 1e-9 * static_cast<double>(started_ns), finished = 1e-9 * static_cast<double>(finished_ns);
         const double t0s = std::chrono::duration<double>(t0.time_since_epoch()).count();
         sample["launch_s"] = started - t0s;
         sample["child_bookkeeping_s"] = finished - started - inside;

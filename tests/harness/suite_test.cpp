@@ -187,8 +187,16 @@ TEST(Suite, QuickSuiteEndToEndAndSummary) {
   for (const char* k : {"growbench_commit", "dirty", "compiler", "cxx_flags", "build_type", "cpu_model", "hardware_threads",
                         "dependencies", "date", "suite_file_hash"})
     EXPECT_TRUE(res["context"].contains(k)) << k;
+  EXPECT_EQ(res["context"]["parent_threads_at_fork"], 1) << "trials must be forked from a single-threaded process";
   ASSERT_GE(res["trials"].size(), 3u);
   for (const auto& t : res["trials"]) {
+    for (const auto& s : t["samples"])
+      for (const char* k : {"launch_s", "child_bookkeeping_s", "exit_s", "harness_overhead_s"}) {
+        EXPECT_TRUE(s.contains(k)) << k;
+        if (s.contains(k)) {
+          EXPECT_GE(s[k].get<double>(), 0.0) << k;
+        }
+      }
     EXPECT_EQ(t["status"], "ok") << t["id"];
     for (const char* k : {"geometry_hash", "metrics", "output_bytes", "alloc", "curve", "scene_hash"})
       EXPECT_TRUE(t.contains(k)) << k;
