@@ -5,10 +5,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <new>
 #include <set>
 #include <sstream>
@@ -350,6 +352,33 @@ std::string results_csv(const json& results) {
   return out;
 }
 
+// The per-cell fields taken from the first successful repetition's record.
+const char* const kCellFields[] = {"geometry_hash", "counts",         "output_bytes", "metrics",   "total_length_m", "steps",
+                                   "stopped_by",    "curve",          "params",       "algorithm_stats", "threads", "scene_hash",
+                                   "alloc"};
+
+// Adds one finished repetition to its cell: the live run and the journal replay both come here.
+// `cell` holds the record's per-cell fields (all of them for the cell's first success, else just the
+// geometry hash and counts, which are compared to catch nondeterminism).
+void apply_sample(json& t, const json& sample, const json& cell) {
+  if (sample["status"] == "ok" && cell.is_object()) {
+    if (!t.contains("geometry_hash")) {
+      for (const char* k : kCellFields)
+        if (cell.contains(k)) t[k] = cell[k];
+    } else if (t["geometry_hash"] != cell["geometry_hash"] || t["counts"] != cell["counts"]) {
+      t["nondeterministic"] = true;  // the same cell grew a different plant: report it loudly
+    }
+  }
+  t["samples"].push_back(sample);
+  std::string st = "ok";
+  for (const auto& s : t["samples"])
+    if (s["status"] != "ok") st = s["status"];
+  t["status"] = st;
+  if (st != "ok")
+    for (const auto& s : t["samples"])
+      if (s["status"] != "ok" && s.contains("message")) t["message"] = s["message"];
+}
+
 }  // namespace
 
 Suite load_suite(const std::string& path) {
@@ -362,7 +391,11 @@ std::string run_suite(const Suite& suite, const SuiteRunOptions& o) {
   const fs::path results_path = out / "results.json";
   fs::create_directories(out / "trials");
 
+  const fs::path journal_path = out / "journal.jsonl";
   json results;
+  if (!o.resume && fs::exists(journal_path) && !fs::exists(results_path))
+    throw InputError(fmt::format("{} holds a journal of an interrupted run: pass --resume to continue it, or another --out",
+                                 journal_path.string()));
   if (fs::exists(results_path)) {
     if (!o.resume)
       throw InputError(fmt::format("{} already holds results: pass --resume to continue that run, or another --out",
@@ -420,6 +453,29 @@ std::string run_suite(const Suite& suite, const SuiteRunOptions& o) {
                                  {"status", "pending"},
                                  {"samples", json::array()}});
   }
+
+  // Replay the journal: repetitions finished after the last snapshot (or before a kill) come back.
+  if (o.resume && fs::exists(journal_path)) {
+    std::ifstream jin(journal_path);
+    for (std::string line; std::getline(jin, line);) {
+      json e;
+      try {
+        e = json::parse(line);
+      } catch (const json::exception&) {
+        continue;  // a line cut short by a kill: its trial runs again
+      }
+      const auto it = index.find(e.value("id", ""));
+      if (it == index.end()) continue;
+      json& t = results["trials"][it->second];
+      bool have = false;
+      for (const auto& smp : t["samples"]) have = have || smp["repetition"] == e["sample"]["repetition"];
+      if (!have) apply_sample(t, e["sample"], e["cell"]);
+    }
+  }
+  write_atomic(results_path, results.dump(1) + "\n");
+  std::unique_ptr<FILE, int (*)(FILE*)> journal(std::fopen(journal_path.c_str(), "a"), &std::fclose);
+  if (!journal) throw std::runtime_error(fmt::format("{}: cannot open the journal", journal_path.string()));
+  auto last_snapshot = std::chrono::steady_clock::now();
 
   // Jobs: warm-ups, then repetitions, each pass over the interleaved cells.
   struct Job {
@@ -514,28 +570,24 @@ std::string run_suite(const Suite& suite, const SuiteRunOptions& o) {
       continue;
     }
     json& t = results["trials"][index[c.id]];
+    json cell = nullptr;
     if (status == "ok") {
       sample["phases"] = rec["phases"];
       double inside = 0.0;
       for (const auto& [k, v] : rec["phases"].items()) inside += v["wall_s"].get<double>();
       sample["steps"] = rec["steps"];
-      const json deterministic = {{"geometry_hash", rec["geometry_hash"]}, {"counts", rec["counts"]},
-                                  {"output_bytes", rec["output_bytes"]}};
+      cell = {{"geometry_hash", rec["geometry_hash"]}, {"counts", rec["counts"]}};
       if (!t.contains("geometry_hash")) {
-        for (const char* k : {"geometry_hash", "counts", "output_bytes", "metrics", "total_length_m", "steps", "stopped_by",
-                              "curve", "params", "algorithm_stats", "threads"})
-          if (rec.contains(k)) t[k] = rec[k];
-        t["scene_hash"] = rec["scene"]["hash"];
+        for (const char* k : kCellFields)
+          if (rec.contains(k)) cell[k] = rec[k];
+        cell["scene_hash"] = rec["scene"]["hash"];
         json alloc = json::object();
         for (const auto& [k, v] : rec["phases"].items()) alloc[k] = {{"count", v["alloc_count"]}, {"bytes", v["alloc_bytes"]}};
-        t["alloc"] = alloc;
-      } else if (t["geometry_hash"] != rec["geometry_hash"] || t["counts"] != rec["counts"]) {
-        t["nondeterministic"] = true;  // the same cell grew a different plant: report it loudly
+        cell["alloc"] = alloc;
       }
-      const auto t1 = std::chrono::steady_clock::now();
-      sample["harness_overhead_s"] = std::chrono::duration<double>(t1 - t0).count() - inside;
       // Where the time outside the phases goes: fork to child start, child bookkeeping (record JSON,
-      // files), and child exit to reaping (the kernel freeing the trial's memory).
+      // files), and child exit to reaping (the kernel freeing the trial's memory). The total runs to
+      // just before the journal append below (one short write).
       std::ifstream tin(dir / "timing.txt");
       std::int64_t started_ns = 0, finished_ns = 0;
       if (tin >> started_ns >> finished_ns) {
@@ -546,25 +598,19 @@ std::string run_suite(const Suite& suite, const SuiteRunOptions& o) {
         sample["child_bookkeeping_s"] = finished - started - inside;
         sample["exit_s"] = t0s + cr.wall_s - finished;
       }
+      sample["harness_overhead_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() - inside;
     }
-    t["samples"].push_back(sample);
-    std::string st = "ok";
-    for (const auto& s : t["samples"])
-      if (s["status"] != "ok") st = s["status"];
-    t["status"] = st;
-    if (st != "ok") {
-      for (const auto& s : t["samples"])
-        if (s["status"] != "ok" && s.contains("message")) t["message"] = s["message"];
-    }
-    // Results after every trial, atomically: an interrupted suite loses at most the trial in flight.
-    write_atomic(results_path, results.dump(1) + "\n");
-    write_atomic(out / "results.csv", results_csv(results));
-    if (job.repetition >= 0 && status == "ok") {
-      // Overhead includes writing the results: patch it in now that they are written.
-      const auto t2 = std::chrono::steady_clock::now();
-      double inside = 0.0;
-      for (const auto& [k, v] : rec["phases"].items()) inside += v["wall_s"].get<double>();
-      t["samples"].back()["harness_overhead_s"] = std::chrono::duration<double>(t2 - t0).count() - inside;
+    // The journal line is the durable record: appended and flushed before the next trial starts, so an
+    // interrupted suite (even by kill -9) loses at most the trial in flight.
+    const std::string line = json{{"id", c.id}, {"sample", sample}, {"cell", cell}}.dump() + "\n";
+    if (std::fputs(line.c_str(), journal.get()) < 0 || std::fflush(journal.get()) != 0)
+      throw std::runtime_error(fmt::format("{}: cannot append to the journal", (out / "journal.jsonl").string()));
+    apply_sample(t, sample, cell);
+    // Readable snapshots of the whole run every few seconds (always written atomically).
+    if (std::chrono::steady_clock::now() - last_snapshot > std::chrono::seconds(10)) {
+      write_atomic(results_path, results.dump(1) + "\n");
+      write_atomic(out / "results.csv", results_csv(results));
+      last_snapshot = std::chrono::steady_clock::now();
     }
   }
   write_atomic(results_path, results.dump(1) + "\n");

@@ -1,6 +1,8 @@
 // Suites: a matrix of algorithms x scenes x seeds x parameter sweeps x repetitions, each trial run in
-// its own (forked) process with a timeout and an address-space limit, results written atomically after
-// every trial so that an interrupted suite can be resumed without losing any.
+// its own (forked) process with a timeout and an address-space limit. Every finished repetition is
+// appended to OUT/journal.jsonl (flushed before the next trial); results.json and results.csv are
+// rewritten atomically every 10 s and at the end. --resume replays the journal, so an interrupted suite
+// (even by kill -9) loses at most the trial in flight.
 #pragma once
 
 #include <cstdint>

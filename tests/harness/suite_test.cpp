@@ -141,25 +141,25 @@ TEST(Suite, ResumeAfterKillLosesNothing) {
   argv.push_back(nullptr);
   pid_t pid = 0;
   ASSERT_EQ(posix_spawn(&pid, GROWBENCH_BINARY, nullptr, nullptr, argv.data(), environ), 0);
-  // Kill -9 once a few trials are recorded.
-  json before;
-  for (int i = 0; i < 600; ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    try {
-      before = read_json(dir / "out" / "results.json");
-      int samples = 0;
-      for (const auto& t : before["trials"]) samples += static_cast<int>(t["samples"].size());
-      if (samples >= 3) break;
-    } catch (...) {
+  // Kill -9 once a few repetitions are in the journal.
+  auto journal = [&] {
+    std::vector<json> lines;
+    std::ifstream in(dir / "out" / "journal.jsonl");
+    for (std::string l; std::getline(in, l);) {
+      try {
+        lines.push_back(json::parse(l));
+      } catch (...) {
+      }
     }
-  }
+    return lines;
+  };
+  for (int i = 0; i < 600 && journal().size() < 3; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
   kill(pid, SIGKILL);
   waitpid(pid, nullptr, 0);
-  before = read_json(dir / "out" / "results.json");  // still valid JSON: written atomically
-  int done_before = 0;
-  for (const auto& t : before["trials"]) done_before += static_cast<int>(t["samples"].size());
-  ASSERT_GE(done_before, 3);
-  ASSERT_LT(done_before, 16) << "the suite finished before it could be killed";
+  const std::vector<json> before = journal();
+  ASSERT_GE(before.size(), 3u);
+  ASSERT_LT(before.size(), 16u) << "the suite finished before it could be killed";
+  read_json(dir / "out" / "results.json");  // whatever snapshot is there parses: written atomically
   const auto again = growbench("suite -q -o " + out + " " + file);
   EXPECT_EQ(again.status, 2) << "refuses to overwrite results without --resume: " << again.out;
   const auto r = growbench("suite -q --resume -o " + out + " " + file);
@@ -171,10 +171,18 @@ TEST(Suite, ResumeAfterKillLosesNothing) {
     EXPECT_EQ(t["status"], "ok");
   }
   EXPECT_EQ(done_after, 16);
-  // The samples recorded before the kill are still there, unchanged.
-  for (std::size_t i = 0; i < before["trials"].size(); ++i)
-    for (std::size_t k = 0; k < before["trials"][i]["samples"].size(); ++k)
-      EXPECT_EQ(before["trials"][i]["samples"][k], after["trials"][i]["samples"][k]);
+  // Every repetition journaled before the kill is in the results, unchanged, and was not run again.
+  for (const auto& e : before) {
+    int found = 0;
+    for (const auto& t : after["trials"])
+      if (t["id"] == e["id"])
+        for (const auto& smp : t["samples"])
+          if (smp["repetition"] == e["sample"]["repetition"]) {
+            ++found;
+            EXPECT_EQ(smp, e["sample"]);
+          }
+    EXPECT_EQ(found, 1) << e["id"];
+  }
 }
 
 TEST(Suite, QuickSuiteEndToEndAndSummary) {
