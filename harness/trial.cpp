@@ -351,7 +351,8 @@ nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const P
 
   if (!spec.out_dir.empty()) {
     const std::string path = (std::filesystem::path(spec.out_dir) / "record.json").string();
-    const std::string text = rec.dump(2) + "\n";
+    // Indented for people reading `growbench run` output; compact when a suite parent parses it.
+    const std::string text = rec.dump(spec.skip_teardown ? -1 : 2) + "\n";
     std::ofstream(path + ".tmp") << text;
     std::filesystem::rename(path + ".tmp", path);
   }
