@@ -4,24 +4,15 @@
 #include <cmath>
 
 #include <glm/gtc/quaternion.hpp>
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <nanoflann.hpp>
-#pragma GCC diagnostic pop
 #include <tbb/parallel_for.h>
+
+#include "core/kdtree.hpp"
 
 namespace growbench {
 namespace {
 
-struct PointsAdaptor {
-  const std::vector<glm::vec3>* pts;
-  [[nodiscard]] std::size_t kdtree_get_point_count() const { return pts->size(); }
-  [[nodiscard]] float kdtree_get_pt(std::size_t i, std::size_t d) const { return (*pts)[i][static_cast<int>(d)]; }
-  template <class B>
-  bool kdtree_get_bbox(B&) const { return false; }
-};
-using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, PointsAdaptor>, PointsAdaptor, 3,
-                                                 std::uint32_t>;
+using PointsAdaptor = Vec3Cloud;
+using Tree = Vec3Tree;
 
 float point_segment_distance(const glm::vec3& p, const glm::vec3& a, const glm::vec3& b) {
   const glm::vec3 ab = b - a;

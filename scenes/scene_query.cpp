@@ -6,8 +6,8 @@
 
 #include <embree3/rtcore.h>
 #include <fmt/format.h>
-#include <nanoflann.hpp>
 
+#include "core/kdtree.hpp"
 #include "core/random.hpp"
 #include "scenes/geometry.hpp"
 #include "scenes/sdf.hpp"
@@ -147,32 +147,23 @@ bool point_query_callback(RTCPointQueryFunctionArguments* args) {
   return false;
 }
 
-struct VertexCloud {
-  std::vector<glm::vec3> pts;
-  [[nodiscard]] std::size_t kdtree_get_point_count() const { return pts.size(); }
-  [[nodiscard]] float kdtree_get_pt(std::size_t i, std::size_t d) const { return pts[i][static_cast<int>(d)]; }
-  template <class BBox>
-  bool kdtree_get_bbox(BBox&) const { return false; }
-};
-using VertexTree =
-    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, VertexCloud>, VertexCloud, 3, std::uint32_t>;
-
 }  // namespace
 
 // Every vertex used by a triangle lies on the surface, so the nearest one bounds the closest-point
 // distance from above: an unbounded Embree point query starts from that radius instead of infinity
 // (about 60x fewer BVH nodes visited for points far from the bunny).
 struct SceneQuery::VertexIndex {
-  VertexCloud cloud;
-  std::unique_ptr<VertexTree> tree;
+  std::vector<glm::vec3> pts;
+  Vec3Cloud cloud{&pts};
+  std::unique_ptr<Vec3Tree> tree;
   explicit VertexIndex(const Scene& s) {
     for (const auto& m : s.meshes) {
       std::vector<bool> used(m.vertices.size(), false);
       for (const auto& t : m.triangles) used[t.x] = used[t.y] = used[t.z] = true;
       for (std::size_t i = 0; i < m.vertices.size(); ++i)
-        if (used[i]) cloud.pts.push_back(m.vertices[i]);
+        if (used[i]) pts.push_back(m.vertices[i]);
     }
-    tree = std::make_unique<VertexTree>(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    tree = std::make_unique<Vec3Tree>(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
   }
   float upper_bound(const glm::vec3& p) const {
     std::uint32_t idx = 0;

@@ -35,6 +35,15 @@ inline std::string write_text(const std::filesystem::path& p, const std::string&
   return p.string();
 }
 
+// A scene with one mesh and one seed at the origin.
+inline Scene scene_with(TriangleMesh mesh) {
+  Scene s;
+  s.name = "test";
+  s.meshes.push_back(std::move(mesh));
+  s.seeds.push_back({});
+  return s;
+}
+
 // The message of the InputError that f throws, or "(no error)".
 inline std::string error_of(const std::function<void()>& f) {
   try {

@@ -20,14 +20,9 @@
 #include <sstream>
 
 #include <fmt/format.h>
-// GCC 12 reports a false -Wmaybe-uninitialized inside nanoflann's dynamic index (root_bbox of trees it
-// copies before building them); the warning is about the library's header, so it is silenced here only.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <nanoflann.hpp>
-#pragma GCC diagnostic pop
 #include <tbb/parallel_for.h>
 
+#include "core/kdtree.hpp"
 #include "core/random.hpp"
 
 namespace growbench {
@@ -74,16 +69,9 @@ const AlgorithmInfo kInfo = {
         {"leaf_size", ParamType::Real, 0.05, 0, 10, "m", "leaf blade length", {}},
     }};
 
-struct Cloud {
-  const std::vector<glm::vec3>* pts;
-  [[nodiscard]] std::size_t kdtree_get_point_count() const { return pts->size(); }
-  [[nodiscard]] float kdtree_get_pt(std::size_t i, std::size_t d) const { return (*pts)[i][static_cast<int>(d)]; }
-  template <class BBox>
-  bool kdtree_get_bbox(BBox&) const { return false; }
-};
-using PointTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Cloud>, Cloud, 3, std::uint32_t>;
-using NodeTree =
-    nanoflann::KDTreeSingleIndexDynamicAdaptor<nanoflann::L2_Simple_Adaptor<float, Cloud>, Cloud, 3, std::uint32_t>;
+using Cloud = Vec3Cloud;
+using PointTree = Vec3Tree;
+using NodeTree = Vec3DynamicTree;
 
 // Collects (index, squared distance) within a radius, skipping entries a filter rejects.
 template <class Keep>

@@ -5,17 +5,12 @@
 
 #include "scenes/geometry.hpp"
 #include "scenes/scene_library.hpp"
+#include "test_util.hpp"
 
 namespace growbench {
 namespace {
 
-Scene with_mesh(TriangleMesh m) {
-  Scene s;
-  s.name = "t";
-  s.meshes.push_back(std::move(m));
-  s.seeds.push_back({});
-  return s;
-}
+using test::scene_with;
 
 TriangleMesh unit_quad() {  // the square [0,1] x [0,1] at z = 0, open
   TriangleMesh q;
@@ -42,7 +37,7 @@ TEST(Metrics, SegmentDistance) {
 TEST(Metrics, CountsLengthOrderDepthBox) {
   Plant p = chain({{0, 0, 0}, {0, 1, 0}, {0, 2, 0}});
   p.nodes.push_back({{1, 1, 0}, 0.01f, 1, 1, 1, 0});
-  const Scene s = with_mesh(unit_quad());
+  const Scene s = scene_with(unit_quad());
   SceneQuery q(s, {.build_sdf = false});
   const auto m = compute_metrics(p, q);
   EXPECT_EQ(m["nodes"], 4);
@@ -55,7 +50,7 @@ TEST(Metrics, CountsLengthOrderDepthBox) {
 
 TEST(Metrics, CoverageOfAStripAcrossAQuad) {
   // A segment along y = 0.5 covers the strip |y - 0.5| <= d of the unit square: a fraction 2d.
-  const Scene s = with_mesh(unit_quad());
+  const Scene s = scene_with(unit_quad());
   SceneQuery q(s, {.build_sdf = false});
   MetricOptions o;
   o.coverage_distance = 0.1f;
@@ -66,7 +61,7 @@ TEST(Metrics, CoverageOfAStripAcrossAQuad) {
 
 TEST(Metrics, AdhesionAndPenetration) {
   // A 2 m box: top face at y = 1. Nodes at 0.01, 0.03, 0.1 above it, and one inside.
-  const Scene s = with_mesh(geom::make_box("box", {-1, -1, -1}, {1, 1, 1}));
+  const Scene s = scene_with(geom::make_box("box", {-1, -1, -1}, {1, 1, 1}));
   SceneQuery q(s);
   const Plant p = chain({{0, 1.01f, 0}, {0, 1.03f, 0}, {0, 1.1f, 0}, {0, 0.5f, 0}});
   const auto m = compute_metrics(p, q);
@@ -80,7 +75,7 @@ TEST(Metrics, AdhesionAndPenetration) {
 }
 
 TEST(Metrics, SelfIntersectionOfCrossingBranches) {
-  const Scene s = with_mesh(unit_quad());
+  const Scene s = scene_with(unit_quad());
   SceneQuery q(s, {.build_sdf = false});
   Plant p = chain({{-1, 0, 0}, {0, 0, 0}, {1, 0, 0}}, 0.02f);
   const Plant other = chain({{0, -1, 0.01f}, {0, 1, 0.01f}}, 0.02f);  // crosses 1 cm above, radii sum 4 cm

@@ -11,13 +11,7 @@
 namespace growbench {
 namespace {
 
-Scene single(TriangleMesh m) {
-  Scene s;
-  s.name = "test";
-  s.meshes.push_back(std::move(m));
-  s.seeds.push_back({});
-  return s;
-}
+using test::scene_with;
 
 // Brute force over every triangle: the reference for Embree's closest point.
 float brute_distance(const Scene& s, const glm::vec3& p) {
@@ -96,7 +90,7 @@ TEST(Geometry, FillSmallHolesClosesAScanButNotAWall) {
 }
 
 TEST(SceneQuery, BoxDistancesMatchAnalyticWithinAVoxel) {
-  const Scene s = single(geom::make_box("box", {-1, -1, -1}, {1, 1, 1}));
+  const Scene s = scene_with(geom::make_box("box", {-1, -1, -1}, {1, 1, 1}));
   SceneQuery q(s, {.voxel_size = 0.02f});
   auto analytic = [](const glm::vec3& p) {
     const glm::vec3 d = glm::abs(p) - glm::vec3(1.0f);
@@ -121,7 +115,7 @@ TEST(SceneQuery, BoxDistancesMatchAnalyticWithinAVoxel) {
 
 TEST(SceneQuery, SphereDistancesMatchAnalyticWithinAVoxel) {
   const float r = 0.8f;
-  const Scene s = single(geom::make_icosphere("sphere", {0.5f, 0.2f, -0.3f}, r, 5));
+  const Scene s = scene_with(geom::make_icosphere("sphere", {0.5f, 0.2f, -0.3f}, r, 5));
   SceneQuery q(s, {.voxel_size = 0.015f});
   const float sagitta = r * (1.0f - std::cos(0.5f * 0.0275f));  // icosphere level 5 flattening
   Rng rng(4, 0);
@@ -208,7 +202,7 @@ TEST(SceneQuery, OpenMeshHasNoInside) {
   quad.name = "quad";
   quad.vertices = {{-1, 0, 0}, {1, 0, 0}, {1, 2, 0}, {-1, 2, 0}};
   quad.triangles = {{0, 1, 2}, {0, 2, 3}};
-  const Scene s = single(quad);
+  const Scene s = scene_with(quad);
   SceneQuery q(s, {.voxel_size = 0.02f});
   EXPECT_FALSE(q.mesh_solid()[0]);
   for (const float z : {-0.5f, -0.03f, -0.001f, 0.001f, 0.03f, 0.5f}) {
