@@ -495,7 +495,6 @@ std::string run_suite(const Suite& suite, const SuiteRunOptions& o) {
 
   const bool tty = isatty(STDERR_FILENO) != 0 && !o.quiet;
   const auto t_start = std::chrono::steady_clock::now();
-  double busy = 0.0;
   for (std::size_t jn = 0; jn < jobs.size(); ++jn) {
     const Job& job = jobs[jn];
     const SuiteConfig& c = *job.cell;
@@ -565,10 +564,7 @@ std::string run_suite(const Suite& suite, const SuiteRunOptions& o) {
     }
     sample["status"] = status;
     if (!message.empty()) sample["message"] = message;
-    if (job.repetition < 0) {  // a warm-up: measured, not kept
-      busy += cr.wall_s;
-      continue;
-    }
+    if (job.repetition < 0) continue;  // a warm-up: run, not kept
     json& t = results["trials"][index[c.id]];
     json cell = nullptr;
     if (status == "ok") {

@@ -112,12 +112,10 @@ std::string summarize_results(const json& results) {
         mean /= static_cast<double>(growth.size());
         for (const double g : growth) var += (g - mean) * (g - mean);
         const double cv = std::sqrt(var / static_cast<double>(growth.size() - 1)) / mean;
-        const double spread = std::max(std::abs(lo - med), std::abs(hi - med)) / med;
         const double min_v = *std::min_element(growth.begin(), growth.end()), max_v = *std::max_element(growth.begin(), growth.end());
         const double far = std::max(med - min_v, max_v - med) / med;
         if (cv > 0.10) warnings.push_back(fmt::format("{} on {}: growth time CV {:.0f}% > 10%", cell, sc, 100 * cv));
         if (far > 0.50) warnings.push_back(fmt::format("{} on {}: a repetition is {:.0f}% from the median (> 50%)", cell, sc, 100 * far));
-        (void)spread;
       }
       if (t.value("nondeterministic", false)) warnings.push_back(fmt::format("{} on {}: repetitions grew different plants", cell, sc));
       if (t.value("status", "ok") != "ok")
