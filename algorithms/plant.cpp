@@ -50,11 +50,21 @@ std::string Plant::geometry_hash() const {
     put(o.size);
     put(o.kind);
     put(o.node);
+    put(o.stamp);
   }
   put(polygons.size());
   for (const auto& p : polygons) {
     put(p.vertices.size());
     for (const auto& v : p.vertices) put(v);
+  }
+  if (!node_groups.empty()) {
+    put(node_groups.size());
+    XXH3_64bits_update(st, node_groups.data(), node_groups.size() * sizeof(std::int32_t));
+  }
+  for (const auto& a : node_attributes) {
+    XXH3_64bits_update(st, a.name.data(), a.name.size());
+    put(a.components);
+    XXH3_64bits_update(st, a.values.data(), a.values.size() * sizeof(float));
   }
   const auto h = XXH3_64bits_digest(st);
   XXH3_freeState(st);
@@ -77,6 +87,12 @@ std::string Plant::validate() const {
     if (o.node != kNoParent && (o.node < 0 || static_cast<std::size_t>(o.node) >= nodes.size()))
       return fmt::format("organ {} refers to node {} of {}", i, o.node, nodes.size());
   }
+  if (!node_groups.empty() && node_groups.size() != nodes.size())
+    return fmt::format("{} node groups for {} nodes", node_groups.size(), nodes.size());
+  for (const auto& a : node_attributes)
+    if (a.components < 1 || a.values.size() != nodes.size() * static_cast<std::size_t>(a.components))
+      return fmt::format("attribute '{}' has {} values for {} nodes of {} components", a.name, a.values.size(),
+                         nodes.size(), a.components);
   return {};
 }
 

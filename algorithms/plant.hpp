@@ -2,6 +2,7 @@
 // One mesher, one set of metrics and one renderer serve all algorithms through it.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -33,6 +34,7 @@ struct Organ {
   float size = 0.0f;
   OrganKind kind = OrganKind::Leaf;
   std::int32_t node = kNoParent;  // the node it grows from (or kNoParent)
+  std::array<float, 3> stamp{};   // user values carried to the instanced geometry (L-system J/K/M a, b, c)
 };
 
 // A planar polygon (L-system { . } blocks).
@@ -40,15 +42,27 @@ struct PlantPolygon {
   std::vector<glm::vec3> vertices;
 };
 
+// A per-node float attribute (L-system a("Cd", r, g, b)): `components` values per node.
+struct NodeAttribute {
+  std::string name;
+  int components = 1;
+  std::vector<float> values;
+};
+
 struct Plant {
   std::vector<PlantNode> nodes;
   std::vector<Organ> organs;
   std::vector<PlantPolygon> polygons;
+  // Optional per-node data, empty unless an algorithm fills it (one entry per node when present):
+  std::vector<std::int32_t> node_groups;  // group number (-1: none); L-system g
+  std::vector<NodeAttribute> node_attributes;
 
   void clear() {
     nodes.clear();
     organs.clear();
     polygons.clear();
+    node_groups.clear();
+    node_attributes.clear();
   }
   [[nodiscard]] std::size_t leaf_count() const;
   [[nodiscard]] double total_length() const;  // sum of segment lengths (node to parent)

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "algorithms/algorithm.hpp"
+#include "algorithms/lsystem/lsystem.hpp"
 #include "algorithms/spacecol/spacecol.hpp"
 
 namespace growbench {
@@ -10,6 +11,7 @@ namespace growbench {
 const std::vector<AlgorithmEntry>& algorithm_registry() {
   static const std::vector<AlgorithmEntry> list = {
       {spacecol_info, make_spacecol},
+      {lsystem_info, make_lsystem},
   };
   return list;
 }

@@ -5,11 +5,13 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <optional>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
 #include "algorithms/algorithm.hpp"
+#include "algorithms/lsystem/lsystem.hpp"
 #include "core/errors.hpp"
 #include "harness/suite.hpp"
 #include "harness/trial.hpp"
@@ -80,6 +82,24 @@ int main(int argc, char** argv) {
   suite_cmd->add_option("--shard", shard, "run only shard I of N (I/N, 0-based): a deterministic slice of the cells");
   suite_cmd->add_flag("-q,--quiet", suite_quiet, "no progress lines");
 
+  auto* lsys_cmd = app.add_subcommand(
+      "lsystem", "Derive an L-system's string without drawing it: symbol counts, and the string with --print");
+  std::string lsys_file;
+  std::vector<std::string> lsys_sets;
+  std::string lsys_generations;
+  std::string lsys_scene;
+  std::uint64_t lsys_seed = 1;
+  bool lsys_print = false, lsys_examples = false;
+  std::size_t lsys_limit = 0;
+  lsys_cmd->add_option("grammar", lsys_file, "a .lsys grammar file or an example name (see --examples)");
+  lsys_cmd->add_option("-g,--generations", lsys_generations, "generations (default: the grammar's)");
+  lsys_cmd->add_option("--set", lsys_sets, "L-system parameter key=value (repeatable; see `growbench list`)");
+  lsys_cmd->add_option("--seed", lsys_seed, "random seed")->default_val(1);
+  lsys_cmd->add_option("--scene", lsys_scene, "scene for in() and the start point (default: none; in() is 0)");
+  lsys_cmd->add_flag("-p,--print", lsys_print, "print the derived string");
+  lsys_cmd->add_option("--limit", lsys_limit, "print at most this many modules (0: all)")->default_val(0);
+  lsys_cmd->add_flag("--examples", lsys_examples, "list the example grammars");
+
   auto* summary_cmd = app.add_subcommand("summary", "Print the tables of a results file: per scene, cell by metric");
   std::string results_file;
   summary_cmd->add_option("results", results_file, "results.json written by `growbench suite`")->required();
@@ -136,6 +156,34 @@ int main(int argc, char** argv) {
       const auto results = nlohmann::json::parse(in);
       fmt::print("{}", gb::summarize_results(results));
       fmt::print("\nwrote {} and results.csv beside it\n", path);
+      return 0;
+    }
+    if (*lsys_cmd) {
+      if (lsys_examples) {
+        for (const auto& name : gb::lsystem_examples()) fmt::print("{}\n", name);
+        return 0;
+      }
+      gb::Params params = gb::default_params(gb::find_algorithm("lsystem"));
+      if (!lsys_file.empty()) params.set("grammar", lsys_file);
+      if (!lsys_generations.empty()) params.set("generations", lsys_generations);
+      for (const auto& a : lsys_sets) params.set_assignment(a);
+      std::optional<gb::Scene> scene;
+      std::unique_ptr<gb::SceneQuery> query;
+      if (!lsys_scene.empty()) {
+        scene = gb::load_scene(lsys_scene);
+        query = std::make_unique<gb::SceneQuery>(*scene);
+      }
+      const auto t0 = std::chrono::steady_clock::now();
+      const gb::DerivedString d = gb::derive_lsystem(params, lsys_seed, scene ? &*scene : nullptr, query.get(), lsys_limit);
+      const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      if (lsys_print) {
+        fmt::print("{}", d.text);
+        if (lsys_limit && d.modules > lsys_limit) fmt::print(" ... ({} more modules)", d.modules - lsys_limit);
+        fmt::print("\n");
+      }
+      fmt::print(stderr, "generation {}: {} modules, {} parameters, {:.1f} MiB, derived in {:.3f} s\n", d.generations,
+                 d.modules, d.params, d.bytes / (1024.0 * 1024.0), secs);
+      for (const auto& [c, n] : d.counts) fmt::print(stderr, "  {}  {}\n", c, n);
       return 0;
     }
     if (*summary_cmd) {

@@ -1,0 +1,429 @@
+#include "algorithms/lsystem/derive.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+
+#include "core/errors.hpp"
+#include "core/random.hpp"
+
+namespace growbench::lsys {
+namespace {
+
+constexpr std::size_t kBlock = 1u << 15;  // modules per block
+constexpr std::uint16_t kCopy = 0xffff;
+
+double draw(std::uint64_t seed, std::uint64_t stream, int generation, std::size_t module, std::size_t rule) {
+  const std::uint64_t bits = random_bits(seed ^ (static_cast<std::uint64_t>(generation) << 40), stream,
+                                         (static_cast<std::uint64_t>(module) << 16) ^ rule);
+  return static_cast<double>(bits >> 11) * 0x1.0p-53;
+}
+
+std::size_t block_count(std::size_t n) { return (n + kBlock - 1) / kBlock; }
+
+}  // namespace
+
+std::string to_text(const LString& s, const std::vector<std::string>& strings, std::size_t limit) {
+  std::string out;
+  std::size_t p = 0;
+  const std::size_t n = limit ? std::min(limit, s.size()) : s.size();
+  for (std::size_t m = 0; m < n; ++m) {
+    const std::uint16_t w = s.symbols[m];
+    const char c = symbol_of(w);
+    out.push_back(c);
+    const int k = count_of(w);
+    if (k > 0) {
+      out.push_back('(');
+      for (int a = 0; a < k; ++a) {
+        if (a) out.push_back(',');
+        const float v = s.params[p + a];
+        if (c == 'a' && a == 0 && v >= 0 && static_cast<std::size_t>(v) < strings.size())
+          out += fmt::format("\"{}\"", strings[static_cast<std::size_t>(v)]);
+        else
+          out += fmt::format("{:g}", v);
+      }
+      out.push_back(')');
+    }
+    p += k;
+  }
+  return out;
+}
+
+std::vector<std::size_t> symbol_counts(const LString& s) {
+  std::vector<std::size_t> counts(128, 0);
+  for (std::size_t m = 0; m < s.size(); ++m) ++counts[static_cast<unsigned char>(symbol_of(s.symbols[m]))];
+  return counts;
+}
+
+Deriver::Deriver(const Grammar& grammar, DeriveSettings settings) : g_(grammar), s_(std::move(settings)) {
+  s_.env.resize(kMaxSlots, 0.0);
+  for (int c = 0; c < 128; ++c) {
+    const auto& list = g_.rules_for[c];
+    if (list.empty()) continue;
+    const Rule& r = g_.rules[list[0]];
+    const bool simple = list.size() == 1 && !r.has_context && r.condition.empty() && r.probability.empty() &&
+                        r.static_successor && !r.pred.has_parens && !g_.uses_age;
+    kind_[c] = simple ? 1 : 2;
+  }
+}
+
+void Deriver::premise(LString& out) const {
+  std::vector<std::uint16_t> syms;
+  std::vector<float> pars;
+  std::vector<double> env = s_.env;
+  env[kVarGeneration] = 0.0;
+  for (std::size_t m = 0; m < g_.premise.size(); ++m) {
+    const auto& mod = g_.premise[m];
+    env[kVarIndex] = static_cast<double>(m);
+    syms.push_back(static_cast<std::uint16_t>(encode(mod.symbol, static_cast<int>(mod.args.size())) | kNewFlag));
+    for (const auto& a : mod.args) pars.push_back(static_cast<float>(a.eval(env.data(), *s_.host)));
+  }
+  out.symbols.assign(syms);
+  out.params.assign(pars);
+  if (g_.uses_age) {
+    out.ages.resize_discard(syms.size());
+    std::fill_n(out.ages.data(), syms.size(), std::uint16_t{0});
+  }
+}
+
+// Matches the rule's contexts around module m (parameters at offset poff) and binds every formal.
+bool Deriver::bind(const Rule& r, const LString& in, std::size_t m, std::size_t poff, double* env) const {
+  const std::uint16_t* sym = in.symbols.data();
+  const float* par = in.params.data();
+  const std::size_t n = in.size();
+  const int k = count_of(sym[m]);
+  if (r.pred.has_parens && static_cast<std::size_t>(k) != r.pred.formals.size()) return false;
+  std::size_t slot = 0;
+  for (std::size_t a = 0; a < r.pred.formals.size(); ++a) env[kFormal0 + slot++] = par[poff + a];
+  if (!r.has_context) return true;
+  const bool flat = s_.brackets_transparent;
+
+  // left context, right to left
+  if (!r.left.empty()) {
+    std::size_t left_slot = slot;
+    for (const auto& p : r.left) left_slot += p.formals.size();
+    std::ptrdiff_t pos = static_cast<std::ptrdiff_t>(m) - 1;
+    std::size_t off = poff;
+    for (std::size_t j = r.left.size(); j-- > 0;) {
+      const Pattern& pat = r.left[j];
+      char c = 0;
+      std::uint16_t w = 0;
+      while (true) {
+        if (pos < 0) return false;
+        w = sym[pos];
+        c = symbol_of(w);
+        off -= count_of(w);
+        if (c == '[' || c == ']') {
+          if (flat || c == '[') {  // '[' leads from a branch into its parent
+            --pos;
+            continue;
+          }
+          // ']' : skip the sibling branch that ends here
+          int depth = 1;
+          --pos;
+          while (depth > 0) {
+            if (pos < 0) return false;
+            const std::uint16_t w2 = sym[pos];
+            off -= count_of(w2);
+            const char c2 = symbol_of(w2);
+            if (c2 == ']') ++depth;
+            else if (c2 == '[') --depth;
+            --pos;
+          }
+          continue;
+        }
+        if (g_.ignore.test(static_cast<unsigned char>(c)) && c != pat.symbol) {
+          --pos;
+          continue;
+        }
+        break;
+      }
+      if (c != pat.symbol) return false;
+      if (pat.has_parens && static_cast<std::size_t>(count_of(w)) != pat.formals.size()) return false;
+      left_slot -= pat.formals.size();
+      for (std::size_t a = 0; a < pat.formals.size(); ++a) env[kFormal0 + left_slot + a] = par[off + a];
+      --pos;
+    }
+    for (const auto& p : r.left) slot += p.formals.size();
+  }
+
+  // right context, left to right
+  if (!r.right.empty()) {
+    std::size_t pos = m + 1;
+    std::size_t off = poff + static_cast<std::size_t>(k);
+    for (const Pattern& pat : r.right) {
+      if (pat.symbol == ']') {  // skip the rest of the current branch, then consume its ']'
+        int depth = 0;
+        while (true) {
+          if (pos >= n) return false;
+          const char c = symbol_of(sym[pos]);
+          if (c == '[') ++depth;
+          else if (c == ']') {
+            if (depth == 0) break;
+            --depth;
+          }
+          off += count_of(sym[pos]);
+          ++pos;
+        }
+        ++pos;
+        continue;
+      }
+      char c = 0;
+      std::uint16_t w = 0;
+      while (true) {
+        if (pos >= n) return false;
+        w = sym[pos];
+        c = symbol_of(w);
+        if (c == pat.symbol) break;
+        if (c == '[' || c == ']') {
+          if (flat) {
+            ++pos;
+            continue;
+          }
+          if (c == ']') return false;  // the branch ends before the context does
+          int depth = 1;               // skip a sub-branch
+          ++pos;
+          while (depth > 0) {
+            if (pos >= n) return false;
+            const std::uint16_t w2 = sym[pos];
+            const char c2 = symbol_of(w2);
+            if (c2 == '[') ++depth;
+            else if (c2 == ']') --depth;
+            off += count_of(w2);
+            ++pos;
+          }
+          continue;
+        }
+        if (g_.ignore.test(static_cast<unsigned char>(c))) {
+          off += count_of(w);
+          ++pos;
+          continue;
+        }
+        break;
+      }
+      if (c != pat.symbol) return false;
+      if (pat.has_parens && static_cast<std::size_t>(count_of(w)) != pat.formals.size()) return false;
+      for (std::size_t a = 0; a < pat.formals.size(); ++a) env[kFormal0 + slot + a] = par[off + a];
+      slot += pat.formals.size();
+      off += count_of(w);
+      ++pos;
+    }
+  }
+  return true;
+}
+
+int Deriver::choose(const LString& in, std::size_t m, std::size_t poff, double* env, int generation) const {
+  const std::uint16_t w = in.symbols[m];
+  const auto& list = g_.rules_for[static_cast<unsigned char>(symbol_of(w))];
+  double psum = 0.0;
+  int candidates[64];
+  double weights[64];
+  int ncand = 0;
+  int fallback = -1;
+  for (const std::uint16_t ri : list) {
+    const Rule& r = g_.rules[ri];
+    if (!bind(r, in, m, poff, env)) continue;
+    if (!r.condition.empty() && r.condition.eval(env, *s_.host) == 0.0) continue;
+    if (r.probability.empty()) {
+      fallback = ri;
+      break;
+    }
+    double p = r.probability.eval(env, *s_.host);
+    if (p > 1.0) p *= 0.01;
+    if (!(p > 0.0)) continue;
+    if (s_.probability == ProbabilityMode::Sequential) {
+      if (draw(s_.seed, s_.stream, generation, m, ri) < p) return ri;
+      continue;
+    }
+    if (ncand < 64) {
+      candidates[ncand] = ri;
+      weights[ncand++] = p;
+      psum += p;
+    }
+  }
+  if (ncand > 0) {
+    const double u = draw(s_.seed, s_.stream, generation, m, 0xffff) * std::max(1.0, psum);
+    double acc = 0.0;
+    for (int k = 0; k < ncand; ++k) {
+      acc += weights[k];
+      if (u < acc) return candidates[k];
+    }
+  }
+  return fallback;
+}
+
+void Deriver::rewrite(const LString& in, LString& out, int generation, const std::vector<TurtleVars>& states) {
+  const std::size_t n = in.size();
+  const std::size_t nb = block_count(n);
+  const std::uint16_t* sym = in.symbols.data();
+  const bool general = std::any_of(std::begin(kind_), std::end(kind_), [](std::uint8_t k) { return k == 2; });
+  const bool ages = g_.uses_age;
+  const bool turtle = g_.uses_turtle && states.size() == n;
+  if (general) choice_.resize(n);
+  block_in_params_.assign(nb + 1, 0);
+  block_out_syms_.assign(nb + 1, 0);
+  block_out_params_.assign(nb + 1, 0);
+
+  // parameter offset of every block's first module
+  if (in.params.size() > 0) {
+    tbb::parallel_for(std::size_t{0}, nb, [&](std::size_t b) {
+      std::size_t s = 0;
+      const std::size_t end = std::min(n, (b + 1) * kBlock);
+      for (std::size_t m = b * kBlock; m < end; ++m) s += static_cast<std::size_t>(count_of(sym[m]));
+      block_in_params_[b + 1] = s;
+    });
+    for (std::size_t b = 0; b < nb; ++b) block_in_params_[b + 1] += block_in_params_[b];
+  }
+
+  std::uint32_t static_syms[128] = {}, static_pars[128] = {};
+  for (int c = 0; c < 128; ++c) {
+    if (kind_[c] != 1) continue;
+    const Rule& r = g_.rules[g_.rules_for[c][0]];
+    static_syms[c] = static_cast<std::uint32_t>(r.static_symbols.size());
+    static_pars[c] = static_cast<std::uint32_t>(r.static_params.size());
+  }
+
+  auto setup_env = [&](double* env) {
+    std::memcpy(env, s_.env.data(), sizeof(double) * kMaxSlots);
+    env[kVarGeneration] = generation;
+  };
+  auto set_module_env = [&](double* env, std::size_t m) {
+    env[kVarIndex] = static_cast<double>(m);
+    if (ages) env[kVarAge] = in.ages[m];
+    if (turtle) {
+      const TurtleVars& t = states[m];
+      env[kVarX] = t.x;
+      env[kVarY] = t.y;
+      env[kVarZ] = t.z;
+      env[kVarArc] = t.arc;
+      env[kVarLength] = t.length;
+      env[kVarWidth] = t.width;
+      env[kVarU] = t.u;
+      env[kVarV] = t.v;
+    }
+  };
+
+  // pass 1: choose and count
+  tbb::parallel_for(std::size_t{0}, nb, [&](std::size_t b) {
+    double env[kMaxSlots];
+    setup_env(env);
+    std::size_t osyms = 0, opars = 0, poff = block_in_params_[b];
+    const std::size_t end = std::min(n, (b + 1) * kBlock);
+    for (std::size_t m = b * kBlock; m < end; ++m) {
+      const std::uint16_t w = sym[m];
+      const unsigned c = w & kSymbolMask;
+      const int k = count_of(w);
+      switch (kind_[c]) {
+        case 0:
+          osyms += 1;
+          opars += static_cast<std::size_t>(k);
+          break;
+        case 1:
+          osyms += static_syms[c];
+          opars += static_pars[c];
+          break;
+        default: {
+          set_module_env(env, m);
+          const int r = choose(in, m, poff, env, generation);
+          choice_[m] = r < 0 ? kCopy : static_cast<std::uint16_t>(r);
+          if (r < 0) {
+            osyms += 1;
+            opars += static_cast<std::size_t>(k);
+          } else {
+            osyms += g_.rules[r].successor.size();
+            opars += g_.rules[r].out_params;
+          }
+        }
+      }
+      poff += static_cast<std::size_t>(k);
+    }
+    block_out_syms_[b + 1] = osyms;
+    block_out_params_[b + 1] = opars;
+  });
+  for (std::size_t b = 0; b < nb; ++b) {
+    block_out_syms_[b + 1] += block_out_syms_[b];
+    block_out_params_[b + 1] += block_out_params_[b];
+  }
+  const std::size_t total_syms = block_out_syms_[nb], total_pars = block_out_params_[nb];
+  if (total_syms > s_.max_symbols)
+    throw InputError(fmt::format("L-system runaway: generation {} would have {} symbols (from {}), over the limit "
+                                 "max_symbols={}; lower generations or raise max_symbols",
+                                 generation, total_syms, n, s_.max_symbols));
+  if (total_pars > s_.max_params)
+    throw InputError(fmt::format("L-system runaway: generation {} would have {} parameters, over the limit of {}",
+                                 generation, total_pars, s_.max_params));
+  out.symbols.resize_discard(total_syms);
+  out.params.resize_discard(total_pars);
+  if (ages) out.ages.resize_discard(total_syms);
+  else out.ages.release();
+
+  // pass 2: write
+  tbb::parallel_for(std::size_t{0}, nb, [&](std::size_t b) {
+    double env[kMaxSlots];
+    setup_env(env);
+    std::uint16_t* os = out.symbols.data() + block_out_syms_[b];
+    float* op = out.params.data() + block_out_params_[b];
+    std::uint16_t* oa = ages ? out.ages.data() + block_out_syms_[b] : nullptr;
+    std::size_t poff = block_in_params_[b];
+    const float* ip = in.params.data();
+    const std::size_t end = std::min(n, (b + 1) * kBlock);
+    auto copy_module = [&](std::size_t m, std::uint16_t w, int k) {
+      *os++ = static_cast<std::uint16_t>(w & ~kNewFlag);
+      for (int a = 0; a < k; ++a) *op++ = ip[poff + a];
+      if (oa) {
+        const std::uint16_t age = in.ages[m];
+        *oa++ = age == 0xffff ? age : static_cast<std::uint16_t>(age + 1);
+      }
+    };
+    auto put_static = [&](const Rule& r) {
+      const std::size_t ns = r.static_symbols.size();
+      for (std::size_t q = 0; q < ns; ++q) os[q] = static_cast<std::uint16_t>(r.static_symbols[q] | kNewFlag);
+      os += ns;
+      if (!r.static_params.empty()) {
+        std::memcpy(op, r.static_params.data(), r.static_params.size() * sizeof(float));
+        op += r.static_params.size();
+      }
+      if (oa) {
+        std::fill_n(oa, ns, std::uint16_t{0});
+        oa += ns;
+      }
+    };
+    for (std::size_t m = b * kBlock; m < end; ++m) {
+      const std::uint16_t w = sym[m];
+      const unsigned c = w & kSymbolMask;
+      const int k = count_of(w);
+      switch (kind_[c]) {
+        case 0:
+          copy_module(m, w, k);
+          break;
+        case 1:
+          put_static(g_.rules[g_.rules_for[c][0]]);
+          break;
+        default: {
+          const std::uint16_t ri = choice_[m];
+          if (ri == kCopy) {
+            copy_module(m, w, k);
+            break;
+          }
+          const Rule& r = g_.rules[ri];
+          if (r.static_successor) {
+            put_static(r);
+            break;
+          }
+          set_module_env(env, m);
+          bind(r, in, m, poff, env);
+          for (const auto& mod : r.successor) {
+            *os++ = static_cast<std::uint16_t>(encode(mod.symbol, static_cast<int>(mod.args.size())) | kNewFlag);
+            for (const auto& a : mod.args) *op++ = static_cast<float>(a.eval(env, *s_.host));
+            if (oa) *oa++ = 0;
+          }
+        }
+      }
+      poff += static_cast<std::size_t>(k);
+    }
+  });
+}
+
+}  // namespace growbench::lsys

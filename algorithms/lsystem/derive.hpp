@@ -1,0 +1,79 @@
+// Parallel, deterministic rewriting of an LString by a Grammar.
+//
+// One generation is two passes over fixed blocks of the input (TBB): the first chooses a rule for every
+// module and counts what the block will write, an exclusive scan turns the counts into output offsets
+// (the total is checked against the symbol limit before anything is allocated), and the second writes
+// each block's output at its offset. Blocks never share output, and every random draw is a pure
+// function of (seed, stream, generation, module index, rule index), so the string is identical for
+// any thread count.
+//
+// Rule choice. Rules for a symbol are tried in file order; the first applicable rule wins (its
+// pattern's parameter count, contexts and condition hold). Probabilities, two documented modes:
+//  - sequential (Houdini's wording, the default): an applicable rule with a probability p fires with
+//    chance p (an independent draw per rule); if it does not, the next rule is tried. So
+//    A=X:0.5, A=Y:0.5 gives X 50%, Y 25%, and A copied 25%.
+//  - normalized (The Algorithmic Beauty of Plants): the applicable probabilistic rules before the first
+//    applicable rule without a probability form one choice; rule k is picked with chance
+//    p_k / max(1, sum p); the rest (1 - sum p when sum p < 1) goes to that rule without a probability,
+//    or to copying the symbol. So A=X:0.5, A=Y:0.5 gives X 50%, Y 50%.
+// A symbol with no applicable rule is copied.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "algorithms/lsystem/grammar.hpp"
+#include "algorithms/lsystem/lstring.hpp"
+
+namespace growbench::lsys {
+
+enum class ProbabilityMode { Sequential, Normalized };
+
+// The turtle's state at a module, for rules whose conditions or arguments read x y z A L W U V.
+struct TurtleVars {
+  float x = 0, y = 0, z = 0, arc = 0, length = 0, width = 0, u = 0, v = 0;
+};
+
+struct DeriveSettings {
+  const ExprHost* host = nullptr;
+  std::uint64_t seed = 0;
+  std::uint64_t stream = 0;  // e.g. the plant (scene seed) index
+  ProbabilityMode probability = ProbabilityMode::Sequential;
+  bool brackets_transparent = false;  // context includes siblings, or [ ] in the ignore list
+  std::size_t max_symbols = 50'000'000;
+  std::size_t max_params = 100'000'000;
+  std::vector<double> env;  // kMaxSlots values: a b c d T and user variables filled in
+};
+
+class Deriver {
+ public:
+  Deriver(const Grammar& grammar, DeriveSettings settings);
+
+  // The premise, evaluated at generation 0.
+  void premise(LString& out) const;
+  // Rewrites `in` into `out` as generation `generation` (1 for the first rewrite). `states` holds the
+  // turtle state of every module of `in` when the grammar reads it (else may be empty). Throws
+  // InputError when the result would exceed the symbol or parameter limit.
+  void rewrite(const LString& in, LString& out, int generation, const std::vector<TurtleVars>& states);
+
+  // The random stream of the plant being rewritten (one per scene seed).
+  void set_stream(std::uint64_t stream) { s_.stream = stream; }
+  [[nodiscard]] const Grammar& grammar() const { return g_; }
+  [[nodiscard]] const DeriveSettings& settings() const { return s_; }
+
+ private:
+  struct Block;
+  int choose(const LString& in, std::size_t m, std::size_t poff, double* env, int generation) const;
+  bool bind(const Rule& r, const LString& in, std::size_t m, std::size_t poff, double* env) const;
+
+  const Grammar& g_;
+  DeriveSettings s_;
+  std::uint8_t kind_[128] = {};  // 0 copy, 1 one static rule without conditions, 2 general
+  std::vector<std::uint16_t> choice_;
+  std::vector<std::size_t> block_in_params_, block_out_syms_, block_out_params_;
+};
+
+// Symbol counts of a string (index: ASCII code).
+std::vector<std::size_t> symbol_counts(const LString& s);
+
+}  // namespace growbench::lsys

@@ -1,0 +1,383 @@
+#include "algorithms/lsystem/expr.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <numbers>
+
+#include <fmt/format.h>
+
+namespace growbench::lsys {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr int kMaxStack = 64;
+
+struct Function {
+  const char* name;
+  Op op;
+  int arity;
+  bool host;
+};
+constexpr Function kFunctions[] = {
+    {"sin", Op::Sin, 1, false},     {"cos", Op::Cos, 1, false},     {"tan", Op::Tan, 1, false},
+    {"asin", Op::Asin, 1, false},   {"acos", Op::Acos, 1, false},   {"atan", Op::Atan, 1, false},
+    {"atan2", Op::Atan2, 2, false}, {"sqrt", Op::Sqrt, 1, false},   {"abs", Op::Abs, 1, false},
+    {"floor", Op::Floor, 1, false}, {"ceil", Op::Ceil, 1, false},   {"min", Op::Min, 2, false},
+    {"max", Op::Max, 2, false},     {"clamp", Op::Clamp, 3, false}, {"pow", Op::Pow, 2, false},
+    {"rand", Op::Rand, 1, true},    {"in", Op::In, 3, true},        {"pic", Op::Pic, 3, true},
+    {"chan", Op::Chan, 1, true},
+};
+
+struct Reserved {
+  const char* name;
+  int slot;
+  bool turtle;
+};
+constexpr Reserved kReserved[] = {
+    {"a", kVarA, false},        {"b", kVarB, false},        {"c", kVarC, false},
+    {"d", kVarD, false},        {"g", kVarAge, false},      {"i", kVarIndex, false},
+    {"t", kVarGeneration, false}, {"x", kVarX, true},       {"y", kVarY, true},
+    {"z", kVarZ, true},         {"A", kVarArc, true},       {"L", kVarLength, true},
+    {"T", kVarGravity, false},  {"U", kVarU, true},         {"V", kVarV, true},
+    {"W", kVarWidth, true},
+};
+
+int stack_effect(Op op) {
+  switch (op) {
+    case Op::Const: case Op::Load: return 1;
+    case Op::Neg: case Op::Not: case Op::Sin: case Op::Cos: case Op::Tan: case Op::Asin: case Op::Acos:
+    case Op::Atan: case Op::Sqrt: case Op::Abs: case Op::Floor: case Op::Ceil: case Op::Rand: case Op::Chan:
+      return 0;
+    case Op::In: case Op::Pic: case Op::Clamp: return -2;
+    default: return -1;  // binary operators
+  }
+}
+
+class Parser {
+ public:
+  Parser(std::string_view text, const ExprScope& scope, std::vector<Instr>& code, ExprUse& use)
+      : s_(text), scope_(scope), code_(code), use_(use) {}
+
+  bool run(ExprError& error) {
+    try {
+      skip();
+      if (pos_ >= s_.size()) fail("expected an expression");
+      parse_or();
+      skip();
+      if (pos_ < s_.size()) fail(fmt::format("unexpected '{}' after the expression", s_[pos_]));
+      return true;
+    } catch (const ExprError& e) {
+      error = e;
+      return false;
+    }
+  }
+
+ private:
+  [[noreturn]] void fail(std::string message) const { throw ExprError{pos_, std::move(message)}; }
+  void skip() {
+    while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+  }
+  bool peek(std::string_view tok) {
+    skip();
+    return s_.substr(pos_, tok.size()) == tok;
+  }
+  bool accept(std::string_view tok) {
+    if (!peek(tok)) return false;
+    pos_ += tok.size();
+    return true;
+  }
+  void emit(Op op, std::uint8_t slot = 0, double value = 0.0) { code_.push_back({op, slot, value}); }
+
+  void parse_or() {
+    parse_and();
+    while (true) {
+      if (accept("||") || accept("|")) {
+        parse_and();
+        emit(Op::Or);
+      } else {
+        return;
+      }
+    }
+  }
+  void parse_and() {
+    parse_eq();
+    while (true) {
+      if (accept("&&") || accept("&")) {
+        parse_eq();
+        emit(Op::And);
+      } else {
+        return;
+      }
+    }
+  }
+  void parse_eq() {
+    parse_rel();
+    while (true) {
+      if (accept("==")) {
+        parse_rel();
+        emit(Op::Eq);
+      } else if (accept("!=")) {
+        parse_rel();
+        emit(Op::Ne);
+      } else if (accept("=")) {
+        parse_rel();
+        emit(Op::Eq);
+      } else {
+        return;
+      }
+    }
+  }
+  void parse_rel() {
+    parse_add();
+    while (true) {
+      if (accept("<=")) {
+        parse_add();
+        emit(Op::Le);
+      } else if (accept(">=")) {
+        parse_add();
+        emit(Op::Ge);
+      } else if (accept("<")) {
+        parse_add();
+        emit(Op::Lt);
+      } else if (accept(">")) {
+        parse_add();
+        emit(Op::Gt);
+      } else {
+        return;
+      }
+    }
+  }
+  void parse_add() {
+    parse_mul();
+    while (true) {
+      if (accept("+")) {
+        parse_mul();
+        emit(Op::Add);
+      } else if (accept("-")) {
+        parse_mul();
+        emit(Op::Sub);
+      } else {
+        return;
+      }
+    }
+  }
+  void parse_mul() {
+    parse_unary();
+    while (true) {
+      if (accept("*")) {
+        parse_unary();
+        emit(Op::Mul);
+      } else if (accept("/")) {
+        parse_unary();
+        emit(Op::Div);
+      } else if (accept("%")) {
+        parse_unary();
+        emit(Op::Mod);
+      } else {
+        return;
+      }
+    }
+  }
+  void parse_unary() {
+    if (++depth_ > 200) fail("expression nested too deeply");
+    if (accept("-")) {
+      parse_unary();
+      emit(Op::Neg);
+    } else if (accept("+")) {
+      parse_unary();
+    } else if (peek("!") && !peek("!=")) {
+      ++pos_;
+      parse_unary();
+      emit(Op::Not);
+    } else {
+      parse_primary();
+      if (accept("^")) {
+        parse_unary();
+        emit(Op::Pow);
+      }
+    }
+    --depth_;
+  }
+  void parse_primary() {
+    skip();
+    if (pos_ >= s_.size()) fail("expected a number, a variable, a function call or '('");
+    const char ch = s_[pos_];
+    if (ch == '(') {
+      ++pos_;
+      parse_or();
+      if (!accept(")")) fail("expected ')'");
+      return;
+    }
+    if (std::isdigit(static_cast<unsigned char>(ch)) || ch == '.') {
+      const std::size_t start = pos_;
+      while (pos_ < s_.size() &&
+             (std::isdigit(static_cast<unsigned char>(s_[pos_])) || s_[pos_] == '.' ||
+              ((s_[pos_] == 'e' || s_[pos_] == 'E') && pos_ + 1 < s_.size() &&
+               (std::isdigit(static_cast<unsigned char>(s_[pos_ + 1])) ||
+                ((s_[pos_ + 1] == '-' || s_[pos_ + 1] == '+') && pos_ + 2 < s_.size() &&
+                 std::isdigit(static_cast<unsigned char>(s_[pos_ + 2]))))))) {
+        if (s_[pos_] == 'e' || s_[pos_] == 'E') ++pos_;  // the exponent sign (if any) follows
+        ++pos_;
+      }
+      double v = 0.0;
+      const auto [end, ec] = std::from_chars(s_.data() + start, s_.data() + pos_, v);
+      if (ec != std::errc() || end != s_.data() + pos_) {
+        pos_ = start;
+        fail(fmt::format("malformed number '{}'", s_.substr(start, pos_ - start)));
+      }
+      emit(Op::Const, 0, v);
+      return;
+    }
+    if (std::isalpha(static_cast<unsigned char>(ch)) || ch == '_') {
+      const std::size_t start = pos_;
+      while (pos_ < s_.size() && (std::isalnum(static_cast<unsigned char>(s_[pos_])) || s_[pos_] == '_')) ++pos_;
+      const std::string_view name = s_.substr(start, pos_ - start);
+      skip();
+      if (pos_ < s_.size() && s_[pos_] == '(') {
+        for (const auto& f : kFunctions) {
+          if (name != f.name) continue;
+          ++pos_;
+          for (int k = 0; k < f.arity; ++k) {
+            if (k > 0 && !accept(",")) fail(fmt::format("{}() takes {} arguments; expected ','", f.name, f.arity));
+            parse_or();
+          }
+          if (!accept(")")) fail(fmt::format("{}() takes {} argument{}; expected ')'", f.name, f.arity, f.arity == 1 ? "" : "s"));
+          emit(f.op);
+          if (f.op == Op::In || f.op == Op::Pic) use_.turtle = true;
+          return;
+        }
+        pos_ = start;
+        fail(fmt::format("unknown function '{}'", name));
+      }
+      load(name, start);
+      return;
+    }
+    fail(fmt::format("expected a number, a variable, a function call or '(', found '{}'", ch));
+  }
+  void load(std::string_view name, std::size_t at) {
+    if (scope_.formals) {
+      for (std::size_t k = 0; k < scope_.formals->size(); ++k) {
+        if ((*scope_.formals)[k] == name) {
+          emit(Op::Load, static_cast<std::uint8_t>(kFormal0 + k));
+          use_.formals |= 1ull << k;
+          return;
+        }
+      }
+    }
+    for (const auto& r : kReserved) {
+      if (name == r.name) {
+        emit(Op::Load, static_cast<std::uint8_t>(r.slot));
+        if (r.turtle) use_.turtle = true;
+        if (r.slot == kVarAge) use_.age = true;
+        return;
+      }
+    }
+    if (scope_.user_names) {
+      for (std::size_t k = 0; k < scope_.user_names->size(); ++k) {
+        if ((*scope_.user_names)[k] == name) {
+          emit(Op::Load, static_cast<std::uint8_t>(kUserVar0 + k));
+          return;
+        }
+      }
+    }
+    pos_ = at;
+    fail(fmt::format("unknown variable '{}' (not a parameter of this rule, a reserved variable "
+                     "a b c d g i t x y z A L T U V W, or a user variable)",
+                     name));
+  }
+
+  std::string_view s_;
+  const ExprScope& scope_;
+  std::vector<Instr>& code_;
+  ExprUse& use_;
+  std::size_t pos_ = 0;
+  int depth_ = 0;
+};
+
+}  // namespace
+
+int reserved_slot(std::string_view name) {
+  for (const auto& r : kReserved)
+    if (name == r.name) return r.slot;
+  return -1;
+}
+
+bool ExprCompiler::compile(std::string_view text, const ExprScope& scope, Expr& out, ExprError& error) {
+  out = Expr();
+  out.text_ = std::string(text);
+  Parser p(text, scope, out.code_, out.use_);
+  if (!p.run(error)) return false;
+  int depth = 0, max_depth = 0;
+  for (const auto& in : out.code_) {
+    depth += stack_effect(in.op);
+    max_depth = std::max(max_depth, depth);
+  }
+  if (max_depth > kMaxStack) {
+    error = {0, fmt::format("expression needs a stack of {} values; at most {} are supported", max_depth, kMaxStack)};
+    return false;
+  }
+  bool pure = out.code_.size() > 1;
+  for (const auto& in : out.code_)
+    if (in.op == Op::Load || in.op == Op::Rand || in.op == Op::In || in.op == Op::Pic || in.op == Op::Chan) pure = false;
+  if (pure) {
+    struct NoHost final : ExprHost {
+      double in(double, double, double) const override { return 0.0; }
+      double pic(double, double, double) const override { return 0.0; }
+      double rand(double) const override { return 0.0; }
+      double chan(double) const override { return 0.0; }
+    } host;
+    const double v = out.eval(nullptr, host);
+    out.code_.assign(1, Instr{Op::Const, 0, v});
+  }
+  return true;
+}
+
+double Expr::eval(const double* env, const ExprHost& host) const {
+  double st[kMaxStack];
+  int sp = 0;
+  for (const Instr& in : code_) {
+    switch (in.op) {
+      case Op::Const: st[sp++] = in.value; break;
+      case Op::Load: st[sp++] = env[in.slot]; break;
+      case Op::Add: --sp; st[sp - 1] += st[sp]; break;
+      case Op::Sub: --sp; st[sp - 1] -= st[sp]; break;
+      case Op::Mul: --sp; st[sp - 1] *= st[sp]; break;
+      case Op::Div: --sp; st[sp - 1] /= st[sp]; break;
+      case Op::Mod: --sp; st[sp - 1] = std::fmod(st[sp - 1], st[sp]); break;
+      case Op::Pow: --sp; st[sp - 1] = std::pow(st[sp - 1], st[sp]); break;
+      case Op::Neg: st[sp - 1] = -st[sp - 1]; break;
+      case Op::Not: st[sp - 1] = st[sp - 1] == 0.0 ? 1.0 : 0.0; break;
+      case Op::Lt: --sp; st[sp - 1] = st[sp - 1] < st[sp] ? 1.0 : 0.0; break;
+      case Op::Le: --sp; st[sp - 1] = st[sp - 1] <= st[sp] ? 1.0 : 0.0; break;
+      case Op::Gt: --sp; st[sp - 1] = st[sp - 1] > st[sp] ? 1.0 : 0.0; break;
+      case Op::Ge: --sp; st[sp - 1] = st[sp - 1] >= st[sp] ? 1.0 : 0.0; break;
+      case Op::Eq: --sp; st[sp - 1] = st[sp - 1] == st[sp] ? 1.0 : 0.0; break;
+      case Op::Ne: --sp; st[sp - 1] = st[sp - 1] != st[sp] ? 1.0 : 0.0; break;
+      case Op::And: --sp; st[sp - 1] = (st[sp - 1] != 0.0 && st[sp] != 0.0) ? 1.0 : 0.0; break;
+      case Op::Or: --sp; st[sp - 1] = (st[sp - 1] != 0.0 || st[sp] != 0.0) ? 1.0 : 0.0; break;
+      case Op::Sin: st[sp - 1] = std::sin(st[sp - 1] * kDeg); break;
+      case Op::Cos: st[sp - 1] = std::cos(st[sp - 1] * kDeg); break;
+      case Op::Tan: st[sp - 1] = std::tan(st[sp - 1] * kDeg); break;
+      case Op::Asin: st[sp - 1] = std::asin(std::clamp(st[sp - 1], -1.0, 1.0)) / kDeg; break;
+      case Op::Acos: st[sp - 1] = std::acos(std::clamp(st[sp - 1], -1.0, 1.0)) / kDeg; break;
+      case Op::Atan: st[sp - 1] = std::atan(st[sp - 1]) / kDeg; break;
+      case Op::Atan2: --sp; st[sp - 1] = std::atan2(st[sp - 1], st[sp]) / kDeg; break;
+      case Op::Sqrt: st[sp - 1] = std::sqrt(st[sp - 1]); break;
+      case Op::Abs: st[sp - 1] = std::fabs(st[sp - 1]); break;
+      case Op::Floor: st[sp - 1] = std::floor(st[sp - 1]); break;
+      case Op::Ceil: st[sp - 1] = std::ceil(st[sp - 1]); break;
+      case Op::Min: --sp; st[sp - 1] = std::min(st[sp - 1], st[sp]); break;
+      case Op::Max: --sp; st[sp - 1] = std::max(st[sp - 1], st[sp]); break;
+      case Op::Clamp: sp -= 2; st[sp - 1] = std::clamp(st[sp - 1], std::min(st[sp], st[sp + 1]), std::max(st[sp], st[sp + 1])); break;
+      case Op::Rand: st[sp - 1] = host.rand(st[sp - 1]); break;
+      case Op::Chan: st[sp - 1] = host.chan(st[sp - 1]); break;
+      case Op::In: sp -= 2; st[sp - 1] = host.in(st[sp - 1], st[sp], st[sp + 1]); break;
+      case Op::Pic: sp -= 2; st[sp - 1] = host.pic(st[sp - 1], st[sp], st[sp + 1]); break;
+    }
+  }
+  return st[0];
+}
+
+}  // namespace growbench::lsys

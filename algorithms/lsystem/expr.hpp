@@ -1,0 +1,114 @@
+// Expressions of the Houdini L-system dialect, compiled once to a small stack bytecode and evaluated
+// per module without re-parsing.
+//
+// Grammar (lowest precedence first):
+//   or      := and (('|' | '||') and)*
+//   and     := eq (('&' | '&&') eq)*
+//   eq      := rel (('==' | '=' | '!=') rel)*        a lone '=' compares, as in Houdini's ':m=0'
+//   rel     := add (('<' | '<=' | '>' | '>=') add)*
+//   add     := mul (('+' | '-') mul)*
+//   mul     := unary (('*' | '/' | '%') unary)*
+//   unary   := ('-' | '+' | '!') unary | power
+//   power   := primary ('^' unary)?                     right-associative
+//   primary := number | name | name '(' args ')' | '(' or ')'
+// Truth is "not zero"; comparisons and logic give 1 or 0. Angles of sin, cos, tan, asin, acos, atan2
+// are in degrees (the reference's convention).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace growbench::lsys {
+
+// Where each variable lives in the evaluation environment (a flat array of doubles).
+enum Slot : std::uint8_t {
+  kFormal0 = 0,      // rule formals: predecessor and context parameters, up to kMaxFormals
+  kMaxFormals = 24,
+  kVarA = kMaxFormals,  // a: angle
+  kVarB, kVarC, kVarD,
+  kVarAge,          // g
+  kVarIndex,        // i
+  kVarGeneration,   // t
+  kVarX, kVarY, kVarZ,
+  kVarArc,          // A
+  kVarLength,       // L
+  kVarGravity,      // T
+  kVarU, kVarV,     // colour indices
+  kVarWidth,        // W
+  kUserVar0,        // user-defined single-letter variables follow
+  kMaxSlots = 96,
+};
+
+// Calls an expression can make that need the outside world (the scene, an image, the seed).
+class ExprHost {
+ public:
+  virtual ~ExprHost() = default;
+  virtual double in(double x, double y, double z) const = 0;
+  virtual double pic(double u, double v, double plane) const = 0;
+  virtual double rand(double seed) const = 0;
+  virtual double chan(double index) const = 0;
+};
+
+enum class Op : std::uint8_t {
+  Const, Load,
+  Add, Sub, Mul, Div, Mod, Pow, Neg, Not,
+  Lt, Le, Gt, Ge, Eq, Ne, And, Or,
+  Sin, Cos, Tan, Asin, Acos, Atan, Atan2, Sqrt, Abs, Floor, Ceil, Min, Max, Clamp,
+  Rand, In, Pic, Chan,
+};
+
+struct Instr {
+  Op op;
+  std::uint8_t slot = 0;
+  double value = 0.0;
+};
+
+// Which environment slots an expression reads (bit i = slot i) and which host calls it makes.
+struct ExprUse {
+  std::uint64_t formals = 0;  // bit per formal slot
+  bool turtle = false;        // x y z A L W U V or in()/pic() of them: needs the turtle's state
+  bool age = false;           // g
+};
+
+class Expr {
+ public:
+  Expr() = default;
+  [[nodiscard]] double eval(const double* env, const ExprHost& host) const;
+  [[nodiscard]] bool empty() const { return code_.empty(); }
+  [[nodiscard]] bool constant() const { return code_.size() == 1 && code_[0].op == Op::Const; }
+  [[nodiscard]] double constant_value() const { return code_[0].value; }
+  [[nodiscard]] const ExprUse& use() const { return use_; }
+  [[nodiscard]] const std::string& text() const { return text_; }
+
+ private:
+  friend class ExprCompiler;
+  std::vector<Instr> code_;
+  ExprUse use_;
+  std::string text_;
+};
+
+// A compile error: `offset` is the byte offset into the expression text where the problem is.
+struct ExprError {
+  std::size_t offset;
+  std::string message;
+};
+
+// Name resolution for one rule: its formal parameter names, then the reserved single-letter variables,
+// then the user's variables (`user_names[k]` lives in slot kUserVar0 + k).
+struct ExprScope {
+  const std::vector<std::string>* formals = nullptr;
+  const std::vector<std::string>* user_names = nullptr;
+};
+
+class ExprCompiler {
+ public:
+  // Compiles `text`; on error returns false and fills `error`. Constant sub-expressions are folded.
+  static bool compile(std::string_view text, const ExprScope& scope, Expr& out, ExprError& error);
+};
+
+// Reserved single-letter variables and their slots ("a" -> kVarA, ...); -1 when not reserved.
+int reserved_slot(std::string_view name);
+
+}  // namespace growbench::lsys

@@ -1,0 +1,475 @@
+// L-systems in the Houdini L-system SOP dialect (seeds/houdini-lsystem-reference.txt): parametric,
+// stochastic, context-sensitive rules with conditions, a full 3D turtle, leaf/flower instancing, in()
+// against the scene, and a surface-wrap mode (the Hyphae notes' wrapped L-systems).
+//
+// One growth step is one generation: every plant (one per scene seed, each with its own random stream)
+// rewrites its string once (derive.cpp, parallel and deterministic), then the turtle redraws the whole
+// plant (turtle.cpp). A fractional generation count adds one last rewrite whose new modules are drawn
+// scaled by the fraction (continuous length, angles, width).
+//
+// Settings come from, in increasing precedence: this table's defaults, a `.lsys` grammar file
+// (grammar=FILE or the name of an example), and --set.
+#include "algorithms/lsystem/lsystem.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <optional>
+
+#include <fmt/format.h>
+#include <stb_image.h>
+
+#include "algorithms/lsystem/derive.hpp"
+#include "algorithms/lsystem/grammar.hpp"
+#include "algorithms/lsystem/turtle.hpp"
+#include "core/errors.hpp"
+#include "core/random.hpp"
+
+#ifndef GROWBENCH_LSYSTEM_EXAMPLES
+#define GROWBENCH_LSYSTEM_EXAMPLES "algorithms/lsystem/examples"
+#endif
+
+namespace growbench {
+namespace {
+
+// ---- parameter table (what `growbench list` prints) ----
+const AlgorithmInfo kInfo = {
+    "lsystem",
+    "L-system, Houdini dialect: parametric, stochastic, context-sensitive rules, 3D turtle, J/K/M organs, in(), wrap",
+    {
+        {"grammar", ParamType::String, std::string(""), -INFINITY, INFINITY, "",
+         "a .lsys grammar file (premise, rules and values) or an example name (koch-island, bush, ...)", {}},
+        {"premise", ParamType::String, std::string("FFFA"), -INFINITY, INFINITY, "", "the string at generation 0", {}},
+        {"rules", ParamType::String, std::string("A = !\"[&FFFA]////[&FFFA]////[&FFFA]"), -INFINITY, INFINITY, "",
+         "rules, one per line: [left<] sym [>right] [:cond] = replacement [:prob]", {}},
+        {"rules_file", ParamType::String, std::string(""), -INFINITY, INFINITY, "",
+         "read the rules from this file (one per line, # comments) instead", {}},
+        {"generations", ParamType::Real, 5.0, 0, 200, "", "rewrites; a fraction adds a partly grown last generation", {}},
+        {"step_size", ParamType::Real, 0.1, 0, 1e4, "m", "default length of F, f, G (and of J/K/M organs)", {}},
+        {"step_scale", ParamType::Real, 0.8, 0, 1e4, "", "factor of \" (and divisor of _)", {}},
+        {"angle", ParamType::Real, 28.0, -360, 360, "deg", "default angle of + - & ^ \\ /; also the variable a", {}},
+        {"angle_scale", ParamType::Real, 0.9, 0, 1e4, "", "factor of ; (and divisor of @)", {}},
+        {"thickness", ParamType::Real, 0.02, 0, 1e3, "m", "initial width (node radius = width / 2)", {}},
+        {"thickness_scale", ParamType::Real, 0.7, 0, 1e4, "", "factor of ! (and divisor of ?)", {}},
+        {"gravity", ParamType::Real, 0.2, -100, 100, "", "tropism of T toward -Y (radians per unit sin); also T", {}},
+        {"random_scale", ParamType::Real, 0.0, 0, 1, "", "every move length is scaled by 1 + random_scale * uniform(-1, 1)", {}},
+        {"u_increment", ParamType::Real, 0.1, -1e4, 1e4, "", "default increment of ' (colour index U)", {}},
+        {"v_increment", ParamType::Real, 0.1, -1e4, 1e4, "", "default increment of # (colour index V)", {}},
+        {"b", ParamType::Real, 0.0, -1e12, 1e12, "", "expression variable b", {}},
+        {"c", ParamType::Real, 0.0, -1e12, 1e12, "", "expression variable c", {}},
+        {"d", ParamType::Real, 0.0, -1e12, 1e12, "", "expression variable d", {}},
+        {"variables", ParamType::String, std::string(""), -INFINITY, INFINITY, "",
+         "user variables, single letters: 'k=0.5, q=2'", {}},
+        {"channels", ParamType::String, std::string(""), -INFINITY, INFINITY, "", "values of chan(0), chan(1), ...: '1, 0.5'", {}},
+        {"context_ignore", ParamType::String, std::string(""), -INFINITY, INFINITY, "",
+         "symbols skipped when matching contexts, e.g. '+-F'; with '[' or ']' brackets become transparent", {}},
+        {"context_siblings", ParamType::Bool, false, -INFINITY, INFINITY, "",
+         "contexts read across branch brackets (pre-Houdini 10 behaviour) instead of skipping sub-branches", {}},
+        {"probability", ParamType::Choice, std::string("sequential"), -INFINITY, INFINITY, "",
+         "sequential: each applicable rule fires with its own chance, in order (Houdini); normalized: one of the "
+         "applicable probabilistic rules by weight (ABOP)",
+         {"sequential", "normalized"}},
+        {"convention", ParamType::Choice, std::string("houdini"), -INFINITY, INFINITY, "",
+         "houdini: + turns right; abop: + turns left (The Algorithmic Beauty of Plants)", {"houdini", "abop"}},
+        {"continuous_length", ParamType::Bool, true, -INFINITY, INFINITY, "", "fractional generation scales new lengths", {}},
+        {"continuous_angles", ParamType::Bool, true, -INFINITY, INFINITY, "", "fractional generation scales new angles", {}},
+        {"continuous_width", ParamType::Bool, true, -INFINITY, INFINITY, "", "fractional generation scales new widths", {}},
+        {"start", ParamType::Choice, std::string("seeds"), -INFINITY, INFINITY, "",
+         "seeds: one plant per scene seed (along its direction); origin: one plant at start_position, +Y",
+         {"seeds", "origin"}},
+        {"start_position", ParamType::Vec3, glm::dvec3(0.0), -1e6, 1e6, "m", "where the turtle starts when start=origin", {}},
+        {"surface", ParamType::Choice, std::string("free"), -INFINITY, INFINITY, "",
+         "free: the turtle moves in space; wrap: every move is mapped onto the nearest scene surface", {"free", "wrap"}},
+        {"wrap_offset", ParamType::Real, 0.01, 0, 10, "m", "distance kept from the surface when wrapping", {}},
+        {"in_test", ParamType::Choice, std::string("auto"), -INFINITY, INFINITY, "",
+         "what in(x,y,z) tests: the scene envelope, the scene's solids, or auto (envelope if any, else solids)",
+         {"auto", "envelope", "solids"}},
+        {"pic_image", ParamType::String, std::string(""), -INFINITY, INFINITY, "", "image read by pic(u, v, plane) (PNG, JPEG, ...)", {}},
+        {"max_symbols", ParamType::Int, std::int64_t{50'000'000}, 1, 2e9, "",
+         "a generation that would exceed this many symbols stops the run with an error", {}},
+    }};
+
+const std::vector<std::string>& setting_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> v;
+    for (const auto& p : kInfo.params)
+      if (p.name != "grammar") v.push_back(p.name);
+    return v;
+  }();
+  return names;
+}
+
+struct Image {
+  int w = 0, h = 0;
+  std::vector<float> rgb;  // row 0 at the top
+};
+
+class Host final : public lsys::ExprHost {
+ public:
+  double in(double x, double y, double z) const override {
+    if (!query_ || mode_ == 0) return 0.0;
+    const glm::vec3 p(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
+    if (mode_ == 1) return query_->inside_shape(*query_->scene().envelope, p) ? 1.0 : 0.0;
+    return query_->inside(p) ? 1.0 : 0.0;
+  }
+  double pic(double u, double v, double plane) const override {
+    if (image_.w == 0) throw InputError("pic() needs an image: set pic_image=FILE");
+    const int x = std::clamp(static_cast<int>(std::floor(u * image_.w)), 0, image_.w - 1);
+    const int y = std::clamp(static_cast<int>(std::floor((1.0 - v) * image_.h)), 0, image_.h - 1);
+    const float* px = &image_.rgb[(static_cast<std::size_t>(y) * image_.w + x) * 3];
+    const int pl = static_cast<int>(plane);
+    if (pl >= 1 && pl <= 3) return px[pl - 1];
+    return 0.2126 * px[0] + 0.7152 * px[1] + 0.0722 * px[2];
+  }
+  double rand(double s) const override {
+    std::uint64_t bits;
+    std::memcpy(&bits, &s, sizeof bits);
+    return static_cast<double>(random_bits(seed_, 0x7261'6e64, bits) >> 11) * 0x1.0p-53;
+  }
+  double chan(double index) const override {
+    const auto k = static_cast<long>(std::floor(index));
+    if (k < 0 || static_cast<std::size_t>(k) >= channels_.size())
+      throw InputError(fmt::format("chan({}) has no value: 'channels' gives {} value(s)", k, channels_.size()));
+    return channels_[static_cast<std::size_t>(k)];
+  }
+
+  const SceneQuery* query_ = nullptr;
+  int mode_ = 0;  // 0 none, 1 envelope, 2 solids
+  Image image_;
+  std::uint64_t seed_ = 0;
+  std::vector<double> channels_;
+};
+
+std::vector<double> parse_channels(const std::string& text) {
+  std::vector<double> out;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    std::size_t end = text.find(',', start);
+    if (end == std::string::npos) end = text.size();
+    std::string item = text.substr(start, end - start);
+    item.erase(0, item.find_first_not_of(" \t"));
+    item.erase(item.find_last_not_of(" \t") + 1);
+    if (!item.empty()) {
+      char* e = nullptr;
+      const double v = std::strtod(item.c_str(), &e);
+      if (e == item.c_str() || *e != '\0') throw InputError(fmt::format("channels: expected a number, found '{}'", item));
+      out.push_back(v);
+    }
+    start = end + 1;
+  }
+  return out;
+}
+
+// Everything derived from the parameters that both the growth algorithm and `growbench lsystem` need.
+struct Setup {
+  Params params;
+  lsys::Grammar grammar;
+  lsys::DeriveSettings derive;
+  lsys::TurtleSettings turtle;
+  std::unique_ptr<Host> host;
+  double generations = 0.0;
+};
+
+Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* query) {
+  Setup s;
+  s.params = given;
+  Params& p = s.params;
+  // grammar file values under the user's --set values
+  std::optional<lsys::GrammarFile> file;
+  if (!p.text("grammar").empty()) {
+    file = lsys::read_grammar_file(resolve_grammar_path(p.text("grammar")), setting_names());
+    for (const auto& st : file->settings) {
+      if (p.was_set(st.key)) continue;
+      try {
+        p.set(st.key, st.value);
+      } catch (const InputError& e) {
+        throw InputError(fmt::format("{}:{}: {}", file->path, st.line, e.what()));
+      }
+    }
+  }
+  // rules: rules_file, else --set rules, else the grammar file's, else the default tree's
+  std::vector<lsys::GrammarText> rules;
+  if (!p.text("rules_file").empty()) {
+    rules.push_back(lsys::read_rules_file(p.text("rules_file")));
+  } else if (p.was_set("rules") || !file) {
+    rules.push_back({"parameter 'rules'", p.text("rules"), 1});
+  } else {
+    rules.push_back(file->rules);
+  }
+  if (file && !p.was_set("premise") &&
+      std::none_of(file->settings.begin(), file->settings.end(), [](const auto& st) { return st.key == "premise"; }))
+    throw InputError(fmt::format("{}: no premise; expected a line 'premise: SYMBOLS'", file->path));
+  const auto vars = lsys::parse_variables("parameter 'variables'", p.text("variables"));
+  std::vector<std::string> user_names;
+  std::vector<double> user_values;
+  for (const auto& [name, value] : vars) {
+    if (name == "b" || name == "c" || name == "d") continue;
+    user_names.push_back(name);
+    user_values.push_back(value);
+  }
+  if (user_names.size() > static_cast<std::size_t>(lsys::kMaxSlots - lsys::kUserVar0))
+    throw InputError("variables: too many user variables");
+  const std::string premise_source = file && !p.was_set("premise") ? file->path + " (premise)" : "parameter 'premise'";
+  s.grammar = lsys::parse_grammar({premise_source, p.text("premise"), 1}, rules, user_names, p.text("context_ignore"));
+
+  s.host = std::make_unique<Host>();
+  s.host->seed_ = seed;
+  s.host->query_ = query;
+  s.host->channels_ = parse_channels(p.text("channels"));
+  if (query) {
+    const std::string& mode = p.text("in_test");
+    const bool has_env = query->scene().envelope.has_value();
+    if (mode == "envelope") {
+      if (!has_env) throw InputError("in_test=envelope: the scene has no envelope");
+      s.host->mode_ = 1;
+    } else if (mode == "solids") {
+      s.host->mode_ = 2;
+    } else {
+      s.host->mode_ = has_env ? 1 : 2;
+    }
+    if (s.host->mode_ == 2 && !query->has_sdf()) s.host->mode_ = 0;
+  }
+  if (!p.text("pic_image").empty()) {
+    int w = 0, h = 0, ch = 0;
+    unsigned char* px = stbi_load(p.text("pic_image").c_str(), &w, &h, &ch, 3);
+    if (!px)
+      throw InputError(fmt::format("pic_image '{}': cannot read the image ({})", p.text("pic_image"), stbi_failure_reason()));
+    s.host->image_.w = w;
+    s.host->image_.h = h;
+    s.host->image_.rgb.resize(static_cast<std::size_t>(w) * h * 3);
+    for (std::size_t k = 0; k < s.host->image_.rgb.size(); ++k) s.host->image_.rgb[k] = px[k] / 255.0f;
+    stbi_image_free(px);
+  }
+
+  auto& d = s.derive;
+  d.host = s.host.get();
+  d.seed = seed;
+  d.probability = p.text("probability") == "normalized" ? lsys::ProbabilityMode::Normalized : lsys::ProbabilityMode::Sequential;
+  d.brackets_transparent = p.boolean("context_siblings") || s.grammar.ignore.test('[') || s.grammar.ignore.test(']');
+  d.max_symbols = static_cast<std::size_t>(p.integer("max_symbols"));
+  d.max_params = d.max_symbols * 2;
+  d.env.assign(lsys::kMaxSlots, 0.0);
+  d.env[lsys::kVarA] = p.real("angle");
+  d.env[lsys::kVarB] = p.real("b");
+  d.env[lsys::kVarC] = p.real("c");
+  d.env[lsys::kVarD] = p.real("d");
+  for (const auto& [name, value] : vars) {
+    if (name == "b") d.env[lsys::kVarB] = value;
+    if (name == "c") d.env[lsys::kVarC] = value;
+    if (name == "d") d.env[lsys::kVarD] = value;
+  }
+  d.env[lsys::kVarGravity] = p.real("gravity");
+  d.env[lsys::kVarLength] = p.real("step_size");
+  d.env[lsys::kVarWidth] = p.real("thickness");
+  for (std::size_t k = 0; k < user_values.size(); ++k) d.env[lsys::kUserVar0 + k] = user_values[k];
+
+  auto& t = s.turtle;
+  t.step = p.real("step_size");
+  t.step_scale = p.real("step_scale");
+  t.angle = p.real("angle");
+  t.angle_scale = p.real("angle_scale");
+  t.thickness = p.real("thickness");
+  t.thickness_scale = p.real("thickness_scale");
+  t.gravity = p.real("gravity");
+  t.random_scale = p.real("random_scale");
+  t.uv_increment = {p.real("u_increment"), p.real("v_increment")};
+  t.convention = p.text("convention") == "abop" ? lsys::Convention::Abop : lsys::Convention::Houdini;
+  t.continuous_length = p.boolean("continuous_length");
+  t.continuous_angles = p.boolean("continuous_angles");
+  t.continuous_width = p.boolean("continuous_width");
+  t.seed = seed;
+  t.wrap_offset = p.real("wrap_offset");
+  if (p.text("surface") == "wrap") {
+    if (!query) throw InputError("surface=wrap needs a scene with surfaces");
+    t.wrap = query;
+  }
+  s.generations = p.real("generations");
+  return s;
+}
+
+struct Plantlet {
+  lsys::LString cur, next;
+  std::vector<lsys::TurtleVars> states;
+  int generation = 0;
+  int start_step = 0;
+  glm::dvec3 origin{0.0}, heading{0.0, 1.0, 0.0};
+  std::uint64_t stream = 0;
+  bool started = false;
+};
+
+class LSystem final : public GrowthAlgorithm {
+ public:
+  const AlgorithmInfo& describe() const override { return kInfo; }
+
+  void start(const Scene& scene, const SceneQuery& query, const Params& params, std::uint64_t seed) override {
+    setup_ = make_setup(params, seed, &query);
+    full_ = static_cast<int>(std::floor(setup_.generations + 1e-9));
+    fraction_ = setup_.generations - full_;
+    if (fraction_ < 1e-6) fraction_ = 0.0;
+    rewrites_ = full_ + (fraction_ > 0.0 ? 1 : 0);
+    deriver_ = std::make_unique<lsys::Deriver>(setup_.grammar, setup_.derive);
+    plants_.clear();
+    if (setup_.params.text("start") == "origin" || scene.seeds.empty()) {
+      Plantlet pl;
+      pl.origin = setup_.params.vec3("start_position");
+      plants_.push_back(std::move(pl));
+    } else {
+      for (std::size_t k = 0; k < scene.seeds.size(); ++k) {
+        Plantlet pl;
+        pl.origin = glm::dvec3(scene.seeds[k].position);
+        pl.heading = glm::dvec3(scene.seeds[k].direction);
+        pl.start_step = std::max(0, scene.seeds[k].start_step);
+        pl.stream = k;
+        plants_.push_back(std::move(pl));
+      }
+    }
+    step_ = 0;
+    begin_due();
+    redraw();
+  }
+
+  bool step() override {
+    ++step_;
+    bool more = false;
+    for (auto& pl : plants_) {
+      if (!pl.started || pl.generation >= rewrites_) continue;
+      const auto t0 = std::chrono::steady_clock::now();
+      deriver_->set_stream(pl.stream);
+      deriver_->rewrite(pl.cur, pl.next, pl.generation + 1, pl.states);
+      rewrite_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      std::swap(pl.cur, pl.next);
+      ++pl.generation;
+    }
+    begin_due();
+    redraw();
+    for (const auto& pl : plants_) more |= !pl.started || pl.generation < rewrites_;
+    if (!more) {
+      for (auto& pl : plants_) {  // the spare buffers are no longer needed
+        pl.next.symbols.release();
+        pl.next.params.release();
+        pl.next.ages.release();
+      }
+    }
+    return more;
+  }
+
+  const Plant& plant() const override { return plant_; }
+
+  std::vector<std::pair<std::string, double>> stats() const override {
+    std::size_t symbols = 0, bytes = 0;
+    for (const auto& pl : plants_) {
+      symbols += pl.cur.size();
+      bytes += pl.cur.bytes() + pl.next.bytes();
+    }
+    return {{"symbols", static_cast<double>(symbols)},
+            {"string_bytes", static_cast<double>(bytes)},
+            {"rewrite_s", rewrite_s_},
+            {"turtle_s", turtle_s_},
+            {"max_branch_depth", static_cast<double>(max_depth_)}};
+  }
+
+ private:
+  void begin_due() {
+    for (auto& pl : plants_) {
+      if (pl.started || pl.start_step > step_) continue;
+      deriver_->set_stream(pl.stream);
+      deriver_->premise(pl.cur);
+      pl.started = true;
+    }
+  }
+
+  void redraw() {
+    const auto t0 = std::chrono::steady_clock::now();
+    plant_.clear();
+    for (auto& pl : plants_) {
+      if (!pl.started) continue;
+      lsys::TurtleSettings ts = setup_.turtle;
+      ts.origin = pl.origin;
+      ts.heading = pl.heading;
+      ts.stream = pl.stream;
+      ts.birth_step = static_cast<std::uint32_t>(step_);
+      ts.fraction = (fraction_ > 0.0 && pl.generation == rewrites_) ? fraction_ : 1.0;
+      const bool need_states = setup_.grammar.uses_turtle && pl.generation < rewrites_;
+      const auto r = lsys::interpret(pl.cur, ts, setup_.grammar.strings, plant_, need_states ? &pl.states : nullptr);
+      if (!need_states) pl.states.clear();
+      max_depth_ = std::max(max_depth_, r.max_depth);
+    }
+    turtle_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+
+  Setup setup_;
+  std::unique_ptr<lsys::Deriver> deriver_;
+  std::vector<Plantlet> plants_;
+  Plant plant_;
+  int full_ = 0, rewrites_ = 0, step_ = 0;
+  double fraction_ = 0.0;
+  double rewrite_s_ = 0.0, turtle_s_ = 0.0;
+  std::size_t max_depth_ = 0;
+};
+
+}  // namespace
+
+const AlgorithmInfo& lsystem_info() { return kInfo; }
+std::unique_ptr<GrowthAlgorithm> make_lsystem() { return std::make_unique<LSystem>(); }
+
+std::vector<std::string> lsystem_examples() {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(GROWBENCH_LSYSTEM_EXAMPLES, ec))
+    if (e.path().extension() == ".lsys") names.push_back(e.path().stem().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+std::string resolve_grammar_path(const std::string& name) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::is_regular_file(name, ec)) return name;
+  const fs::path dir(GROWBENCH_LSYSTEM_EXAMPLES);
+  for (const auto& candidate : {dir / name, dir / (name + ".lsys")})
+    if (fs::is_regular_file(candidate, ec)) return candidate.string();
+  const auto names = lsystem_examples();
+  const std::string near = closest_match(name, names);
+  throw InputError(fmt::format("grammar '{}': no such file, and not an example{}; examples: {}", name,
+                               near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near), fmt::join(names, ", ")));
+}
+
+DerivedString derive_lsystem(const Params& params, std::uint64_t seed, const Scene* scene, const SceneQuery* query,
+                             std::size_t print_limit) {
+  Setup setup = make_setup(params, seed, query);
+  lsys::Deriver deriver(setup.grammar, setup.derive);
+  lsys::LString cur, next;
+  std::vector<lsys::TurtleVars> states;
+  deriver.premise(cur);
+  const int full = static_cast<int>(std::floor(setup.generations + 1e-9));
+  const int rewrites = full + (setup.generations - full > 1e-6 ? 1 : 0);
+  lsys::TurtleSettings ts = setup.turtle;
+  if (scene && !scene->seeds.empty() && setup.params.text("start") == "seeds") {
+    ts.origin = glm::dvec3(scene->seeds[0].position);
+    ts.heading = glm::dvec3(scene->seeds[0].direction);
+  } else {
+    ts.origin = setup.params.vec3("start_position");
+  }
+  for (int g = 1; g <= rewrites; ++g) {
+    if (setup.grammar.uses_turtle) {
+      Plant scratch;
+      lsys::interpret(cur, ts, setup.grammar.strings, scratch, &states);
+    }
+    deriver.rewrite(cur, next, g, states);
+    std::swap(cur, next);
+  }
+  DerivedString out;
+  out.text = lsys::to_text(cur, setup.grammar.strings, print_limit);
+  out.modules = cur.size();
+  out.params = cur.params.size();
+  out.bytes = cur.bytes();
+  out.generations = rewrites;
+  const auto counts = lsys::symbol_counts(cur);
+  for (int c = 0; c < 128; ++c)
+    if (counts[static_cast<std::size_t>(c)] > 0) out.counts.emplace_back(static_cast<char>(c), counts[static_cast<std::size_t>(c)]);
+  return out;
+}
+
+}  // namespace growbench

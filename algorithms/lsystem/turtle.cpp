@@ -1,0 +1,408 @@
+#include "algorithms/lsystem/turtle.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "core/random.hpp"
+#include "scenes/scene_query.hpp"
+
+namespace growbench::lsys {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+struct State {
+  glm::dvec3 pos{0.0}, H{0.0, 1.0, 0.0}, L{-1.0, 0.0, 0.0}, U{0.0, 0.0, 1.0};
+  double length = 0.0, width = 0.0, angle = 0.0, arc = 0.0, u = 0.0, v = 0.0;
+  std::int32_t node = kNoParent;
+  std::int32_t group = -1;
+  std::uint32_t shoot = 0;
+  std::uint32_t attrs = 0;  // index of the attribute snapshot in force
+  std::uint16_t order = 0;
+};
+
+// Rotates (a, b) by theta in their plane: a' = a cos + b sin, b' = b cos - a sin.
+inline void rotate_pair(glm::dvec3& a, glm::dvec3& b, double c, double s) {
+  const glm::dvec3 a2 = a * c + b * s;
+  b = b * c - a * s;
+  a = a2;
+}
+
+glm::dvec3 rotate_about(const glm::dvec3& v, const glm::dvec3& axis, double c, double s) {
+  return v * c + glm::cross(axis, v) * s + axis * glm::dot(axis, v) * (1.0 - c);
+}
+
+class Interpreter {
+ public:
+  Interpreter(const LString& str, const TurtleSettings& s, const std::vector<std::string>& strings, Plant& plant,
+              std::vector<TurtleVars>* states)
+      : str_(str), s_(s), strings_(strings), plant_(plant), states_(states) {}
+
+  TurtleResult run() {
+    State t;
+    t.pos = s_.origin;
+    t.H = glm::length(s_.heading) > 0 ? glm::normalize(s_.heading) : glm::dvec3(0, 1, 0);
+    glm::dvec3 side = glm::cross(glm::dvec3(0, 0, 1), t.H);
+    if (glm::length(side) < 1e-9) side = glm::cross(glm::dvec3(0, 1, 0), t.H);
+    t.L = glm::normalize(side);
+    t.U = glm::cross(t.H, t.L);
+    t.length = s_.step;
+    t.width = s_.thickness;
+    t.angle = s_.angle;
+    t.shoot = next_shoot();
+    if (s_.wrap) snap_start(t);
+    const std::size_t first_node = plant_.nodes.size();
+    const std::size_t first_organ = plant_.organs.size();
+    const std::size_t first_poly = plant_.polygons.size();
+    attr_snapshots_.assign(1, {});
+    if (states_) states_->resize(str_.size());
+
+    const std::uint16_t* sym = str_.symbols.data();
+    const float* par = str_.params.data();
+    const std::size_t n = str_.size();
+    {  // one node per F or H (plus roots): reserve once instead of growing
+      std::size_t draws = 0;
+      for (std::size_t m = 0; m < n; ++m) {
+        const char c = symbol_of(sym[m]);
+        draws += (c == 'F') | (c == 'H');
+      }
+      plant_.nodes.reserve(plant_.nodes.size() + draws + 1);
+    }
+    std::size_t p = 0;
+    const double turn_sign = s_.convention == Convention::Houdini ? -1.0 : 1.0;
+    for (std::size_t m = 0; m < n; ++m) {
+      const std::uint16_t w = sym[m];
+      const char c = symbol_of(w);
+      const int k = count_of(w);
+      const float* a = par + p;
+      p += static_cast<std::size_t>(k);
+      if (states_) record(t, m);
+      const bool fresh = is_new(w) && s_.fraction < 1.0;
+      switch (c) {
+        case 'F': case 'H': case 'G': case 'f': case 'h': {
+          double len = k > 0 ? a[0] : t.length;
+          if (c == 'H' || c == 'h') len *= 0.5;
+          if (s_.random_scale != 0.0) {
+            Rng rng(s_.seed, s_.stream * 0x100000001ull + 7, m);
+            len *= std::max(0.0, 1.0 + s_.random_scale * rng.uniform(-1.0, 1.0));
+          }
+          if (fresh && s_.continuous_length) len *= s_.fraction;
+          double width = k > 1 ? a[1] : t.width;
+          if (fresh && s_.continuous_width) width *= s_.fraction;
+          const bool draw = c == 'F' || c == 'H';
+          if (draw && t.node == kNoParent) t.node = add_node(t.pos, width, kNoParent, t);
+          const glm::dvec3 before = t.pos;
+          t.pos += t.H * len;
+          if (s_.wrap) snap(t);
+          if (c == 'F' || c == 'H' || c == 'G') t.arc += glm::length(t.pos - before);
+          if (draw) t.node = add_node(t.pos, width, t.node, t);
+          else if (c == 'f' || c == 'h') t.node = kNoParent;
+          break;
+        }
+        case 'J': case 'K': case 'M': {
+          Organ o;
+          o.position = glm::vec3(t.pos);
+          o.orientation = glm::quat_cast(glm::mat3(glm::vec3(t.L), glm::vec3(t.U), glm::vec3(t.H)));
+          double size = k > 0 ? a[0] : t.length;
+          if (fresh && s_.continuous_length) size *= s_.fraction;
+          o.size = static_cast<float>(std::max(0.0, size));
+          o.kind = c == 'J' ? OrganKind::Leaf : c == 'K' ? OrganKind::Flower : OrganKind::Bud;
+          o.node = t.node;
+          for (int q = 2; q < k && q < 5; ++q) o.stamp[static_cast<std::size_t>(q - 2)] = a[q];
+          plant_.organs.push_back(o);
+          break;
+        }
+        case 'T': {
+          const double g = k > 0 ? a[0] : s_.gravity;
+          const glm::dvec3 down(0.0, -1.0, 0.0);
+          const glm::dvec3 axis = glm::cross(t.H, down);
+          const double sin_between = glm::length(axis);
+          if (sin_between > 1e-12 && g != 0.0) {
+            const glm::dvec3 ax = axis / sin_between;
+            const double alpha = g * sin_between;
+            const double cs = std::cos(alpha), sn = std::sin(alpha);
+            t.H = glm::normalize(rotate_about(t.H, ax, cs, sn));
+            t.L = glm::normalize(rotate_about(t.L, ax, cs, sn));
+            t.U = glm::cross(t.H, t.L);
+          }
+          break;
+        }
+        case '+': case '-': case '&': case '^': case '\\': case '/': {
+          double ang = k > 0 ? a[0] : t.angle;
+          if (fresh && s_.continuous_angles) ang *= s_.fraction;
+          double cs, sn;
+          sincos_deg(ang, cs, sn);
+          switch (c) {
+            case '+': rotate_pair(t.H, t.L, cs, turn_sign * sn); break;   // about U
+            case '-': rotate_pair(t.H, t.L, cs, -turn_sign * sn); break;
+            case '&': rotate_pair(t.H, t.U, cs, -sn); break;              // about L: pitch down
+            case '^': rotate_pair(t.H, t.U, cs, sn); break;
+            case '\\': rotate_pair(t.L, t.U, cs, sn); break;              // about H: roll
+            default: rotate_pair(t.L, t.U, cs, -sn); break;               // '/'
+          }
+          break;
+        }
+        case '|':
+          t.H = -t.H;
+          t.L = -t.L;
+          break;
+        case '*':
+          t.L = -t.L;
+          t.U = -t.U;
+          break;
+        case '~': {
+          const double lim = k > 0 ? a[0] : 180.0;
+          Rng rng(s_.seed, s_.stream * 0x100000001ull + 11, m);
+          double cs, sn;
+          sincos_deg(lim * rng.uniform(-1.0, 1.0), cs, sn);
+          rotate_pair(t.H, t.U, cs, sn);
+          sincos_deg(lim * rng.uniform(-1.0, 1.0), cs, sn);
+          rotate_pair(t.L, t.U, cs, sn);
+          sincos_deg(lim * rng.uniform(-1.0, 1.0), cs, sn);
+          rotate_pair(t.H, t.L, cs, sn);
+          break;
+        }
+        case '"': t.length *= k > 0 ? a[0] : s_.step_scale; break;
+        case '_': t.length /= k > 0 ? a[0] : s_.step_scale; break;
+        case '!': t.width *= k > 0 ? a[0] : s_.thickness_scale; break;
+        case '?': t.width /= k > 0 ? a[0] : s_.thickness_scale; break;
+        case ';': t.angle *= k > 0 ? a[0] : s_.angle_scale; break;
+        case '@': t.angle /= k > 0 ? a[0] : s_.angle_scale; break;
+        case '\'': t.u += k > 0 ? a[0] : s_.uv_increment.x; break;
+        case '#': t.v += k > 0 ? a[0] : s_.uv_increment.y; break;
+        case '%': {  // skip to the end of this branch; its ']' then pops as usual
+          int depth = 0;
+          while (m + 1 < n) {
+            const std::uint16_t w2 = sym[m + 1];
+            const char c2 = symbol_of(w2);
+            if (c2 == ']' && depth == 0) break;
+            if (c2 == '[') ++depth;
+            if (c2 == ']') --depth;
+            ++m;
+            p += static_cast<std::size_t>(count_of(w2));
+            if (states_) record(t, m);
+          }
+          break;
+        }
+        case '$': {
+          if (k >= 3) {
+            const glm::dvec3 d = glm::dvec3(a[0], a[1], a[2]) - t.pos;
+            if (glm::length(d) > 1e-12) {
+              const glm::dvec3 h = glm::normalize(d);
+              // keep the frame: the minimal rotation from the old heading
+              const glm::dvec3 axis = glm::cross(t.H, h);
+              const double sn = glm::length(axis), cs = glm::dot(t.H, h);
+              if (sn > 1e-12) {
+                const glm::dvec3 ax = axis / sn;
+                t.L = rotate_about(t.L, ax, cs, sn);
+              }
+              t.H = h;
+            }
+          }
+          const glm::dvec3 side = glm::cross(glm::dvec3(0.0, 1.0, 0.0), t.H);
+          if (glm::length(side) > 1e-9) {
+            t.L = glm::normalize(side);
+          } else {
+            t.L = glm::normalize(t.L - t.H * glm::dot(t.L, t.H));
+          }
+          t.U = glm::cross(t.H, t.L);
+          break;
+        }
+        case '[':
+          stack_.push_back(t);
+          t.order = static_cast<std::uint16_t>(std::min<int>(t.order + 1, 65535));
+          t.shoot = next_shoot();
+          result_.max_depth = std::max(result_.max_depth, stack_.size());
+          break;
+        case ']':
+          if (!stack_.empty()) {
+            t = stack_.back();
+            stack_.pop_back();
+          }
+          break;
+        case '{':
+          polys_.emplace_back();
+          break;
+        case '.':
+          if (!polys_.empty()) polys_.back().vertices.push_back(glm::vec3(t.pos));
+          break;
+        case '}':
+          if (!polys_.empty()) {
+            if (polys_.back().vertices.size() >= 3) plant_.polygons.push_back(std::move(polys_.back()));
+            polys_.pop_back();
+          }
+          break;
+        case 'g':
+          if (k > 0) {
+            t.group = static_cast<std::int32_t>(std::lround(a[0]));
+          } else {
+            t.group = group_counter_++;
+          }
+          if (!groups_used_) node_groups_.assign(plant_.nodes.size() - first_node, -1);
+          groups_used_ = true;
+          break;
+        case 'a':
+          if (k >= 2 && a[0] >= 0 && static_cast<std::size_t>(a[0]) < strings_.size()) {
+            const auto id = static_cast<std::size_t>(a[0]);
+            auto snap = attr_snapshots_[t.attrs];
+            if (snap.size() <= id) snap.resize(id + 1);
+            snap[id] = {a[1], k > 2 ? a[2] : 0.0f, k > 3 ? a[3] : 0.0f, static_cast<float>(std::min(k - 1, 3))};
+            attr_components_.resize(std::max(attr_components_.size(), id + 1), 0);
+            attr_components_[id] = std::max(attr_components_[id], std::min(k - 1, 3));
+            attr_snapshots_.push_back(std::move(snap));
+            if (!attrs_used_) node_attrs_.assign(plant_.nodes.size() - first_node, 0);
+            attrs_used_ = true;
+            t.attrs = static_cast<std::uint32_t>(attr_snapshots_.size() - 1);
+          }
+          break;
+        default:
+          break;  // any other symbol does nothing to the turtle
+      }
+    }
+    finish_attributes(first_node);
+    (void)first_poly;
+    result_.nodes = plant_.nodes.size() - first_node;
+    result_.organs = plant_.organs.size() - first_organ;
+    result_.polygons = plant_.polygons.size() - first_poly;
+    return result_;
+  }
+
+ private:
+  void sincos_deg(double deg, double& c, double& s) {
+    if (deg != cached_angle_) {
+      cached_angle_ = deg;
+      cached_cos_ = std::cos(deg * kDeg);
+      cached_sin_ = std::sin(deg * kDeg);
+    }
+    c = cached_cos_;
+    s = cached_sin_;
+  }
+  std::uint32_t next_shoot() {
+    if (plant_.nodes.empty() && shoot_counter_ == 0) shoot_counter_ = base_shoot();
+    return shoot_counter_++;
+  }
+  std::uint32_t base_shoot() const {
+    std::uint32_t b = 0;
+    for (const auto& nd : plant_.nodes) b = std::max(b, nd.shoot + 1);
+    return b;
+  }
+  void record(const State& t, std::size_t m) {
+    (*states_)[m] = {static_cast<float>(t.pos.x), static_cast<float>(t.pos.y), static_cast<float>(t.pos.z),
+                     static_cast<float>(t.arc),   static_cast<float>(t.length), static_cast<float>(t.width),
+                     static_cast<float>(t.u),     static_cast<float>(t.v)};
+  }
+  std::int32_t add_node(const glm::dvec3& pos, double width, std::int32_t parent, const State& t) {
+    PlantNode nd;
+    nd.position = glm::vec3(pos);
+    nd.radius = static_cast<float>(std::max(0.0, width * 0.5));
+    nd.parent = parent;
+    nd.order = t.order;
+    nd.shoot = t.shoot;
+    nd.birth_step = s_.birth_step;
+    plant_.nodes.push_back(nd);
+    // per-node groups and attribute snapshots are kept only once a g or an a has appeared (every node
+    // before that has no group and the empty snapshot)
+    if (groups_used_) node_groups_.push_back(t.group);
+    if (attrs_used_) node_attrs_.push_back(t.attrs);
+    return static_cast<std::int32_t>(plant_.nodes.size() - 1);
+  }
+  void snap_start(State& t) { snap(t); }
+  // Maps the position onto the nearest surface, offset along the direction away from it, and turns the
+  // frame so the heading is tangent there (the minimal rotation, so the turtle keeps its roll). The
+  // projection repeats (up to 6 times; a point inside a solid first leaves it along the SDF gradient) until the point is wrap_offset from its nearest surface, which
+  // settles points in concave corners, where the offset from one face can lie inside another.
+  void snap(State& t) {
+    glm::dvec3 dir(0.0);
+    for (int iter = 0; iter < 6; ++iter) {
+      if (s_.wrap->has_sdf()) {  // inside a solid (e.g. near a face of another mesh): out along the gradient
+        const float sd = s_.wrap->signed_distance(glm::vec3(t.pos));
+        if (sd < 0.0f) {
+          t.pos += glm::dvec3(s_.wrap->gradient(glm::vec3(t.pos))) * (static_cast<double>(-sd) + s_.wrap_offset);
+          continue;
+        }
+      }
+      const ClosestHit hit = s_.wrap->closest_point(glm::vec3(t.pos));
+      if (!hit.found) break;
+      const glm::dvec3 cp(hit.point), nrm(hit.normal);
+      const glm::dvec3 v = t.pos - cp;
+      const double dist = glm::length(v);
+      const auto& solid = s_.wrap->mesh_solid();
+      const bool inside = glm::dot(v, nrm) < 0.0 && hit.mesh < solid.size() && solid[hit.mesh];
+      if (!inside && dist > 1e-9) dir = v / dist;
+      else dir = nrm;
+      if (!inside && std::fabs(dist - s_.wrap_offset) <= 1e-6 + 1e-4 * s_.wrap_offset) break;
+      t.pos = cp + dir * s_.wrap_offset;
+    }
+    if (glm::length(dir) > 0.0) retangent(t, dir);
+  }
+  static void retangent(State& t, const glm::dvec3& nrm) {
+    glm::dvec3 h = t.H - nrm * glm::dot(t.H, nrm);
+    if (glm::length(h) < 1e-9) return;
+    h = glm::normalize(h);
+    const glm::dvec3 axis = glm::cross(t.H, h);
+    const double sn = glm::length(axis), cs = glm::dot(t.H, h);
+    if (sn > 1e-12) t.L = glm::normalize(rotate_about(t.L, axis / sn, cs, sn));
+    t.H = h;
+    t.L = glm::normalize(t.L - t.H * glm::dot(t.L, t.H));
+    t.U = glm::cross(t.H, t.L);
+  }
+  void finish_attributes(std::size_t first_node) {
+    const std::size_t count = plant_.nodes.size() - first_node;
+    if (groups_used_) node_groups_.resize(count, -1);
+    if (attrs_used_) node_attrs_.resize(count, 0);
+    if (groups_used_ || !plant_.node_groups.empty()) {
+      plant_.node_groups.resize(first_node, -1);
+      plant_.node_groups.insert(plant_.node_groups.end(), node_groups_.begin(), node_groups_.end());
+    }
+    for (std::size_t id = 0; id < attr_components_.size(); ++id) {
+      const int comps = attr_components_[id];
+      if (comps == 0) continue;
+      const std::string& name = strings_[id];
+      auto it = std::find_if(plant_.node_attributes.begin(), plant_.node_attributes.end(),
+                             [&](const NodeAttribute& x) { return x.name == name; });
+      if (it == plant_.node_attributes.end()) {
+        plant_.node_attributes.push_back({name, comps, std::vector<float>(first_node * comps, 0.0f)});
+        it = plant_.node_attributes.end() - 1;
+      }
+      NodeAttribute& attr = *it;
+      for (std::size_t q = 0; q < count; ++q) {
+        const auto& snap = attr_snapshots_[attrs_used_ ? node_attrs_[q] : 0];
+        for (int cpt = 0; cpt < attr.components; ++cpt)
+          attr.values.push_back(id < snap.size() && cpt < 3 ? snap[id][static_cast<std::size_t>(cpt)] : 0.0f);
+      }
+    }
+    // attributes other plants made before this one: pad with zeros for this plant's nodes
+    for (auto& attr : plant_.node_attributes)
+      attr.values.resize(plant_.nodes.size() * static_cast<std::size_t>(attr.components), 0.0f);
+  }
+
+  const LString& str_;
+  const TurtleSettings& s_;
+  const std::vector<std::string>& strings_;
+  Plant& plant_;
+  std::vector<TurtleVars>* states_;
+  std::vector<State> stack_;
+  std::vector<PlantPolygon> polys_;
+  std::vector<std::int32_t> node_groups_;
+  std::vector<std::uint32_t> node_attrs_;
+  std::vector<std::vector<std::array<float, 4>>> attr_snapshots_;
+  std::vector<int> attr_components_;
+  std::int32_t group_counter_ = 0;
+  bool groups_used_ = false, attrs_used_ = false;
+  std::uint32_t shoot_counter_ = 0;
+  double cached_angle_ = std::numeric_limits<double>::quiet_NaN(), cached_cos_ = 1.0, cached_sin_ = 0.0;
+  TurtleResult result_;
+};
+
+}  // namespace
+
+TurtleResult interpret(const LString& s, const TurtleSettings& settings, const std::vector<std::string>& strings,
+                       Plant& plant, std::vector<TurtleVars>* states) {
+  Interpreter it(s, settings, strings, plant, states);
+  return it.run();
+}
+
+}  // namespace growbench::lsys

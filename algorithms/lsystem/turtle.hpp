@@ -1,0 +1,66 @@
+// The 3D turtle: interprets a derived string into the shared Plant.
+//
+// Frame. H (heading), L (left), U (up) with H x L = U; the default start is H = +Y, L = -X, U = +Z, so
+// a flat L-system draws in the XY plane seen from +Z. Every rotation is right-handed about one frame
+// axis: '+' rotates about U (toward L: a left turn, as in The Algorithmic Beauty of Plants), '&' about
+// L (pitch down), '\' about H (roll). The Houdini convention (the default) negates the turn, so its '+'
+// turns right as Houdini's documentation says; pitch and roll are the same in both.
+//
+// Geometry. F and H draw (a node at the new position, parented to the last one; the first F after the
+// start, an f or an h puts a root node where it begins); G moves and keeps drawing from the last vertex
+// without recording one; f and h move without drawing. Node radius = width / 2. J, K, M place a leaf,
+// a flower and a bud (blade +Z along H, +Y along U), scaled by their first parameter (default: the
+// current step length) and stamped with their third to fifth parameters. '%' skips to the end of the
+// branch (the reference's "cut off remainder of branch", applied when drawing).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "algorithms/lsystem/derive.hpp"
+#include "algorithms/lsystem/lstring.hpp"
+#include "algorithms/plant.hpp"
+
+namespace growbench {
+class SceneQuery;
+}
+
+namespace growbench::lsys {
+
+enum class Convention { Houdini, Abop };
+
+struct TurtleSettings {
+  double step = 0.1;             // default F length (m)
+  double step_scale = 0.9;       // " and _
+  double angle = 30.0;           // default turn (degrees)
+  double angle_scale = 0.9;      // ; and @
+  double thickness = 0.01;       // default width (m)
+  double thickness_scale = 0.9;  // ! and ?
+  double gravity = 0.2;          // T: susceptibility (radians per unit |H x down|)
+  double random_scale = 0.0;     // lengths scaled by 1 + random_scale * uniform(-1, 1)
+  glm::dvec2 uv_increment{0.1, 0.1};
+  Convention convention = Convention::Houdini;
+  double fraction = 1.0;  // < 1: modules of the last generation are scaled by it (fractional generations)
+  bool continuous_length = true, continuous_angles = true, continuous_width = true;
+  std::uint64_t seed = 0, stream = 0;
+  glm::dvec3 origin{0.0};
+  glm::dvec3 heading{0.0, 1.0, 0.0};
+  const SceneQuery* wrap = nullptr;  // when set: every move is mapped onto the nearest surface
+  double wrap_offset = 0.005;
+  std::uint32_t birth_step = 0;
+};
+
+struct TurtleResult {
+  std::size_t nodes = 0, organs = 0, polygons = 0;
+  std::size_t max_depth = 0;  // deepest branch nesting
+};
+
+// Appends the plant drawn by `s` to `plant` (several plants share one Plant). When `states` is not
+// null it receives the turtle state at every module (before the module acts), for rules that read it.
+TurtleResult interpret(const LString& s, const TurtleSettings& settings, const std::vector<std::string>& strings,
+                       Plant& plant, std::vector<TurtleVars>* states);
+
+}  // namespace growbench::lsys

@@ -1,0 +1,107 @@
+// L-system rates against the targets: context-free rewriting of plain symbols (>= 100 M
+// symbols/s per core), parametric rewriting with expressions (>= 10 M/s), turtle interpretation
+// (>= 20 M/s), and memory per plain symbol (<= 8 bytes). Each benchmark times one generation (or one
+// interpretation) of about 5-25 million symbols; the generations before it are derived outside the
+// timed region. Rates count output symbols.
+#include <benchmark/benchmark.h>
+#include <tbb/global_control.h>
+
+#include "algorithms/lsystem/derive.hpp"
+#include "algorithms/lsystem/grammar.hpp"
+#include "algorithms/lsystem/turtle.hpp"
+
+namespace growbench::lsys {
+namespace {
+
+struct NoHost final : ExprHost {
+  double in(double, double, double) const override { return 0.0; }
+  double pic(double, double, double) const override { return 0.0; }
+  double rand(double) const override { return 0.0; }
+  double chan(double) const override { return 0.0; }
+};
+
+Grammar grammar(const std::string& premise, const std::string& rules) {
+  return parse_grammar({"bench premise", premise, 1}, {{"bench rules", rules, 1}}, {}, "");
+}
+
+DeriveSettings settings(const NoHost& host) {
+  DeriveSettings s;
+  s.host = &host;
+  s.seed = 1;
+  s.max_symbols = 200'000'000;
+  s.max_params = 400'000'000;
+  s.env.assign(kMaxSlots, 0.0);
+  return s;
+}
+
+// Derives `generations - 1` generations, then times the last one.
+void time_last_generation(benchmark::State& state, const std::string& premise, const std::string& rules, int generations) {
+  tbb::global_control gc(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(state.range(0)));
+  static const NoHost host;
+  const Grammar g = grammar(premise, rules);
+  Deriver d(g, settings(host));
+  LString a, b;
+  d.premise(a);
+  for (int k = 1; k < generations; ++k) {
+    d.rewrite(a, b, k, {});
+    std::swap(a, b);
+  }
+  std::size_t out = 0;
+  for (auto _ : state) {
+    d.rewrite(a, b, generations, {});
+    out = b.size();
+    benchmark::DoNotOptimize(b.symbols.data());
+  }
+  state.counters["symbols"] = static_cast<double>(out);
+  state.counters["symbols_per_s"] = benchmark::Counter(static_cast<double>(out), benchmark::Counter::kIsIterationInvariantRate);
+  // input and output strings together, per output symbol (what one generation holds in memory)
+  state.counters["bytes_per_symbol"] = static_cast<double>(a.bytes() + b.bytes()) / static_cast<double>(out);
+}
+
+void BM_LsysPlainRewrite(benchmark::State& state) {  // F -> F[+F]F[-F]F, generation 10: 24.4 M symbols
+  time_last_generation(state, "F", "F = F[+F]F[-F]F", 10);
+}
+BENCHMARK(BM_LsysPlainRewrite)->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()
+    ->Repetitions(3)->ReportAggregatesOnly(true);
+
+void BM_LsysParametricRewrite(benchmark::State& state) {  // conditions and expressions, ~12.6 M symbols
+  time_last_generation(state, "A(1,0)",
+                       "A(l,k): k < 100 & l > 0 = F(l, l*0.1)[+(k*2+10)A(l*0.7, k+1)]A(l*0.9, k+1)\n"
+                       "A(l,k) = F(l)",
+                       21);
+}
+BENCHMARK(BM_LsysParametricRewrite)->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()
+    ->Repetitions(3)->ReportAggregatesOnly(true);
+
+// The plain plant at generation 9: 4.9 M symbols, 2 M nodes. Arg 0: a fresh Plant per interpretation
+// (cold: the node array's pages are touched for the first time); arg 1: the Plant is cleared and
+// reused, as the algorithm does when it redraws after every generation.
+void BM_LsysTurtle(benchmark::State& state) {
+  static const NoHost host;
+  const Grammar g = grammar("F", "F = F[+F]F[-F]F");
+  Deriver d(g, settings(host));
+  LString a, b;
+  d.premise(a);
+  for (int k = 1; k <= 9; ++k) {
+    d.rewrite(a, b, k, {});
+    std::swap(a, b);
+  }
+  TurtleSettings ts;
+  ts.angle = 25.7;
+  std::size_t nodes = 0;
+  Plant reused;
+  for (auto _ : state) {
+    Plant fresh;
+    Plant& plant = state.range(0) ? reused : fresh;
+    plant.clear();
+    nodes = interpret(a, ts, g.strings, plant, nullptr).nodes;
+    benchmark::DoNotOptimize(plant.nodes.data());
+  }
+  state.counters["symbols"] = static_cast<double>(a.size());
+  state.counters["nodes"] = static_cast<double>(nodes);
+  state.counters["symbols_per_s"] = benchmark::Counter(static_cast<double>(a.size()), benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_LsysTurtle)->ArgName("reuse")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->Repetitions(3)->ReportAggregatesOnly(true);
+
+}  // namespace
+}  // namespace growbench::lsys

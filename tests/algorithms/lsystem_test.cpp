@@ -1,0 +1,485 @@
+// The L-system: exact derivations from The Algorithmic Beauty of Plants (chapter 1) and the Houdini
+// reference, turtle geometry with known answers, probabilities, errors, determinism.
+#include <cmath>
+#include <map>
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include "algorithms/grow_util.hpp"
+#include "algorithms/lsystem/derive.hpp"
+#include "algorithms/lsystem/expr.hpp"
+#include "algorithms/lsystem/lsystem.hpp"
+#include "core/errors.hpp"
+#include "scenes/scene_library.hpp"
+#include "test_util.hpp"
+
+namespace growbench {
+namespace {
+
+Params lsys_params(const std::string& premise, const std::string& rules, double generations,
+                   const std::vector<std::string>& extra = {}) {
+  Params p = default_params(find_algorithm("lsystem"));
+  p.set("premise", premise);
+  p.set("rules", rules);
+  p.set("generations", std::to_string(generations));
+  for (const auto& e : extra) p.set_assignment(e);
+  return p;
+}
+
+std::string derive(const std::string& premise, const std::string& rules, double generations,
+                   const std::vector<std::string>& extra = {}) {
+  return derive_lsystem(lsys_params(premise, rules, generations, extra), 1, nullptr, nullptr, 0).text;
+}
+
+std::map<char, std::size_t> counts(const DerivedString& d) {
+  return {d.counts.begin(), d.counts.end()};
+}
+
+// ---------- derivations: The Algorithmic Beauty of Plants, chapter 1 ----------
+
+TEST(LSystemDerivation, AlgaeFibonacci) {  // ABOP 1.1: a -> ab, b -> a
+  EXPECT_EQ(derive("b", "a = ab\nb = a", 5), "abaababa");
+  const auto d = derive_lsystem(lsys_params("b", "a -> ab\nb -> a", 20), 1, nullptr, nullptr, 0);
+  EXPECT_EQ(d.modules, 10946u);  // Fibonacci(21)
+  EXPECT_EQ(counts(d)['a'], 6765u);
+  EXPECT_EQ(counts(d)['b'], 4181u);
+}
+
+TEST(LSystemDerivation, KochIslandCounts) {  // ABOP fig. 1.7a: F-F-F-F, F -> F-F+F+FF-F-F+F
+  const std::string rule = "F = F-F+F+FF-F-F+F";
+  EXPECT_EQ(derive("F-F-F-F", rule, 1), "F-F+F+FF-F-F+F-F-F+F+FF-F-F+F-F-F+F+FF-F-F+F-F-F+F+FF-F-F+F");
+  for (int n = 0; n <= 4; ++n) {
+    const auto d = derive_lsystem(lsys_params("F-F-F-F", rule, n), 1, nullptr, nullptr, 0);
+    const std::size_t f = 4 * static_cast<std::size_t>(std::pow(8, n));
+    const std::size_t turns = 3 + 6 * (f - 4) / 7;  // 3 + 6 * (F_0 + ... + F_{n-1})
+    EXPECT_EQ(counts(d)['F'], f) << n;
+    EXPECT_EQ(d.modules, f + turns) << n;
+  }
+}
+
+TEST(LSystemDerivation, BracketedPlantCounts) {  // ABOP fig. 1.24a: F -> F[+F]F[-F]F
+  const auto d = derive_lsystem(lsys_params("F", "F=F[+F]F[-F]F", 5), 1, nullptr, nullptr, 0);
+  EXPECT_EQ(counts(d)['F'], 3125u);
+  EXPECT_EQ(d.modules, 1u + 10u * (3125u - 1u) / 4u);  // each F adds 10 symbols
+  EXPECT_EQ(counts(d)['['], counts(d)[']']);
+  EXPECT_EQ(derive("F", "F=F[+F]F[-F]F", 1), "F[+F]F[-F]F");
+}
+
+TEST(LSystemDerivation, NodeRewriting) {  // ABOP fig. 1.24d: X -> F[+X]F[-X]+X, F -> FF
+  EXPECT_EQ(derive("X", "X=F[+X]F[-X]+X\nF=FF", 2), "FF[+F[+X]F[-X]+X]FF[-F[+X]F[-X]+X]+F[+X]F[-X]+X");
+  const auto d = derive_lsystem(lsys_params("X", "X=F[+X]F[-X]+X\nF=FF", 7), 1, nullptr, nullptr, 0);
+  EXPECT_EQ(counts(d)['X'], 2187u);  // 3^7
+  // F count f_n = 2 f_{n-1} + 2 x_{n-1}: 0, 2, 10, 38, 130, 422, 1330, 4118
+  EXPECT_EQ(counts(d)['F'], 4118u);
+}
+
+TEST(LSystemDerivation, ContextSensitiveSignal) {  // ABOP 1.8: b < a -> b, b -> a
+  EXPECT_EQ(derive("baaaaaaaa", "b < a = b\nb = a", 1), "abaaaaaaa");
+  EXPECT_EQ(derive("baaaaaaaa", "b < a = b\nb = a", 3), "aaabaaaaa");
+  EXPECT_EQ(derive("aaaaaaaab", "a > b = b\nb = a", 2), "aaaaaabaa");
+}
+
+TEST(LSystemDerivation, BranchAwareContext) {
+  // ABOP section 1.8: BC < S > G[H]M matches S in ABC[DE][SG[HI[JK]L]MNO]
+  EXPECT_EQ(derive("ABC[DE][SG[HI[JK]L]MNO]", "BC < S > G[H]M = X", 1), "ABC[DE][XG[HI[JK]L]MNO]");
+  // the reference: with A > B = F, A[B] does not resolve (B is in a sub-branch), A[Q]B does
+  EXPECT_EQ(derive("A[B]", "A > B = F", 1), "A[B]");
+  EXPECT_EQ(derive("A[Q]B", "A > B = F", 1), "F[Q]B");
+  // ... and with [ ] in the ignore list it is the other way round
+  EXPECT_EQ(derive("A[B]", "A > B = F", 1, {"context_ignore=[]"}), "F[B]");
+  EXPECT_EQ(derive("A[Q]B", "A > B = F", 1, {"context_ignore=[]"}), "A[Q]B");
+  // left context passes into the parent and over sibling branches
+  EXPECT_EQ(derive("B[A]", "B < A = X", 1), "B[X]");
+  EXPECT_EQ(derive("B[C]A", "B < A = X", 1), "B[C]X");
+  EXPECT_EQ(derive("BCA", "B < A = X", 1), "BCA");
+  EXPECT_EQ(derive("BCA", "B < A = X", 1, {"context_ignore=C"}), "BCX");
+  // context parameters bind
+  EXPECT_EQ(derive("B(2)A(3)C(4)", "B(x) < A(y) > C(z) : x + z > y = A(x*y*z)", 1), "B(2)A(24)C(4)");
+}
+
+TEST(LSystemDerivation, Parametric) {  // ABOP 1.10, fig. 1.31
+  const std::string rules =
+      "A(x,y): y <= 3 = A(x*2, x+y)\n"
+      "A(x,y): y > 3 = B(x)A(x/y, 0)\n"
+      "B(x): x < 1 = C\n"
+      "B(x): x >= 1 = B(x-1)";
+  EXPECT_EQ(derive("B(2)A(4,4)", rules, 1), "B(1)B(4)A(1,0)");
+  EXPECT_EQ(derive("B(2)A(4,4)", rules, 2), "B(0)B(3)A(2,1)");
+  EXPECT_EQ(derive("B(2)A(4,4)", rules, 3), "CB(2)A(4,3)");
+  EXPECT_EQ(derive("B(2)A(4,4)", rules, 4), "CB(1)A(8,7)");
+  EXPECT_EQ(derive("B(2)A(4,4)", rules, 5), "CB(0)B(8)A(1.14286,0)");
+}
+
+TEST(LSystemDerivation, HoudiniReferenceExamples) {
+  // "A(i):i<5 = A(i+1) A(i+1) will double each A a maximum of five times"
+  const auto d = derive_lsystem(lsys_params("A(0)", "A(i):i<5 = A(i+1) A(i+1)", 8), 1, nullptr, nullptr, 0);
+  EXPECT_EQ(d.modules, 32u);
+  // edge rewriting with a 5th parameter, ':m=0 =' comparing with a lone '='
+  const std::string rules =
+      "F(i,j,k,l,m) :m=0 = F(i,j,k,l,0)+F(i,j,k,l,1)+\n"
+      "F(i,j,k,l,m) :m=1 =-F(i,j,k,l,0)-F(i,j,k,l,1)";
+  EXPECT_EQ(derive("F(1,1,3,3,0)", rules, 2),
+            "F(1,1,3,3,0)+F(1,1,3,3,1)++-F(1,1,3,3,0)-F(1,1,3,3,1)+");
+  // t is the iteration count during each rewrite; b = generations; the table of the reference
+  const std::string lr = "l:t<b=l+r+\nr:t<b=-l-r\nl=F\nr=F";
+  EXPECT_EQ(derive("l", lr, 1, {"b=1"}), "F");
+  EXPECT_EQ(derive("l", lr, 2, {"b=2"}), "F+F+");
+  EXPECT_EQ(derive("l", lr, 3, {"b=3"}), "F+F++-F-F+");
+  // control length over time
+  EXPECT_EQ(derive("A(1)", "A(i)= F(i)A(i*0.5)", 3), "F(1)F(0.5)F(0.25)A(0.125)");
+  // user variables, i (module index), functions in degrees
+  EXPECT_EQ(derive("AAA", "A = B(i*k)", 1, {"variables=k=2"}), "B(0)B(2)B(4)");
+  EXPECT_EQ(derive("A", "A = B(sin(30), acos(0), max(2,3), min(2,3))", 1), "B(0.5,90,3,2)");
+  EXPECT_EQ(derive("A(4)", "A(x): x > 3 & !(x > 5) | 0 = B", 1), "B");
+  EXPECT_EQ(derive("A(2)", "A(x): x == 2 = B(x^3, 7 % 4)", 1), "B(8,3)");
+  // a symbol with no applicable rule is copied; the first applicable rule wins
+  EXPECT_EQ(derive("AB", "A = X\nA = Y", 1), "XB");
+  // string parameters of a()
+  EXPECT_EQ(derive("A", "A = a(\"Cd\", 1, 0, 1)F", 1), "a(\"Cd\",1,0,1)F");
+}
+
+TEST(LSystemDerivation, AgeCountsGenerationsSinceProduced) {
+  EXPECT_EQ(derive("AB", "A = A\nB : g >= 2 = C", 3), "AC");
+  EXPECT_EQ(derive("AB", "A = A\nB : g >= 2 = C", 2), "AB");
+}
+
+// ---------- probabilities ----------
+
+std::map<char, std::size_t> stochastic_counts(const std::string& mode) {
+  Params p = lsys_params(std::string(30000, 'A'), "A = X : 0.5\nA = Y : 0.5", 1, {"probability=" + mode});
+  return counts(derive_lsystem(p, 7, nullptr, nullptr, 0));
+}
+
+double chi_square(const std::map<char, std::size_t>& got, const std::map<char, double>& expected_fraction, double n) {
+  double chi = 0.0;
+  for (const auto& [c, f] : expected_fraction) {
+    const double e = f * n;
+    const double o = got.count(c) ? static_cast<double>(got.at(c)) : 0.0;
+    chi += (o - e) * (o - e) / e;
+  }
+  return chi;
+}
+
+TEST(LSystemProbability, SequentialRulesEachFireWithTheirOwnChance) {
+  // X 50%, then Y 50% of the rest, the remaining 25% copied; chi-square, 2 dof, p = 0.001: 13.8
+  const auto c = stochastic_counts("sequential");
+  EXPECT_LT(chi_square(c, {{'X', 0.5}, {'Y', 0.25}, {'A', 0.25}}, 30000), 13.8);
+  // and a wrong reading (normalized) would be far off
+  EXPECT_GT(chi_square(c, {{'X', 0.5}, {'Y', 0.5 - 1e-9}, {'A', 1e-9}}, 30000), 1000.0);
+}
+
+TEST(LSystemProbability, NormalizedRulesShareOneChoice) {
+  const auto c = stochastic_counts("normalized");
+  EXPECT_EQ(c.count('A'), 0u);
+  EXPECT_LT(chi_square(c, {{'X', 0.5}, {'Y', 0.5}}, 30000), 10.8);  // 1 dof, p = 0.001
+  // weights under 1 leave the rest to the next rule without a probability
+  Params p = lsys_params(std::string(30000, 'A'), "A = X : 0.2\nA = Y : 0.2\nA = Z", 1, {"probability=normalized"});
+  const auto c2 = counts(derive_lsystem(p, 3, nullptr, nullptr, 0));
+  EXPECT_LT(chi_square(c2, {{'X', 0.2}, {'Y', 0.2}, {'Z', 0.6}}, 30000), 13.8);
+  // percentages: ': 80' is 0.8
+  Params q = lsys_params(std::string(30000, 'A'), "A = X : 80", 1);
+  const auto c3 = counts(derive_lsystem(q, 3, nullptr, nullptr, 0));
+  EXPECT_LT(chi_square(c3, {{'X', 0.8}, {'A', 0.2}}, 30000), 10.8);
+}
+
+TEST(LSystemProbability, SeedChangesTheStringAndRepeats) {
+  Params p = lsys_params("A", "A = A[+A] : 0.5\nA = AA", 8);
+  const auto a = derive_lsystem(p, 1, nullptr, nullptr, 0).text;
+  EXPECT_EQ(a, derive_lsystem(p, 1, nullptr, nullptr, 0).text);
+  EXPECT_NE(a, derive_lsystem(p, 2, nullptr, nullptr, 0).text);
+}
+
+// ---------- errors ----------
+
+TEST(LSystemErrors, NameSourceLineColumnAndWhatWasExpected) {
+  auto err = [](const std::string& premise, const std::string& rules) {
+    return test::error_of([&] { derive(premise, rules, 1); });
+  };
+  EXPECT_NE(err("A", "A = B\nA(i = B").find("parameter 'rules':2:"), std::string::npos) << err("A", "A = B\nA(i = B");
+  EXPECT_NE(err("A", "A = B(q)").find("unknown variable 'q'"), std::string::npos);
+  EXPECT_NE(err("A", "A = B(q)").find("parameter 'rules':1:7"), std::string::npos) << err("A", "A = B(q)");
+  EXPECT_NE(err("A", "AB = C").find("expected one predecessor symbol"), std::string::npos);
+  EXPECT_NE(err("A", "A B").find("expected '=' or '->'"), std::string::npos);
+  EXPECT_NE(err("A", "A = B(1+)").find("expected a number"), std::string::npos);
+  EXPECT_NE(err("A", "A = B(foo(1))").find("unknown function 'foo'"), std::string::npos);
+  EXPECT_NE(err("A", "A = B(1,2,3,4,5,6)").find("at most 5"), std::string::npos);
+  EXPECT_NE(err("A", "A = B : 2 + ").find("the probability"), std::string::npos);
+  EXPECT_NE(err("", "A = B").find("premise is empty"), std::string::npos);
+
+  const auto dir = test::temp_dir("lsys-errors");
+  const std::string file = test::write_text(dir / "bad.lsys", "# a comment\npremise: A\ngeneratons: 3\nA = B\n");
+  const std::string e1 = test::error_of([&] {
+    Params p = default_params(find_algorithm("lsystem"));
+    p.set("grammar", file);
+    derive_lsystem(p, 1, nullptr, nullptr, 0);
+  });
+  EXPECT_NE(e1.find("bad.lsys:3:1: unknown setting 'generatons' (did you mean 'generations'?)"), std::string::npos) << e1;
+  const std::string file2 = test::write_text(dir / "bad2.lsys", "premise: A\n\nA = B(\n");
+  const std::string e2 = test::error_of([&] {
+    Params p = default_params(find_algorithm("lsystem"));
+    p.set("grammar", file2);
+    derive_lsystem(p, 1, nullptr, nullptr, 0);
+  });
+  EXPECT_NE(e2.find("bad2.lsys:3:"), std::string::npos) << e2;
+  const std::string file3 = test::write_text(dir / "bad3.lsys", "premise: A\ngenerations: many\n");
+  const std::string e3 = test::error_of([&] {
+    Params p = default_params(find_algorithm("lsystem"));
+    p.set("grammar", file3);
+    derive_lsystem(p, 1, nullptr, nullptr, 0);
+  });
+  EXPECT_NE(e3.find("bad3.lsys:2:"), std::string::npos) << e3;
+}
+
+TEST(LSystemErrors, RunawayGrowthStopsWithAClearError) {
+  const std::string e = test::error_of([] { derive("F", "F = FF", 40, {"max_symbols=100000"}); });
+  EXPECT_NE(e.find("runaway"), std::string::npos) << e;
+  EXPECT_NE(e.find("max_symbols=100000"), std::string::npos) << e;
+}
+
+// ---------- the turtle ----------
+
+class LSystemTurtle : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    scene_ = new Scene(load_scene("envelope"));
+    query_ = new SceneQuery(*scene_);
+  }
+  static void TearDownTestSuite() {
+    delete query_;
+    delete scene_;
+  }
+  static Plant grow(const std::string& premise, const std::string& rules, double generations,
+                    std::vector<std::string> extra = {}, int threads = 0) {
+    std::vector<std::string> sets = {"premise=" + premise, "rules=" + rules,
+                                     "generations=" + std::to_string(generations), "start=origin", "step_size=1",
+                                     "thickness=0.1"};
+    sets.insert(sets.end(), extra.begin(), extra.end());
+    return test::grow("lsystem", *scene_, *query_, sets, threads);
+  }
+  static Scene* scene_;
+  static SceneQuery* query_;
+};
+Scene* LSystemTurtle::scene_ = nullptr;
+SceneQuery* LSystemTurtle::query_ = nullptr;
+
+TEST_F(LSystemTurtle, KochIslandClosesWithExactLengthsAndRightAngles) {
+  const Plant p = grow("F-F-F-F", "F = F-F+F+FF-F-F+F", 2, {"angle=90"});
+  ASSERT_EQ(p.nodes.size(), 4u * 64u + 1u);  // a root and one node per F
+  EXPECT_LT(glm::distance(p.nodes.front().position, p.nodes.back().position), 1e-4f);  // closes
+  for (std::size_t k = 1; k < p.nodes.size(); ++k) {
+    const glm::vec3 d = p.nodes[k].position - p.nodes[static_cast<std::size_t>(p.nodes[k].parent)].position;
+    EXPECT_NEAR(glm::length(d), 1.0f, 1e-5f);
+    EXPECT_NEAR(std::fabs(d.x) + std::fabs(d.y), 1.0f, 1e-5f);  // axis-aligned in the XY plane
+    EXPECT_NEAR(d.z, 0.0f, 1e-6f);
+    EXPECT_EQ(p.nodes[k].parent, static_cast<std::int32_t>(k - 1));
+  }
+  EXPECT_NEAR(p.total_length(), 256.0, 1e-3);
+}
+
+TEST_F(LSystemTurtle, ConventionsTurnOppositeWays) {
+  // F[+F]: ABOP's + turns left (toward -X when heading +Y, seen from +Z); Houdini's turns right
+  const Plant abop = grow("F[+F]", "", 0, {"angle=90", "convention=abop"});
+  const Plant houdini = grow("F[+F]", "", 0, {"angle=90", "convention=houdini"});
+  ASSERT_EQ(abop.nodes.size(), 3u);
+  EXPECT_NEAR(abop.nodes[2].position.x, -1.0f, 1e-6f);
+  EXPECT_NEAR(abop.nodes[2].position.y, 1.0f, 1e-6f);
+  EXPECT_NEAR(houdini.nodes[2].position.x, 1.0f, 1e-6f);
+  // ABOP fig. 1.24a is a mirror image between the conventions
+  const Plant a = grow("F", "F=F[+F]F[-F]F", 3, {"angle=25.7", "convention=abop"});
+  const Plant h = grow("F", "F=F[+F]F[-F]F", 3, {"angle=25.7", "convention=houdini"});
+  ASSERT_EQ(a.nodes.size(), h.nodes.size());
+  for (std::size_t k = 0; k < a.nodes.size(); ++k) {
+    EXPECT_NEAR(a.nodes[k].position.x, -h.nodes[k].position.x, 1e-5f);
+    EXPECT_NEAR(a.nodes[k].position.y, h.nodes[k].position.y, 1e-5f);
+  }
+  // branch order and connectivity: one root, the branch has order 1
+  EXPECT_EQ(abop.nodes[2].order, 1);
+  EXPECT_EQ(abop.nodes[2].parent, 1);
+}
+
+TEST_F(LSystemTurtle, PitchRollAndTurnAround) {
+  // & pitches the heading toward -U (= -Z at the start): F&F goes to (0, 1, -1)
+  const Plant p = grow("F&F", "", 0, {"angle=90"});
+  EXPECT_NEAR(p.nodes[2].position.z, -1.0f, 1e-6f);
+  EXPECT_NEAR(p.nodes[2].position.y, 1.0f, 1e-6f);
+  // a roll by 90 then a turn: the turn happens in the YZ plane
+  const Plant r = grow("F\\+F", "", 0, {"angle=90", "convention=abop"});
+  EXPECT_NEAR(r.nodes[2].position.x, 0.0f, 1e-6f);
+  EXPECT_NEAR(std::fabs(r.nodes[2].position.z), 1.0f, 1e-6f);
+  // | turns around: F|F comes back to the root
+  const Plant back = grow("F|F", "", 0);
+  EXPECT_LT(glm::length(back.nodes[2].position - back.nodes[0].position), 1e-6f);
+  // f moves without drawing: a second root
+  const Plant gap = grow("FfF", "", 0);
+  ASSERT_EQ(gap.nodes.size(), 4u);
+  EXPECT_EQ(gap.nodes[2].parent, kNoParent);
+  EXPECT_NEAR(gap.nodes[3].position.y, 3.0f, 1e-6f);
+  // G moves on without a vertex: FGF has 3 nodes, the last segment 2 long
+  const Plant g = grow("FGF", "", 0);
+  ASSERT_EQ(g.nodes.size(), 3u);
+  EXPECT_NEAR(g.nodes[2].position.y, 3.0f, 1e-6f);
+  // explicit parameters: F(2) goes 2, H half a step, +(90)
+  const Plant q = grow("F(2)+(90)H", "", 0, {"convention=abop"});
+  EXPECT_NEAR(q.nodes[1].position.y, 2.0f, 1e-6f);
+  EXPECT_NEAR(q.nodes[2].position.x, -0.5f, 1e-6f);
+}
+
+TEST_F(LSystemTurtle, DollarLevelsTheLeftVector) {
+  // after arbitrary rotations, $ makes L horizontal (the organ's local +X is L)
+  const Plant p = grow("F&(30)/(50)+(20)$J", "", 0);
+  ASSERT_EQ(p.organs.size(), 1u);
+  const glm::vec3 left = p.organs[0].orientation * glm::vec3(1, 0, 0);
+  const glm::vec3 head = p.organs[0].orientation * glm::vec3(0, 0, 1);
+  EXPECT_NEAR(left.y, 0.0f, 1e-5f);
+  EXPECT_GT(glm::length(head), 0.99f);
+  // $(x,y,z) points the turtle at the point
+  const Plant q = grow("F$(3,1,0)F", "", 0);
+  EXPECT_NEAR(q.nodes[2].position.x, 1.0f, 1e-5f);
+  EXPECT_NEAR(q.nodes[2].position.y, 1.0f, 1e-5f);
+}
+
+TEST_F(LSystemTurtle, ScalesWidthsOrgansPolygonsGroupsAttributes) {
+  const Plant p = grow("F\"F!F_F?F", "", 0, {"step_scale=0.5", "thickness_scale=0.5"});
+  ASSERT_EQ(p.nodes.size(), 6u);
+  EXPECT_NEAR(p.nodes[2].position.y - p.nodes[1].position.y, 0.5f, 1e-6f);
+  EXPECT_NEAR(p.nodes[4].position.y - p.nodes[3].position.y, 1.0f, 1e-6f);  // _ undid "
+  EXPECT_NEAR(p.nodes[1].radius, 0.05f, 1e-7f);                            // width 0.1 -> radius 0.05
+  EXPECT_NEAR(p.nodes[3].radius, 0.025f, 1e-7f);
+  EXPECT_NEAR(p.nodes[5].radius, 0.05f, 1e-7f);
+
+  const Plant o = grow("FJ(0.5,0,1,2,3)K(0.25)M", "", 0);
+  ASSERT_EQ(o.organs.size(), 3u);
+  EXPECT_EQ(o.organs[0].kind, OrganKind::Leaf);
+  EXPECT_EQ(o.organs[1].kind, OrganKind::Flower);
+  EXPECT_EQ(o.organs[2].kind, OrganKind::Bud);
+  EXPECT_FLOAT_EQ(o.organs[0].size, 0.5f);
+  EXPECT_FLOAT_EQ(o.organs[2].size, 1.0f);  // default: the step
+  EXPECT_EQ(o.organs[0].stamp, (std::array<float, 3>{1, 2, 3}));
+  EXPECT_EQ(o.organs[0].node, 1);
+
+  const Plant poly = grow("{.f+.f+.f+.}", "", 0, {"angle=90"});
+  ASSERT_EQ(poly.polygons.size(), 1u);
+  EXPECT_EQ(poly.polygons[0].vertices.size(), 4u);
+
+  const Plant cut = grow("F[F%FF]F", "", 0);
+  EXPECT_EQ(cut.nodes.size(), 4u);  // root, F, the branch's first F, the last F
+
+  const Plant grp = grow("a(\"Cd\",1,0,1)Fg[gF]F", "", 0);
+  ASSERT_EQ(grp.node_groups.size(), grp.nodes.size());
+  EXPECT_EQ(grp.node_groups[1], -1);
+  EXPECT_EQ(grp.node_groups[2], 1);  // the branch's g
+  EXPECT_EQ(grp.node_groups[3], 0);  // back on the main axis: the first g
+  ASSERT_EQ(grp.node_attributes.size(), 1u);
+  EXPECT_EQ(grp.node_attributes[0].name, "Cd");
+  EXPECT_EQ(grp.node_attributes[0].components, 3);
+  EXPECT_FLOAT_EQ(grp.node_attributes[0].values[3 * 1 + 2], 1.0f);
+  EXPECT_EQ(grp.validate(), "");
+}
+
+TEST_F(LSystemTurtle, TropismBendsTowardGravity) {
+  const Plant p = grow("F+(90)FTF", "", 0, {"gravity=0.5", "convention=abop"});
+  // heading -X then T rotates it toward -Y by 0.5 rad
+  const glm::vec3 d = p.nodes[3].position - p.nodes[2].position;
+  EXPECT_NEAR(d.y, -std::sin(0.5f), 1e-5f);
+  EXPECT_NEAR(d.x, -std::cos(0.5f), 1e-5f);
+}
+
+TEST_F(LSystemTurtle, FractionalGenerationsGrowContinuously) {
+  // A -> F A: at 2.5 generations the newest F is half a step
+  const Plant p = grow("A", "A = FA", 2.5);
+  ASSERT_EQ(p.nodes.size(), 4u);
+  EXPECT_NEAR(p.nodes[3].position.y - p.nodes[2].position.y, 0.5f, 1e-6f);
+  EXPECT_NEAR(p.nodes[2].position.y, 2.0f, 1e-6f);
+  // new angles scale too: A -> +(90)F A at 0.5 turns 45 degrees
+  const Plant q = grow("FA", "A = +(90)FA", 0.5, {"convention=abop"});
+  const glm::vec3 d = q.nodes[2].position - q.nodes[1].position;
+  EXPECT_NEAR(std::atan2(-d.x, d.y), glm::radians(45.0f), 1e-5f);
+}
+
+TEST_F(LSystemTurtle, InTestsTheEnvelopeAndArcLengthIsReadable) {
+  // the topiary example stays inside the envelope (plus a step) and grows something there
+  const Plant p = test::grow("lsystem", *scene_, *query_, {"grammar=topiary"});
+  ASSERT_GT(p.nodes.size(), 100u);
+  const Shape& env = *scene_->envelope;
+  std::size_t inside = 0;
+  for (const auto& n : p.nodes) inside += query_->inside_shape(env, n.position) ? 1 : 0;
+  EXPECT_GT(inside, p.nodes.size() / 2);
+  // arc length: a rule that stops at A >= 3 grows exactly 3 unit steps
+  const Plant q = grow("A", "A: A < 3 = FA", 10);
+  EXPECT_EQ(q.nodes.size(), 4u);
+}
+
+TEST_F(LSystemTurtle, DeterministicAcrossThreadCounts) {
+  // a stochastic, parametric, context-sensitive grammar large enough to span many rewrite blocks
+  const std::string rules =
+      "A(l) = F(l)[+A(l*0.7)][-A(l*0.8)]/A(l*0.9) : 0.7\n"
+      "A(l) = F(l)[&A(l*0.8)]A(l*0.9)\n"
+      "F(l) > [ = F(l*1.01)";
+  const std::vector<std::string> extra = {"angle=20", "max_symbols=5000000"};
+  const Plant one = grow("A(1)", rules, 11, extra, 1);
+  const Plant two = grow("A(1)", rules, 11, extra, 2);
+  ASSERT_GT(one.nodes.size(), 20000u);  // more than 32768 modules: several rewrite blocks
+  EXPECT_EQ(one.geometry_hash(), two.geometry_hash());
+}
+
+TEST_F(LSystemTurtle, SurfaceWrapKeepsNodesOnTheSurface) {
+  const Scene column = load_scene("column");
+  const SceneQuery q(column);
+  const Plant p = test::grow("lsystem", column, q, {"surface=wrap", "grammar=bracketed-plant", "wrap_offset=0.01"});
+  ASSERT_GT(p.nodes.size(), 100u);
+  for (const auto& n : p.nodes) {
+    const float d = q.closest_point(n.position).distance;
+    ASSERT_NEAR(d, 0.01f, 2e-3f);
+  }
+}
+
+TEST(LSystemExamples, EveryExampleGrows) {
+  const auto names = lsystem_examples();
+  ASSERT_GE(names.size(), 6u);
+  const Scene scene = load_scene("envelope");
+  const SceneQuery query(scene);
+  for (const auto& name : names) {
+    const Plant p = test::grow("lsystem", scene, query, {"grammar=" + name});
+    EXPECT_GT(p.nodes.size(), 10u) << name;
+    EXPECT_EQ(p.validate(), "") << name;
+  }
+  // the bush carries leaves and flowers
+  const Plant bush = test::grow("lsystem", scene, query, {"grammar=bush"});
+  std::size_t leaves = 0, flowers = 0;
+  for (const auto& o : bush.organs) {
+    leaves += o.kind == OrganKind::Leaf;
+    flowers += o.kind == OrganKind::Flower;
+  }
+  EXPECT_GT(leaves, 0u);
+  EXPECT_GT(flowers, 0u);
+}
+
+TEST(LSystemExpr, CompilesOnceAndFoldsConstants) {
+  lsys::Expr e;
+  lsys::ExprError err;
+  std::vector<std::string> formals = {"x"};
+  ASSERT_TRUE(lsys::ExprCompiler::compile("2 * 3 + 1", {&formals, nullptr}, e, err));
+  EXPECT_TRUE(e.constant());
+  EXPECT_EQ(e.constant_value(), 7.0);
+  ASSERT_TRUE(lsys::ExprCompiler::compile("x * 2 - -1", {&formals, nullptr}, e, err));
+  EXPECT_FALSE(e.constant());
+  struct H final : lsys::ExprHost {
+    double in(double, double, double) const override { return 0; }
+    double pic(double, double, double) const override { return 0; }
+    double rand(double) const override { return 0; }
+    double chan(double) const override { return 0; }
+  } host;
+  double env[lsys::kMaxSlots] = {};
+  env[0] = 5.0;
+  EXPECT_EQ(e.eval(env, host), 11.0);
+  ASSERT_TRUE(lsys::ExprCompiler::compile("2 ^ 3 ^ 2", {&formals, nullptr}, e, err));
+  EXPECT_EQ(e.constant_value(), 512.0);  // right-associative
+  ASSERT_TRUE(lsys::ExprCompiler::compile("-2 ^ 2", {&formals, nullptr}, e, err));
+  EXPECT_EQ(e.constant_value(), -4.0);
+  EXPECT_FALSE(lsys::ExprCompiler::compile("x +", {&formals, nullptr}, e, err));
+  EXPECT_EQ(err.offset, 3u);
+}
+
+}  // namespace
+}  // namespace growbench
