@@ -30,6 +30,28 @@ TEST(Cli, HelpAndLists) {
     EXPECT_NE(r.out.find(s), std::string::npos) << s;
 }
 
+TEST(Cli, LsystemPrintsTheDerivedStringAndGrowsExamplesFromFiles) {
+  auto r = growbench("lsystem koch-island --generations 1 --print");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("F-F+F+FF-F-F+F-F-F+F+FF-F-F+F-F-F+F+FF-F-F+F-F-F+F+FF-F-F+F\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("F  32"), std::string::npos) << r.out;
+  r = growbench("lsystem --examples");
+  EXPECT_NE(r.out.find("topiary"), std::string::npos) << r.out;
+  r = growbench("lsystem bush --set anlge=3");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("did you mean 'angle'"), std::string::npos) << r.out;
+  r = growbench("lsystem busj");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("did you mean 'bush'"), std::string::npos) << r.out;
+  // a grammar file by path, grown on a scene through `run`
+  const auto dir = test::temp_dir("cli-lsys");
+  const std::string file = test::write_text(dir / "mine.lsys", "premise: A\ngenerations: 4\nA = F[+A][-A]\n");
+  r = growbench("run -a lsystem -s wall --set grammar=" + file + " -q -o " + (dir / "out").string());
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("4 steps (finished)"), std::string::npos) << r.out;
+  EXPECT_TRUE(std::filesystem::exists(dir / "out" / "plant.ply"));
+}
+
 TEST(Cli, BadInputExitsTwoWithAClearMessage) {
   auto r = growbench("run -a spacecl -s wall -o /tmp/x");
   EXPECT_EQ(r.status, 2);
