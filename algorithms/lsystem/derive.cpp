@@ -66,6 +66,11 @@ Deriver::Deriver(const Grammar& grammar, DeriveSettings settings) : g_(grammar),
     const bool simple = list.size() == 1 && !r.has_context && r.condition.empty() && r.probability.empty() &&
                         r.static_successor && !r.pred.has_parens && !g_.uses_age;
     kind_[c] = simple ? 1 : 2;
+    any_general_ |= !simple;
+    if (simple) {
+      static_symbols_[c] = static_cast<std::uint32_t>(r.static_symbols.size());
+      static_params_[c] = static_cast<std::uint32_t>(r.static_params.size());
+    }
   }
 }
 
@@ -258,10 +263,9 @@ void Deriver::rewrite(const LString& in, LString& out, int generation, const std
   const std::size_t n = in.size();
   const std::size_t nb = block_count(n);
   const std::uint16_t* sym = in.symbols.data();
-  const bool general = std::any_of(std::begin(kind_), std::end(kind_), [](std::uint8_t k) { return k == 2; });
   const bool ages = g_.uses_age;
   const bool turtle = g_.uses_turtle && states.size() == n;
-  if (general) choice_.resize(n);
+  if (any_general_) choice_.resize(n);
   block_in_params_.assign(nb + 1, 0);
   block_out_syms_.assign(nb + 1, 0);
   block_out_params_.assign(nb + 1, 0);
@@ -275,14 +279,6 @@ void Deriver::rewrite(const LString& in, LString& out, int generation, const std
       block_in_params_[b + 1] = s;
     });
     for (std::size_t b = 0; b < nb; ++b) block_in_params_[b + 1] += block_in_params_[b];
-  }
-
-  std::uint32_t static_syms[128] = {}, static_pars[128] = {};
-  for (int c = 0; c < 128; ++c) {
-    if (kind_[c] != 1) continue;
-    const Rule& r = g_.rules[g_.rules_for[c][0]];
-    static_syms[c] = static_cast<std::uint32_t>(r.static_symbols.size());
-    static_pars[c] = static_cast<std::uint32_t>(r.static_params.size());
   }
 
   auto setup_env = [&](double* env) {
@@ -321,8 +317,8 @@ void Deriver::rewrite(const LString& in, LString& out, int generation, const std
           opars += static_cast<std::size_t>(k);
           break;
         case 1:
-          osyms += static_syms[c];
-          opars += static_pars[c];
+          osyms += static_symbols_[c];
+          opars += static_params_[c];
           break;
         default: {
           set_module_env(env, m);

@@ -69,6 +69,8 @@ class Deriver {
   const Grammar& g_;
   DeriveSettings s_;
   std::uint8_t kind_[128] = {};  // 0 copy, 1 one static rule without conditions, 2 general
+  bool any_general_ = false;     // some symbol is kind 2: rule choices are stored per module
+  std::uint32_t static_symbols_[128] = {}, static_params_[128] = {};  // output size of a kind-1 symbol
   std::vector<std::uint16_t> choice_;
   std::vector<std::size_t> block_in_params_, block_out_syms_, block_out_params_;
 };

@@ -172,8 +172,6 @@ class LineParser {
         if (m.args.size() > static_cast<std::size_t>(kMaxParams))
           fail(s.column + j, fmt::format("a symbol has at most {} parameters, found {}", kMaxParams, m.args.size()));
         k = close + 1;
-      } else if (m.symbol == 'a') {
-        // a bare 'a' is a symbol like any other
       }
       out.push_back(std::move(m));
     }
@@ -237,7 +235,6 @@ class LineParser {
     r.pred = std::move(preds[0]);
     r.has_context = !r.left.empty() || !r.right.empty();
 
-    for (const auto* list : {&r.left, &r.right}) (void)list;
     auto add_formals = [&](const Pattern& p) {
       for (const auto& f : p.formals) r.formals.push_back(f);
     };

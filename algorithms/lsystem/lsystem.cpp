@@ -169,7 +169,8 @@ struct Setup {
   lsys::DeriveSettings derive;
   lsys::TurtleSettings turtle;
   std::unique_ptr<Host> host;
-  double generations = 0.0;
+  int rewrites = 0;       // whole generations, plus one for a fractional part
+  double fraction = 0.0;  // the fractional part (0: none); the last rewrite is drawn scaled by it
 };
 
 Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* query) {
@@ -285,7 +286,10 @@ Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* quer
     if (!query) throw InputError("surface=wrap needs a scene with surfaces");
     t.wrap = query;
   }
-  s.generations = p.real("generations");
+  const double generations = p.real("generations");
+  const int full = static_cast<int>(std::floor(generations + 1e-9));
+  s.fraction = generations - full < 1e-6 ? 0.0 : generations - full;
+  s.rewrites = full + (s.fraction > 0.0 ? 1 : 0);
   return s;
 }
 
@@ -305,10 +309,6 @@ class LSystem final : public GrowthAlgorithm {
 
   void start(const Scene& scene, const SceneQuery& query, const Params& params, std::uint64_t seed) override {
     setup_ = make_setup(params, seed, &query);
-    full_ = static_cast<int>(std::floor(setup_.generations + 1e-9));
-    fraction_ = setup_.generations - full_;
-    if (fraction_ < 1e-6) fraction_ = 0.0;
-    rewrites_ = full_ + (fraction_ > 0.0 ? 1 : 0);
     deriver_ = std::make_unique<lsys::Deriver>(setup_.grammar, setup_.derive);
     plants_.clear();
     if (setup_.params.text("start") == "origin" || scene.seeds.empty()) {
@@ -334,7 +334,7 @@ class LSystem final : public GrowthAlgorithm {
     ++step_;
     bool more = false;
     for (auto& pl : plants_) {
-      if (!pl.started || pl.generation >= rewrites_) continue;
+      if (!pl.started || pl.generation >= setup_.rewrites) continue;
       const auto t0 = std::chrono::steady_clock::now();
       deriver_->set_stream(pl.stream);
       deriver_->rewrite(pl.cur, pl.next, pl.generation + 1, pl.states);
@@ -344,7 +344,7 @@ class LSystem final : public GrowthAlgorithm {
     }
     begin_due();
     redraw();
-    for (const auto& pl : plants_) more |= !pl.started || pl.generation < rewrites_;
+    for (const auto& pl : plants_) more |= !pl.started || pl.generation < setup_.rewrites;
     if (!more) {
       for (auto& pl : plants_) {  // the spare buffers are no longer needed
         pl.next.symbols.release();
@@ -390,8 +390,8 @@ class LSystem final : public GrowthAlgorithm {
       ts.heading = pl.heading;
       ts.stream = pl.stream;
       ts.birth_step = static_cast<std::uint32_t>(step_);
-      ts.fraction = (fraction_ > 0.0 && pl.generation == rewrites_) ? fraction_ : 1.0;
-      const bool need_states = setup_.grammar.uses_turtle && pl.generation < rewrites_;
+      ts.fraction = (setup_.fraction > 0.0 && pl.generation == setup_.rewrites) ? setup_.fraction : 1.0;
+      const bool need_states = setup_.grammar.uses_turtle && pl.generation < setup_.rewrites;
       const auto r = lsys::interpret(pl.cur, ts, setup_.grammar.strings, plant_, need_states ? &pl.states : nullptr);
       if (!need_states) pl.states.clear();
       max_depth_ = std::max(max_depth_, r.max_depth);
@@ -403,8 +403,7 @@ class LSystem final : public GrowthAlgorithm {
   std::unique_ptr<lsys::Deriver> deriver_;
   std::vector<Plantlet> plants_;
   Plant plant_;
-  int full_ = 0, rewrites_ = 0, step_ = 0;
-  double fraction_ = 0.0;
+  int step_ = 0;
   double rewrite_s_ = 0.0, turtle_s_ = 0.0;
   std::size_t max_depth_ = 0;
 };
@@ -443,8 +442,7 @@ DerivedString derive_lsystem(const Params& params, std::uint64_t seed, const Sce
   lsys::LString cur, next;
   std::vector<lsys::TurtleVars> states;
   deriver.premise(cur);
-  const int full = static_cast<int>(std::floor(setup.generations + 1e-9));
-  const int rewrites = full + (setup.generations - full > 1e-6 ? 1 : 0);
+  const int rewrites = setup.rewrites;
   lsys::TurtleSettings ts = setup.turtle;
   if (scene && !scene->seeds.empty() && setup.params.text("start") == "seeds") {
     ts.origin = glm::dvec3(scene->seeds[0].position);

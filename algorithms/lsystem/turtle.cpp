@@ -52,6 +52,7 @@ class Interpreter {
     t.length = s_.step;
     t.width = s_.thickness;
     t.angle = s_.angle;
+    for (const auto& nd : plant_.nodes) shoot_counter_ = std::max(shoot_counter_, nd.shoot + 1);  // after earlier plants'
     t.shoot = next_shoot();
     if (s_.wrap) snap_start(t);
     const std::size_t first_node = plant_.nodes.size();
@@ -263,7 +264,6 @@ class Interpreter {
       }
     }
     finish_attributes(first_node);
-    (void)first_poly;
     result_.nodes = plant_.nodes.size() - first_node;
     result_.organs = plant_.organs.size() - first_organ;
     result_.polygons = plant_.polygons.size() - first_poly;
@@ -280,15 +280,7 @@ class Interpreter {
     c = cached_cos_;
     s = cached_sin_;
   }
-  std::uint32_t next_shoot() {
-    if (plant_.nodes.empty() && shoot_counter_ == 0) shoot_counter_ = base_shoot();
-    return shoot_counter_++;
-  }
-  std::uint32_t base_shoot() const {
-    std::uint32_t b = 0;
-    for (const auto& nd : plant_.nodes) b = std::max(b, nd.shoot + 1);
-    return b;
-  }
+  std::uint32_t next_shoot() { return shoot_counter_++; }
   void record(const State& t, std::size_t m) {
     (*states_)[m] = {static_cast<float>(t.pos.x), static_cast<float>(t.pos.y), static_cast<float>(t.pos.z),
                      static_cast<float>(t.arc),   static_cast<float>(t.length), static_cast<float>(t.width),
