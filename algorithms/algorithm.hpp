@@ -18,6 +18,7 @@ struct AlgorithmInfo {
   std::string name;
   std::string summary;
   std::vector<ParamSpec> params;  // the table `growbench list` prints
+  std::vector<ParamPreset> presets;  // defaults selected by the `preset` parameter (may be empty)
 };
 
 class GrowthAlgorithm {

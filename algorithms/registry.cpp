@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "algorithms/algorithm.hpp"
+#include "algorithms/ivy/ivy.hpp"
 #include "algorithms/lsystem/lsystem.hpp"
 #include "algorithms/spacecol/spacecol.hpp"
 
@@ -12,6 +13,7 @@ const std::vector<AlgorithmEntry>& algorithm_registry() {
   static const std::vector<AlgorithmEntry> list = {
       {spacecol_info, make_spacecol},
       {lsystem_info, make_lsystem},
+      {ivy_info, make_ivy},
   };
   return list;
 }
@@ -29,7 +31,9 @@ const AlgorithmEntry& find_algorithm(const std::string& name) {
 
 Params default_params(const AlgorithmEntry& entry) {
   const auto& info = entry.info();
-  return Params(fmt::format("algorithm '{}'", info.name), info.params);
+  Params p(fmt::format("algorithm '{}'", info.name), info.params);
+  if (!info.presets.empty()) p.set_presets(info.presets);
+  return p;
 }
 
 }  // namespace growbench

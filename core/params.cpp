@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <stdexcept>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -135,6 +136,34 @@ void Params::check_and_store(std::size_t i, ParamValue v, std::string_view shown
   }
   values_[i] = std::move(v);
   set_[i] = true;
+  if (s.name == "preset") apply_preset();
+}
+
+void Params::set_presets(const std::vector<ParamPreset>& presets) {
+  presets_ = presets;
+  for (const auto& p : presets_)
+    for (const auto& [key, v] : p.values) {
+      const std::size_t i = index_of(key);  // a typo in a preset table is a programming error
+      if (v.index() != specs_[i].default_value.index())
+        throw std::logic_error(fmt::format("preset '{}' of {}: '{}' has the wrong type", p.name, owner_, key));
+    }
+  apply_preset();
+}
+
+void Params::apply_preset() {
+  const auto it = std::find_if(specs_.begin(), specs_.end(), [](const ParamSpec& s) { return s.name == "preset"; });
+  if (it == specs_.end() || presets_.empty()) return;
+  const std::string& name = std::get<std::string>(values_[static_cast<std::size_t>(it - specs_.begin())]);
+  const ParamPreset* preset = nullptr;
+  for (const auto& p : presets_)
+    if (p.name == name) preset = &p;
+  for (std::size_t i = 0; i < specs_.size(); ++i) {
+    if (set_[i]) continue;
+    values_[i] = specs_[i].default_value;
+    if (preset)
+      for (const auto& [key, v] : preset->values)
+        if (key == specs_[i].name) values_[i] = v;
+  }
 }
 
 namespace {

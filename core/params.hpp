@@ -8,6 +8,7 @@
 #include <limits>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -39,11 +40,21 @@ std::string format_value(const ParamValue& v);
 // The closest candidate to `name` by edit distance, or "" when nothing is close.
 std::string closest_match(std::string_view name, const std::vector<std::string>& candidates);
 
+// Named defaults for a parameter table: when the table's Choice parameter `preset` takes the value
+// `name`, the listed parameters default to these values instead of their spec defaults (a value the
+// user set explicitly always wins, whichever order the assignments came in).
+struct ParamPreset {
+  std::string name;
+  std::vector<std::pair<std::string, ParamValue>> values;
+};
+
 class Params {
  public:
   Params() = default;
   // `owner` names whose parameters these are in error messages, e.g. "algorithm 'spacecol'".
   Params(std::string owner, const std::vector<ParamSpec>& specs);
+  // Installs presets (see ParamPreset) and applies the one the `preset` parameter names now.
+  void set_presets(const std::vector<ParamPreset>& presets);
 
   void set(std::string_view key, std::string_view text);       // parse and validate
   void set_json(std::string_view key, const nlohmann::json& value);
@@ -66,11 +77,13 @@ class Params {
   [[nodiscard]] std::size_t index_of(std::string_view key) const;  // throws InputError if unknown
   [[nodiscard]] const ParamValue& value(std::string_view key, ParamType expected) const;
   void check_and_store(std::size_t i, ParamValue v, std::string_view shown);
+  void apply_preset();
 
   std::string owner_;
   std::vector<ParamSpec> specs_;
   std::vector<ParamValue> values_;
   std::vector<bool> set_;
+  std::vector<ParamPreset> presets_;
 };
 
 }  // namespace growbench

@@ -116,6 +116,11 @@ int main(int argc, char** argv) {
         const auto& info = e.info();
         fmt::print("{}\n  {}\n", info.name, info.summary);
         print_param_table(info.params);
+        for (const auto& preset : info.presets) {
+          std::vector<std::string> kv;
+          for (const auto& [k, v] : preset.values) kv.push_back(fmt::format("{}={}", k, gb::format_value(v)));
+          fmt::print("    preset={}: {}\n", preset.name, kv.empty() ? "the defaults above" : fmt::format("{}", fmt::join(kv, " ")));
+        }
       }
       return 0;
     }

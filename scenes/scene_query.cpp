@@ -275,6 +275,32 @@ ClosestHit SceneQuery::closest_point(const glm::vec3& p, float max_distance) con
   return st.best;
 }
 
+namespace {
+struct VisitState {
+  SceneQuery::TriangleVisitor visit;
+  void* user;
+};
+bool visit_callback(RTCPointQueryFunctionArguments* args) {
+  const auto* st = static_cast<const VisitState*>(args->userPtr);
+  const float before = args->query->radius;
+  st->visit(st->user, args->geomID, args->primID, &args->query->radius);
+  return args->query->radius != before;
+}
+}  // namespace
+
+void SceneQuery::visit_near(const glm::vec3& p, float radius, TriangleVisitor visit, void* user) const {
+  RTCPointQuery q{};
+  q.x = p.x;
+  q.y = p.y;
+  q.z = p.z;
+  q.time = 0.0f;
+  q.radius = radius;
+  RTCPointQueryContext ctx;
+  rtcInitPointQueryContext(&ctx);
+  VisitState st{visit, user};
+  rtcPointQuery(embree_->main->scene, &q, &ctx, visit_callback, &st);
+}
+
 RayHit SceneQuery::ray(const glm::vec3& origin, const glm::vec3& dir, float tmax, float tmin) const {
   return embree_->main->ray(origin, dir, tmin, tmax);
 }

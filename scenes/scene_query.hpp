@@ -68,6 +68,12 @@ class SceneQuery {
   [[nodiscard]] ClosestHit closest_point(const glm::vec3& p,
                                          float max_distance = std::numeric_limits<float>::infinity()) const;
   // First hit along origin + t dir for t in (tmin, tmax); dir need not be normalised (t is in its units).
+  // Calls `visit` for every triangle in a BVH leaf that comes within `radius` of p (an Embree point
+  // query: a conservative superset of the triangles within radius; a triangle may be visited twice
+  // when the BVH split it). The visitor may shrink *radius to prune the rest of the traversal. For
+  // queries with their own per-triangle rule (the ivy's Luft adhesion and collision candidates).
+  using TriangleVisitor = void (*)(void* user, std::uint32_t mesh, std::uint32_t triangle, float* radius);
+  void visit_near(const glm::vec3& p, float radius, TriangleVisitor visit, void* user) const;
   [[nodiscard]] RayHit ray(const glm::vec3& origin, const glm::vec3& dir,
                            float tmax = std::numeric_limits<float>::infinity(), float tmin = 0.0f) const;
   [[nodiscard]] bool occluded(const glm::vec3& origin, const glm::vec3& dir,

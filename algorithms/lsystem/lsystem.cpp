@@ -89,7 +89,8 @@ const AlgorithmInfo kInfo = {
         {"pic_image", ParamType::String, std::string(""), -INFINITY, INFINITY, "", "image read by pic(u, v, plane) (PNG, JPEG, ...)", {}},
         {"max_symbols", ParamType::Int, std::int64_t{50'000'000}, 1, 2e9, "",
          "a generation that would exceed this many symbols stops the run with an error", {}},
-    }};
+    },
+    {}};
 
 const std::vector<std::string>& setting_names() {
   static const std::vector<std::string> names = [] {

@@ -67,7 +67,8 @@ const AlgorithmInfo kInfo = {
          "where leaves go: none, at branch tips, every leaf_interval nodes, or both", {"none", "tips", "interval", "both"}},
         {"leaf_interval", ParamType::Int, std::int64_t{6}, 1, 1000, "", "a leaf every k nodes along a branch (leaves=interval/both)", {}},
         {"leaf_size", ParamType::Real, 0.05, 0, 10, "m", "leaf blade length", {}},
-    }};
+    },
+    {}};
 
 using Cloud = Vec3Cloud;
 using PointTree = Vec3Tree;

@@ -1,0 +1,561 @@
+// Luft-style ivy. The growth rules are Luft's (ALGORITHMS.md section 1); what changes is the cost:
+//
+//  * Luft loops over every scene triangle for each node's adhesion and again for its collision test.
+//    Here one Embree point query per node does both: it finds the adhesion target under Luft's rule
+//    (or the true closest point) and, on the same traversal, gathers the triangles the collision test
+//    can possibly touch. Every position the collision loop can produce stays within |step| of the old
+//    position (mirroring across a plane the segment crosses never moves the end farther from the
+//    start), so the triangles within that radius are a complete candidate set, and Luft's loop over
+//    them in index order gives exactly his result. A ray could not promise that: its hit set comes
+//    from Embree's own float test, which differs from Luft's rule along edges. (The Blender collision
+//    mode is a ray, because Blender's is.)
+//  * Luft's branching scans every node of every alive root each iteration (quadratic over a run).
+//    The same distribution is drawn without the scan: a node can only branch where its weight
+//    w = 1 - (cos(2 pi l / L) / 2 + 1/2) exceeds the threshold b, a contiguous window of the root
+//    found by binary search on arc length; inside it, Bernoulli trials with p_i = 1 - b / w_i are
+//    thinned from trials with the maximum p = 1 - b whose gaps are geometric. The first accepted
+//    node is distributed exactly as the first success of Luft's node-by-node loop.
+#include "algorithms/ivy/ivy.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "core/random.hpp"
+#include "scenes/geometry.hpp"
+
+namespace growbench {
+namespace {
+
+// ---- parameter table (what `growbench list` prints) ----
+const AlgorithmInfo kInfo = {
+    "ivy",
+    "Luft's ivy generator (and Blender IvyGen): roots creep along surfaces by primary, random, adhesion and "
+    "gravity terms, mirror off what they hit, branch, and carry leaves facing away from the surface",
+    {
+        {"preset", ParamType::Choice, std::string("luft"), -INFINITY, INFINITY, "",
+         "luft: Luft's defaults, sizes relative to R (the scene's bounding-sphere radius); blender: Blender IvyGen "
+         "0.1.5 (absolute metres, max_root_length 1, one ray collision without death, closest-point adhesion, "
+         "one smoothing pass, its leaves)",
+         {"luft", "blender"}},
+        {"units", ParamType::Choice, std::string("relative"), -INFINITY, INFINITY, "",
+         "relative: ivy_size, max_float_length, max_adhesion_distance and the length limits are multiples of R, "
+         "leaf_size and branch_size multiples of R * ivy_size (Luft); absolute: all of them in metres (Blender)",
+         {"relative", "absolute"}},
+        {"ivy_size", ParamType::Real, 0.005, 1e-6, 100, "", "length scale of one growth step", {}},
+        {"primary_weight", ParamType::Real, 0.5, 0, 100, "", "weight of the previous direction", {}},
+        {"random_weight", ParamType::Real, 0.2, 0, 100, "",
+         "weight of a random direction (uniform in a cube, plus 0.2 up)", {}},
+        {"adhesion_weight", ParamType::Real, 0.1, 0, 100, "",
+         "weight of the pull to the nearest surface (the three weights are normalised by their sum)", {}},
+        {"gravity_weight", ParamType::Real, 1.0, 0, 100, "",
+         "gravity: ivy_size * this * (floating length / max_float_length)^0.7 downwards", {}},
+        {"branching_probability", ParamType::Real, 0.95, 0, 1, "",
+         "a node starts a new root when rand * w > this (w peaks mid-root); Blender's panel shows 1 - this", {}},
+        {"leaf_probability", ParamType::Real, 0.7, 0, 10, "",
+         "a leaf grows when rand * w > this (w grows toward the tip and on the ground); Blender's panel shows 1 - this",
+         {}},
+        {"leaf_size", ParamType::Real, 1.5, 0, 100, "", "leaf half-size (relative: times R * ivy_size)", {}},
+        {"branch_size", ParamType::Real, 0.15, 0, 100, "", "branch radius scale (relative: times R * ivy_size)", {}},
+        {"max_float_length", ParamType::Real, 0.1, 1e-6, 1e4, "",
+         "a root dies once it has floated (not touched a surface) this far", {}},
+        {"max_adhesion_distance", ParamType::Real, 0.1, 1e-6, 1e4, "", "surfaces farther than this do not attract", {}},
+        {"max_root_length", ParamType::Real, 3.0, 0, 1e6, "",
+         "stop when a root is this long (Blender's maxIvyLength; Luft's GUI has none, the user stops growth: roots "
+         "that never leave a surface never die); 0: no limit", {}},
+        {"max_total_length", ParamType::Real, 0.0, 0, 1e9, "", "stop when all roots together are this long; 0: no limit",
+         {}},
+        {"adhesion", ParamType::Choice, std::string("luft"), -INFINITY, INFINITY, "",
+         "luft: face interiors only, front sides only (Luft); closest: true closest point incl. edges and vertices "
+         "(Blender's BVH)",
+         {"luft", "closest"}},
+        {"collision", ParamType::Choice, std::string("luft"), -INFINITY, INFINITY, "",
+         "luft: mirror across every entered face, repeat, the root dies after more than 5 passes; blender: one ray, "
+         "mirror across the first face if entering, never dies",
+         {"luft", "blender"}},
+        {"max_depth", ParamType::Int, std::int64_t{3}, 0, 100, "", "roots this deep (ancestor count) can still branch", {}},
+        {"branches_per_step", ParamType::Int, std::int64_t{1}, 1, 1000000, "",
+         "new roots per iteration at most (Luft: 1)", {}},
+        {"smoothing_passes", ParamType::Int, std::int64_t{5}, 0, 100, "",
+         "passes of the 11-tap [1 2 4 7 9 10 9 7 4 2 1]/56 filter over each root's adhesion vectors", {}},
+        {"leaves", ParamType::Choice, std::string("luft"), -INFINITY, INFINITY, "",
+         "luft: leaf_passes passes over each root's nodes, young and adult leaves; blender: leaf_passes tries along "
+         "each segment; none",
+         {"luft", "blender", "none"}},
+        {"leaf_passes", ParamType::Int, std::int64_t{10}, 0, 1000, "", "leaf passes per root (luft) or tries per segment (blender)",
+         {}},
+    },
+    {
+        {"luft", {}},
+        {"blender",
+         {{"units", std::string("absolute")},
+          {"ivy_size", 0.02},
+          {"max_float_length", 0.5},
+          {"max_adhesion_distance", 1.0},
+          {"max_root_length", 1.0},
+          {"branching_probability", 0.95},
+          {"leaf_probability", 0.65},
+          {"leaf_size", 0.02},
+          {"branch_size", 0.001},
+          {"adhesion", std::string("closest")},
+          {"collision", std::string("blender")},
+          {"smoothing_passes", std::int64_t{1}},
+          {"leaves", std::string("blender")}}},
+    }};
+
+constexpr glm::vec3 kUp{0.0f, 1.0f, 0.0f};
+constexpr std::uint64_t kGrowStream = 0x1f7a11ull << 32;
+constexpr std::uint64_t kBranchStream = 0xb4a9c4ull << 32;
+constexpr std::uint64_t kLeafStream = 0x1eaf00ull << 32;
+constexpr float kTwoPi = 2.0f * std::numbers::pi_v<float>;
+
+// Uniform in [-0.5, 0.5]^3 (Luft's getRandomized, Blender's rand_val() - 0.5).
+glm::vec3 cube(Rng& rng) {
+  const auto x = static_cast<float>(rng.uniform() - 0.5);
+  const auto y = static_cast<float>(rng.uniform() - 0.5);
+  const auto z = static_cast<float>(rng.uniform() - 0.5);
+  return {x, y, z};
+}
+
+// ---- Embree geometry ----
+class EmbreeGeometry final : public ivy::Geometry {
+ public:
+  EmbreeGeometry(const SceneQuery& q, const ivy::TriangleTable& t, const ivy::Config& c) : query_(q), table_(t), cfg_(c) {}
+
+  glm::vec3 adhesion(const glm::vec3& p, float gather, ivy::Candidates& candidates) const override {
+    State st{this, {p, cfg_.max_adhesion, cfg_.adhesion_mode == ivy::AdhesionMode::Luft}, &candidates, gather,
+             gather > 0.0f ? gather * gather : -1.0f};
+    const float r = std::max(cfg_.max_adhesion, gather) * (1.0f + 1e-4f) + cfg_.margin;
+    query_.visit_near(p, r, &EmbreeGeometry::visit, &st);
+    return st.search.vector();
+  }
+
+  RayHit first_hit(const glm::vec3& o, const glm::vec3& d) const override { return query_.ray(o, d, 1.0f, 0.0f); }
+
+ private:
+  struct State {
+    const EmbreeGeometry* self;
+    ivy::AdhesionSearch search;
+    ivy::Candidates* candidates;
+    float gather;
+    float gather2;  // squared, -1 when not gathering
+  };
+  static void visit(void* user, std::uint32_t mesh, std::uint32_t tri, float* radius) {
+    auto& st = *static_cast<State*>(user);
+    const auto& table = st.self->table_;
+    const std::uint32_t id = table.id(mesh, tri);
+    const ivy::Triangle& t = table.tris[id];
+    if (st.gather2 >= 0.0f) {
+      const glm::vec3 d = glm::max(glm::vec3(0.0f), glm::max(t.lo - st.search.p, st.search.p - t.hi));
+      if (glm::dot(d, d) <= st.gather2) st.candidates->push(id);
+    }
+    if (st.search.offer(t, id, geom::closest_point_on_triangle)) {
+      // Keep every triangle that could still tie or win (and every collision candidate) in reach.
+      *radius = std::max(st.gather, st.search.best) * (1.0f + 1e-4f) + st.self->cfg_.margin;
+    }
+  }
+  const SceneQuery& query_;
+  const ivy::TriangleTable& table_;
+  ivy::Config cfg_;
+};
+
+// ---- the algorithm as the harness sees it ----
+class IvyAlgorithm final : public GrowthAlgorithm {
+ public:
+  const AlgorithmInfo& describe() const override { return kInfo; }
+  void start(const Scene& scene, const SceneQuery& query, const Params& params, std::uint64_t seed) override {
+    table_ = std::make_unique<ivy::TriangleTable>(scene);
+    const ivy::Config cfg = ivy::make_config(params, scene);
+    geometry_ = ivy::make_embree_geometry(query, *table_, cfg);
+    grower_ = std::make_unique<ivy::Grower>(scene, *geometry_, *table_, cfg, seed);
+  }
+  bool step() override { return grower_->step(); }
+  const Plant& plant() const override { return grower_ ? grower_->plant() : empty_; }
+  void finish() override { grower_->finish(); }
+  std::vector<std::pair<std::string, double>> stats() const override { return grower_->stats(); }
+
+ private:
+  std::unique_ptr<ivy::TriangleTable> table_;
+  std::unique_ptr<ivy::Geometry> geometry_;
+  std::unique_ptr<ivy::Grower> grower_;
+  Plant empty_;
+};
+
+}  // namespace
+
+const AlgorithmInfo& ivy_info() { return kInfo; }
+std::unique_ptr<GrowthAlgorithm> make_ivy() { return std::make_unique<IvyAlgorithm>(); }
+
+namespace ivy {
+
+float bounding_sphere_radius(const Scene& scene) {
+  bool any_climbable = false;
+  for (const auto& m : scene.meshes) any_climbable = any_climbable || m.climbable;
+  glm::dvec3 sum(0.0);
+  std::size_t count = 0;
+  auto each_vertex = [&](auto&& f) {
+    for (const auto& m : scene.meshes) {
+      if (any_climbable && !m.climbable) continue;
+      for (const auto& t : m.triangles) {  // vertices used by a face (Luft's mesh has no loose ones)
+        f(m.vertices[t.x]);
+        f(m.vertices[t.y]);
+        f(m.vertices[t.z]);
+      }
+    }
+  };
+  each_vertex([&](const glm::vec3& v) {
+    sum += glm::dvec3(v);
+    ++count;
+  });
+  if (count == 0) return 0.0f;
+  const glm::vec3 centre(sum / static_cast<double>(count));
+  float r = 0.0f;
+  each_vertex([&](const glm::vec3& v) { r = std::max(r, glm::length(v - centre)); });
+  return r;
+}
+
+Config make_config(const Params& p, const Scene& scene) {
+  Config c;
+  c.radius = bounding_sphere_radius(scene);
+  if (!(c.radius > 0.0f))
+    throw InputError(fmt::format("ivy: scene '{}' has no climbable surface to size R by", scene.name));
+  const bool relative = p.text("units") == "relative";
+  const float R = relative ? c.radius : 1.0f;
+  c.step = static_cast<float>(p.real("ivy_size")) * R;
+  const double sum = p.real("primary_weight") + p.real("random_weight") + p.real("adhesion_weight");
+  if (!(sum > 0.0))
+    throw InputError("ivy: primary_weight, random_weight and adhesion_weight are all 0; at least one must be > 0");
+  c.primary = static_cast<float>(p.real("primary_weight") / sum);
+  c.random = static_cast<float>(p.real("random_weight") / sum);
+  c.adhesion = static_cast<float>(p.real("adhesion_weight") / sum);
+  c.gravity = static_cast<float>(p.real("gravity_weight"));
+  c.branching = static_cast<float>(p.real("branching_probability"));
+  c.leaf_probability = static_cast<float>(p.real("leaf_probability"));
+  c.leaf_size = static_cast<float>(p.real("leaf_size")) * (relative ? c.step : 1.0f);
+  c.branch_size = static_cast<float>(p.real("branch_size")) * (relative ? c.step : 1.0f);
+  c.max_float = static_cast<float>(p.real("max_float_length")) * R;
+  c.max_adhesion = static_cast<float>(p.real("max_adhesion_distance")) * R;
+  c.max_root_length = p.real("max_root_length") * R;
+  c.max_total_length = p.real("max_total_length") * R;
+  c.adhesion_mode = p.text("adhesion") == "luft" ? AdhesionMode::Luft : AdhesionMode::Closest;
+  c.collision_mode = p.text("collision") == "luft" ? CollisionMode::Luft : CollisionMode::Blender;
+  const std::string& leaves = p.text("leaves");
+  c.leaf_mode = leaves == "luft" ? LeafMode::Luft : leaves == "blender" ? LeafMode::Blender : LeafMode::None;
+  c.max_depth = static_cast<int>(p.integer("max_depth"));
+  c.branches_per_step = static_cast<int>(p.integer("branches_per_step"));
+  c.smoothing_passes = static_cast<int>(p.integer("smoothing_passes"));
+  c.leaf_passes = static_cast<int>(p.integer("leaf_passes"));
+  c.margin = 1e-5f * c.radius;
+  return c;
+}
+
+std::span<const std::uint32_t> Candidates::sorted_unique() {
+  std::uint32_t* b = heap_.empty() ? local_.data() : heap_.data();
+  std::uint32_t* e = b + n_;
+  std::sort(b, e);
+  e = std::unique(b, e);
+  n_ = static_cast<std::size_t>(e - b);
+  if (!heap_.empty()) heap_.resize(n_);
+  return {b, n_};
+}
+
+std::unique_ptr<Geometry> make_embree_geometry(const SceneQuery& query, const TriangleTable& table,
+                                               const Config& config) {
+  return std::make_unique<EmbreeGeometry>(query, table, config);
+}
+
+Grower::Grower(const Scene& scene, const Geometry& geometry, const TriangleTable& table, const Config& config,
+               std::uint64_t seed)
+    : scene_(scene), geometry_(geometry), table_(table), cfg_(config), seed_(seed) {
+  if (scene.seeds.empty()) throw InputError(fmt::format("ivy: scene '{}' has no seeds to grow from", scene.name));
+  pending_seeds_ = scene.seeds.size();
+  add_seed_roots();
+}
+
+void Grower::add_seed_roots() {
+  for (const Seed& s : scene_.seeds) {
+    if (s.start_step != iteration_) continue;
+    Root r;
+    r.id = static_cast<std::uint32_t>(roots_.size());
+    const float len = glm::length(s.direction);
+    r.dir = len > 0.0f ? s.direction / len : kUp;
+    PlantNode n;
+    n.position = s.position;
+    n.radius = 1.3f * 2.0f * cfg_.branch_size;
+    n.shoot = r.id;
+    n.birth_step = static_cast<std::uint32_t>(iteration_);
+    r.nodes.push_back(static_cast<std::uint32_t>(plant_.nodes.size()));
+    plant_.nodes.push_back(n);
+    adhesion_.emplace_back(0.0f);
+    length_.push_back(0.0f);
+    floating_.push_back(0.0f);
+    alive_.push_back(r.id);
+    roots_.push_back(std::move(r));
+    --pending_seeds_;
+  }
+}
+
+Grower::Grown Grower::grow_one(const Root& r) const {
+  const std::size_t k = r.nodes.size() - 1;
+  const glm::vec3 pos = plant_.nodes[r.nodes[k]].position;
+  const float floating = floating_at(r, k);
+  Grown g{};
+  g.floated_out = floating > cfg_.max_float;  // Luft: dies, but still grows this once
+
+  Rng rng(seed_, kGrowStream ^ r.id, 3 * static_cast<std::uint64_t>(k));
+  glm::vec3 random = cube(rng) + glm::vec3(0.0f, 0.2f, 0.0f);
+  const float rl = glm::length(random);
+  random = rl > 0.0f ? random / rl : kUp;
+
+  const float fall = cfg_.gravity * std::pow(floating / cfg_.max_float, 0.7f);
+  Candidates candidates;
+  const bool luft_collision = cfg_.collision_mode == CollisionMode::Luft;
+  // |grow| <= step (unit vectors, weights summing to 1) and |gravity| = step * fall: the farthest any
+  // mirrored candidate can be from pos.
+  const float gather = luft_collision ? cfg_.step * (1.0f + fall) * (1.0f + 1e-3f) + cfg_.margin : 0.0f;
+  const glm::vec3 adhesion = geometry_.adhesion(pos, gather, candidates);
+
+  glm::vec3 grow = cfg_.step * (r.dir * cfg_.primary + random * cfg_.random + adhesion * cfg_.adhesion);
+  const glm::vec3 gravity = cfg_.step * fall * glm::vec3(0.0f, -1.0f, 0.0f);
+  glm::vec3 next = pos + grow + gravity;
+
+  bool ok = true;
+  if (luft_collision) {
+    const CollisionResult c = collide(table_, candidates.sorted_unique(), pos, next);
+    g.climbing = c.climbing;
+    g.reflections = static_cast<std::uint32_t>(c.reflections);
+    ok = c.alive;
+  } else {
+    const RayHit h = geometry_.first_hit(pos, next - pos);
+    if (h.hit && glm::dot(next - pos, h.normal) < 0.0f) {
+      next -= 2.0f * h.normal * glm::dot(h.normal, next - h.point);
+      g.climbing = true;
+      g.reflections = 1;
+    }
+  }
+  grow = next - pos - gravity;
+  const float gl = glm::length(grow);
+  const glm::vec3 dir = 0.5f * r.dir + 0.5f * (gl > 0.0f ? grow / gl : r.dir);
+  const float dl = glm::length(dir);
+  const float seg = glm::length(next - pos);
+  g.pos = next;
+  g.dir = dl > 0.0f ? dir / dl : r.dir;
+  g.adhesion = adhesion;
+  g.length = length_at(r, k) + seg;
+  g.floating = g.climbing ? 0.0f : floating + seg;
+  g.alive = ok && !g.floated_out;
+  g.collision_death = !ok;
+  return g;
+}
+
+std::ptrdiff_t Grower::pick_branch_node(const Root& r) const {
+  Rng rng(seed_, kBranchStream ^ static_cast<std::uint64_t>(iteration_), static_cast<std::uint64_t>(r.id) << 20);
+  return sample_branch_node(r.nodes.size(), [&](std::size_t k) { return length_at(r, k); }, cfg_.branching, rng);
+}
+
+bool Grower::limits_reached() const {
+  return (cfg_.max_root_length > 0.0 && longest_root_ >= cfg_.max_root_length) ||
+         (cfg_.max_total_length > 0.0 && total_length_ >= cfg_.max_total_length);
+}
+
+bool Grower::step() {
+  if (limits_reached()) return false;
+  // Grow every alive root by one node (in parallel; each root writes its own slot).
+  const std::size_t count = alive_.size();
+  grown_.resize(count);
+  auto grow_range = [&](std::size_t a, std::size_t b) {
+    for (std::size_t i = a; i < b; ++i) grown_[i] = grow_one(roots_[alive_[i]]);
+  };
+  if (count >= 128)
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 32),
+                      [&](const tbb::blocked_range<std::size_t>& rg) { grow_range(rg.begin(), rg.end()); });
+  else
+    grow_range(0, count);
+
+  // Append in root order.
+  std::size_t still = 0;
+  for (std::size_t i = 0; i < count; ++i) {
+    Root& r = roots_[alive_[i]];
+    const Grown& g = grown_[i];
+    PlantNode n;
+    n.position = g.pos;
+    n.parent = static_cast<std::int32_t>(r.nodes.back());
+    n.radius = 1.3f * (1.0f / static_cast<float>(r.depth + 1) + 1.0f) * cfg_.branch_size;
+    n.order = r.depth;
+    n.shoot = r.id;
+    n.birth_step = static_cast<std::uint32_t>(iteration_ + 1);
+    total_length_ += glm::length(g.pos - plant_.nodes[r.nodes.back()].position);
+    longest_root_ = std::max(longest_root_, static_cast<double>(g.length));
+    r.nodes.push_back(static_cast<std::uint32_t>(plant_.nodes.size()));
+    plant_.nodes.push_back(n);
+    adhesion_.push_back(g.adhesion);
+    length_.push_back(g.length);
+    floating_.push_back(g.floating);
+    r.dir = g.dir;
+    r.alive = g.alive;
+    climbing_nodes_ += g.climbing ? 1 : 0;
+    reflections_ += g.reflections;
+    floated_out_ += g.floated_out ? 1 : 0;
+    collision_deaths_ += g.collision_death ? 1 : 0;
+    if (r.alive) alive_[still++] = alive_[i];
+  }
+  alive_.resize(still);
+
+  // Branching: alive roots in index order; the first `branches_per_step` that branch start new roots.
+  int started = 0;
+  const std::size_t alive_now = alive_.size();
+  for (std::size_t i = 0; i < alive_now && started < cfg_.branches_per_step; ++i) {
+    const std::uint32_t ri = alive_[i];
+    if (roots_[ri].depth > cfg_.max_depth) continue;
+    const std::ptrdiff_t k = pick_branch_node(roots_[ri]);
+    if (k < 0) continue;
+    Root child;
+    child.id = static_cast<std::uint32_t>(roots_.size());
+    child.depth = static_cast<std::uint16_t>(roots_[ri].depth + 1);
+    child.nodes.push_back(roots_[ri].nodes[static_cast<std::size_t>(k)]);
+    child.first_floating = floating_at(roots_[ri], static_cast<std::size_t>(k));
+    child.dir = kUp;
+    alive_.push_back(child.id);
+    roots_.push_back(std::move(child));
+    ++started;
+  }
+  ++iteration_;
+  if (pending_seeds_ > 0) {
+    add_seed_roots();
+    std::sort(alive_.begin(), alive_.end());
+  }
+  return (!alive_.empty() || pending_seeds_ > 0) && !limits_reached();
+}
+
+void Grower::finish() {
+  // Per root: smooth the adhesion vectors, assign radii, place leaves. Roots are independent; each
+  // writes its own slot and the slots are concatenated in root order.
+  std::vector<std::vector<Organ>> leaves(roots_.size());
+  std::vector<std::vector<glm::vec3>> smooth(roots_.size());
+  static constexpr float kGauss[11] = {1, 2, 4, 7, 9, 10, 9, 7, 4, 2, 1};
+  auto per_root = [&](std::size_t ri) {
+    const Root& r = roots_[ri];
+    const std::size_t n = r.nodes.size();
+    std::vector<glm::vec3>& a = smooth[ri];
+    a.resize(n);
+    a[0] = glm::vec3(0.0f);  // the start node carries no adhesion (Luft's new-root node)
+    for (std::size_t k = 1; k < n; ++k) a[k] = adhesion_[r.nodes[k]];
+    std::vector<glm::vec3> tmp(n);
+    for (int pass = 0; pass < cfg_.smoothing_passes; ++pass) {
+      for (std::size_t k = 0; k < n; ++k) {
+        glm::vec3 e(0.0f);
+        for (int i = -5; i <= 5; ++i) {
+          const auto j = static_cast<std::ptrdiff_t>(k) + i;
+          const std::size_t c = j < 0 ? 0 : std::min(static_cast<std::size_t>(j), n - 1);
+          e += a[c] * kGauss[i + 5];
+        }
+        tmp[k] = e / 56.0f;
+      }
+      a.swap(tmp);
+    }
+    const float L = length_at(r, n - 1);
+    if (n < 2 || !(L > 0.0f)) return;
+    const float base = (1.0f / static_cast<float>(r.depth + 1) + 1.0f) * cfg_.branch_size;
+    // Radii: the start node of a branch root belongs to its parent root and keeps the parent's.
+    for (std::size_t k = (r.depth == 0 ? 0 : 1); k < n; ++k)
+      plant_.nodes[r.nodes[k]].radius = base * (1.3f - length_at(r, k) / L);
+    if (cfg_.leaf_mode == LeafMode::None) return;
+
+    auto make_leaf = [&](const glm::vec3& centre, const glm::vec3& adh, float dphi, float dtheta, float half,
+                         std::uint32_t node, OrganKind kind) {
+      const float align = glm::length(adh);
+      const glm::vec3 an = align > 0.0f ? adh / align : glm::vec3(0.0f);
+      // Toward the surface, horizontally; the leaf normal tilts from up away from it by half the
+      // angle between the adhesion vector and straight down (Luft's theta), turned by phi.
+      float phi = std::abs(an.x) + std::abs(an.z) > 1e-6f ? std::atan2(an.z, an.x) : 0.0f;
+      float theta = align > 0.0f ? 0.5f * std::acos(std::clamp(-an.y, -1.0f, 1.0f)) : 0.0f;
+      phi += dphi;
+      theta += dtheta;
+      const glm::vec3 toward(std::cos(phi), 0.0f, std::sin(phi));
+      const glm::vec3 normal = std::cos(theta) * kUp - std::sin(theta) * toward;
+      const glm::vec3 blade = glm::normalize(glm::cross(kUp, toward));
+      const glm::vec3 across = glm::cross(normal, blade);
+      Organ o;
+      o.size = 2.0f * half;
+      o.position = centre - 0.5f * o.size * blade;
+      o.orientation = glm::quat_cast(glm::mat3(across, normal, blade));
+      o.kind = kind;
+      o.node = static_cast<std::int32_t>(node);
+      leaves[ri].push_back(o);
+    };
+    auto leaf_weight = [&](std::size_t k) {
+      const float x = length_at(r, k) / L;
+      const float al = glm::length(a[k]);
+      const float ground = al > 0.0f ? std::max(0.0f, -glm::dot(kUp, a[k] / al)) : 0.0f;
+      return std::pow(x, 0.7f) + ground * std::pow(1.0f - x, 2.0f);
+    };
+    if (cfg_.leaf_mode == LeafMode::Luft) {
+      for (int pass = 0; pass < cfg_.leaf_passes; ++pass)
+        for (std::size_t k = 0; k < n; ++k) {
+          Rng rng(seed_, kLeafStream ^ (static_cast<std::uint64_t>(r.id) << 8) ^ static_cast<std::uint64_t>(pass),
+                  8 * k);
+          const float w = leaf_weight(k);
+          if (!(static_cast<float>(rng.uniform()) * w > cfg_.leaf_probability)) continue;
+          const float align = glm::length(a[k]);
+          const glm::vec3 centre = plant_.nodes[r.nodes[k]].position + cube(rng) * cfg_.leaf_size;
+          const float size_w = 1.5f - (std::cos(w * kTwoPi) * 0.5f + 0.5f);
+          const auto dphi = static_cast<float>(rng.uniform() - 0.5) * (1.3f - align);
+          const auto dtheta = static_cast<float>(rng.uniform() - 0.5) * (1.1f - align);
+          const bool young = static_cast<float>(rng.uniform()) * w > cfg_.leaf_probability;
+          make_leaf(centre, a[k], dphi, dtheta, cfg_.leaf_size * size_w, r.nodes[k],
+                    young ? OrganKind::YoungLeaf : OrganKind::Leaf);
+        }
+    } else {  // Blender: angles once per node, leaf_passes tries spread along the segment to the next node
+      for (std::size_t k = 0; k + 1 < n; ++k) {
+        Rng rng(seed_, kLeafStream ^ (static_cast<std::uint64_t>(r.id) << 8) ^ 0xFFull, 64 * k);
+        const float w = leaf_weight(k);
+        const float align = glm::length(a[k]);
+        const float size_w = 1.5f - (std::cos(w * kTwoPi) * 0.5f + 0.5f);
+        const auto dphi = static_cast<float>(rng.uniform() - 0.5) * (1.3f - align);
+        const auto dtheta = static_cast<float>(rng.uniform() - 0.5) * (1.1f - align);
+        const glm::vec3 p0 = plant_.nodes[r.nodes[k]].position, p1 = plant_.nodes[r.nodes[k + 1]].position;
+        for (int j = 0; j < cfg_.leaf_passes; ++j) {
+          if (!(static_cast<float>(rng.uniform()) * w > cfg_.leaf_probability)) continue;
+          const float t = static_cast<float>(j) / static_cast<float>(cfg_.leaf_passes);
+          const glm::vec3 centre = glm::mix(p0, p1, t) + cfg_.leaf_size * cube(rng);
+          make_leaf(centre, a[k], dphi, dtheta, cfg_.leaf_size * size_w, r.nodes[k], OrganKind::Leaf);
+        }
+      }
+    }
+  };
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, roots_.size(), 16), [&](const tbb::blocked_range<std::size_t>& rg) {
+    for (std::size_t ri = rg.begin(); ri < rg.end(); ++ri) per_root(ri);
+  });
+  plant_.organs.clear();
+  for (auto& l : leaves) plant_.organs.insert(plant_.organs.end(), l.begin(), l.end());
+}
+
+double Grower::state_bytes_per_node() const {
+  if (plant_.nodes.empty()) return 0.0;
+  double bytes = static_cast<double>(plant_.nodes.capacity() * sizeof(PlantNode) + adhesion_.capacity() * sizeof(glm::vec3) +
+                                     (length_.capacity() + floating_.capacity()) * sizeof(float) +
+                                     roots_.capacity() * sizeof(Root));
+  for (const auto& r : roots_) bytes += static_cast<double>(r.nodes.capacity() * sizeof(std::uint32_t));
+  return bytes / static_cast<double>(plant_.nodes.size());
+}
+
+std::vector<std::pair<std::string, double>> Grower::stats() const {
+  return {{"R_m", cfg_.radius},
+          {"step_m", cfg_.step},
+          {"iterations", iteration_},
+          {"roots", static_cast<double>(roots_.size())},
+          {"roots_alive", static_cast<double>(alive_.size())},
+          {"climbing_nodes", static_cast<double>(climbing_nodes_)},
+          {"reflections", static_cast<double>(reflections_)},
+          {"deaths_floating", static_cast<double>(floated_out_)},
+          {"deaths_collision", static_cast<double>(collision_deaths_)},
+          {"longest_root_m", longest_root_},
+          {"state_bytes_per_node", state_bytes_per_node()}};
+}
+
+}  // namespace ivy
+}  // namespace growbench

@@ -1,0 +1,151 @@
+// Luft-style ivy (Thomas Luft, "An Ivy Generator", 2006-2008; Blender's IvyGen add-on ports it).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "algorithms/algorithm.hpp"
+#include "algorithms/ivy/luft_rules.hpp"
+
+namespace growbench {
+
+const AlgorithmInfo& ivy_info();
+std::unique_ptr<GrowthAlgorithm> make_ivy();
+
+namespace ivy {
+
+enum class AdhesionMode : std::uint8_t { Luft, Closest };
+enum class CollisionMode : std::uint8_t { Luft, Blender };
+enum class LeafMode : std::uint8_t { Luft, Blender, None };
+
+// Parameters resolved to metres (units=relative multiplied through by R).
+struct Config {
+  float radius = 1.0f;            // R: the climbable meshes' bounding-sphere radius
+  float step = 0.01f;             // ivy size: length scale of one growth step
+  float primary = 0.5f, random = 0.2f, adhesion = 0.1f;  // normalised to sum 1
+  float gravity = 1.0f;
+  float branching = 0.95f;        // a node branches when rand * w > this
+  float leaf_probability = 0.7f;  // a leaf grows when rand * w > this
+  float leaf_size = 0.01f;        // half the side of a leaf quad
+  float branch_size = 0.001f;     // radius scale
+  float max_float = 0.2f;
+  float max_adhesion = 0.2f;
+  double max_root_length = 0.0;   // 0: unlimited
+  double max_total_length = 0.0;  // 0: unlimited
+  AdhesionMode adhesion_mode = AdhesionMode::Luft;
+  CollisionMode collision_mode = CollisionMode::Luft;
+  LeafMode leaf_mode = LeafMode::Luft;
+  int max_depth = 3;
+  int branches_per_step = 1;
+  int smoothing_passes = 5;
+  int leaf_passes = 10;
+  float margin = 1e-5f;           // slack added to query radii (1e-5 R)
+};
+
+// The max distance from the vertex centroid of the climbable meshes (all meshes when none is
+// climbable) to one of their vertices.
+float bounding_sphere_radius(const Scene& scene);
+Config make_config(const Params& params, const Scene& scene);
+
+// Triangle ids collected for one node's collision test: a fixed inline buffer that spills to the
+// heap only for unusually many candidates (no per-node allocation in the common case, and the
+// allocation count depends on the geometry only, never on threads).
+class Candidates {
+ public:
+  void push(std::uint32_t id) {
+    if (n_ < local_.size()) local_[n_++] = id;
+    else {
+      if (heap_.empty()) heap_.assign(local_.begin(), local_.end());
+      heap_.push_back(id);
+      ++n_;
+    }
+  }
+  // Sorted, without duplicates (a BVH with spatial splits may offer a triangle twice).
+  std::span<const std::uint32_t> sorted_unique();
+  [[nodiscard]] std::size_t size() const { return n_; }
+
+ private:
+  std::array<std::uint32_t, 64> local_{};
+  std::vector<std::uint32_t> heap_;
+  std::size_t n_ = 0;
+};
+
+// The scene queries the growth needs; the Embree implementation is make_embree_geometry, the tests
+// add a brute-force one over all triangles.
+class Geometry {
+ public:
+  virtual ~Geometry() = default;
+  // The adhesion vector at p. With gather > 0 it also pushes every triangle that may come within
+  // `gather` of p (a superset) into `candidates` for the Luft collision test.
+  virtual glm::vec3 adhesion(const glm::vec3& p, float gather, Candidates& candidates) const = 0;
+  // Blender's collision: the first hit on the segment o -> o + d (t in [0, 1]), any side.
+  virtual RayHit first_hit(const glm::vec3& o, const glm::vec3& d) const = 0;
+};
+
+std::unique_ptr<Geometry> make_embree_geometry(const SceneQuery& query, const TriangleTable& table,
+                                               const Config& config);
+
+// Luft's generator: one step() is one of his grow() iterations. Deterministic for any thread count:
+// roots grow in parallel into per-root slots and are appended in root order; every random draw is a
+// pure function of (seed, root, node) or (seed, iteration, root).
+class Grower {
+ public:
+  Grower(const Scene& scene, const Geometry& geometry, const TriangleTable& table, const Config& config,
+         std::uint64_t seed);
+  // One iteration; false once nothing more can grow (no root alive, or a length limit reached).
+  bool step();
+  // Luft's birth(): adhesion smoothing, branch radii, leaves.
+  void finish();
+  [[nodiscard]] const Plant& plant() const { return plant_; }
+  [[nodiscard]] std::vector<std::pair<std::string, double>> stats() const;
+  [[nodiscard]] std::size_t root_count() const { return roots_.size(); }
+  [[nodiscard]] std::size_t alive_count() const { return alive_.size(); }
+  // Bytes held per plant node by the growth state (plant nodes + per-node arrays + root lists).
+  [[nodiscard]] double state_bytes_per_node() const;
+
+ private:
+  struct Root {
+    std::vector<std::uint32_t> nodes;  // plant node indices; [0] is the start (a branch root's parent node)
+    glm::vec3 dir{0.0f, 1.0f, 0.0f};   // primary direction at the tip
+    float first_floating = 0.0f;       // floating length of node [0] as this root sees it
+    std::uint32_t id = 0;
+    std::uint16_t depth = 0;
+    bool alive = true;
+  };
+  struct Grown {
+    glm::vec3 pos, dir, adhesion;
+    float length, floating;
+    std::uint32_t reflections;
+    bool alive, climbing, floated_out, collision_death;
+  };
+  [[nodiscard]] float length_at(const Root& r, std::size_t k) const { return k == 0 ? 0.0f : length_[r.nodes[k]]; }
+  [[nodiscard]] float floating_at(const Root& r, std::size_t k) const {
+    return k == 0 ? r.first_floating : floating_[r.nodes[k]];
+  }
+  void add_seed_roots();
+  Grown grow_one(const Root& r) const;
+  [[nodiscard]] std::ptrdiff_t pick_branch_node(const Root& r) const;
+  [[nodiscard]] bool limits_reached() const;
+
+  const Scene& scene_;
+  const Geometry& geometry_;
+  const TriangleTable& table_;
+  Config cfg_;
+  std::uint64_t seed_;
+  Plant plant_;
+  std::vector<glm::vec3> adhesion_;  // per plant node
+  std::vector<float> length_, floating_;
+  std::vector<Root> roots_;
+  std::vector<std::uint32_t> alive_;  // alive root indices, ascending
+  std::vector<Grown> grown_;          // per-iteration slots (reused)
+  int iteration_ = 0;
+  double total_length_ = 0.0, longest_root_ = 0.0;
+  std::size_t pending_seeds_ = 0;
+  std::uint64_t climbing_nodes_ = 0, reflections_ = 0, floated_out_ = 0, collision_deaths_ = 0;
+};
+
+}  // namespace ivy
+}  // namespace growbench

@@ -1,0 +1,296 @@
+// The Luft-style ivy: Luft's per-triangle rules on cases with known answers, the branching sampler
+// against Luft's node-by-node loop, the Embree path against a brute-force reference over all triangles,
+// and what every ivy must do on real scenes (no node inside a solid, attached to the wall, leaves
+// facing away from it, Blender's limits).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+#include "algorithms/ivy/ivy.hpp"
+#include "scenes/geometry.hpp"
+#include "scenes/scene_library.hpp"
+#include "scenes/scene_query.hpp"
+#include "test_util.hpp"
+#include "grow_util.hpp"
+
+namespace growbench {
+namespace {
+
+using ivy::Triangle;
+
+Triangle make_tri(glm::vec3 a, glm::vec3 b, glm::vec3 c) {
+  Scene s;
+  TriangleMesh m;
+  m.vertices = {a, b, c};
+  m.triangles = {{0, 1, 2}};
+  s.meshes.push_back(m);
+  return ivy::TriangleTable(s).tris[0];
+}
+
+// The unit right triangle in z = 0, normal +z.
+const Triangle kFloor = make_tri({0, 0, 0}, {1, 0, 0}, {0, 1, 0});
+
+TEST(IvyRules, AdhesionCountsFaceInteriorsFromTheFrontOnly) {
+  glm::vec3 foot;
+  EXPECT_FLOAT_EQ(ivy::adhesion_distance(kFloor, {0.2f, 0.2f, 0.5f}, foot), 0.5f);
+  EXPECT_EQ(foot, glm::vec3(0.2f, 0.2f, 0.0f));
+  EXPECT_LT(ivy::adhesion_distance(kFloor, {0.2f, 0.2f, -0.5f}, foot), 0.0f) << "back side";
+  EXPECT_LT(ivy::adhesion_distance(kFloor, {0.8f, 0.8f, 0.1f}, foot), 0.0f) << "projects outside the face";
+  // The true closest point would be the vertex at 0.1 away; Luft's rule ignores it.
+  EXPECT_LT(ivy::adhesion_distance(kFloor, {-0.1f, 0.0f, 0.0f}, foot), 0.0f);
+}
+
+TEST(IvyRules, AdhesionSearchPicksTheNearestAndBreaksTiesByIndex) {
+  ivy::AdhesionSearch s{{0.2f, 0.2f, 0.3f}, 1.0f, true};
+  const Triangle higher = make_tri({0, 0, 0.1f}, {1, 0, 0.1f}, {0, 1, 0.1f});  // 0.2 away
+  EXPECT_TRUE(s.offer(kFloor, 7, geom::closest_point_on_triangle));
+  EXPECT_TRUE(s.offer(higher, 9, geom::closest_point_on_triangle));
+  EXPECT_FALSE(s.offer(higher, 12, geom::closest_point_on_triangle)) << "a tie keeps the lower index";
+  EXPECT_TRUE(s.offer(higher, 3, geom::closest_point_on_triangle)) << "a tie goes to the lower index";
+  EXPECT_EQ(s.best_id, 3u);
+  EXPECT_NEAR(s.best, 0.2f, 1e-6f);
+  // normalize(foot - p) * (1 - d / max): straight down, 0.8 long.
+  const glm::vec3 v = s.vector();
+  EXPECT_NEAR(v.z, -0.8f, 1e-6f);
+  EXPECT_NEAR(glm::length(glm::vec2(v.x, v.y)), 0.0f, 1e-6f);
+  ivy::AdhesionSearch far{{0.2f, 0.2f, 0.3f}, 0.25f, true};
+  EXPECT_FALSE(far.offer(kFloor, 0, geom::closest_point_on_triangle)) << "beyond max_adhesion_distance";
+  EXPECT_EQ(far.vector(), glm::vec3(0.0f));
+  ivy::AdhesionSearch closest{{-0.3f, 0.2f, 0.4f}, 1.0f, false};
+  EXPECT_TRUE(closest.offer(kFloor, 0, geom::closest_point_on_triangle)) << "closest mode counts edges";
+  EXPECT_NEAR(closest.best, 0.5f, 1e-6f);
+}
+
+TEST(IvyRules, CollisionMirrorsEnteringSegmentsOnly) {
+  EXPECT_TRUE(ivy::crosses(kFloor, {0.2f, 0.2f, 0.5f}, {0.2f, 0.2f, -0.3f}));
+  EXPECT_FALSE(ivy::crosses(kFloor, {0.2f, 0.2f, -0.5f}, {0.2f, 0.2f, 0.3f})) << "leaving";
+  EXPECT_FALSE(ivy::crosses(kFloor, {0.2f, 0.2f, 0.5f}, {0.2f, 0.2f, 0.1f})) << "stops short";
+  EXPECT_FALSE(ivy::crosses(kFloor, {0.9f, 0.9f, 0.5f}, {0.9f, 0.9f, -0.3f})) << "misses the face";
+  Scene s;
+  TriangleMesh m;
+  m.vertices = {{-5, -5, 0}, {5, -5, 0}, {0, 5, 0}};
+  m.triangles = {{0, 1, 2}};
+  s.meshes.push_back(m);
+  const ivy::TriangleTable table(s);
+  const std::uint32_t ids[] = {0};
+  glm::vec3 q(0.2f, 0.2f, -0.3f);
+  const auto r = ivy::collide(table, ids, {0.1f, 0.1f, 0.5f}, q);
+  EXPECT_TRUE(r.climbing);
+  EXPECT_TRUE(r.alive);
+  EXPECT_EQ(r.reflections, 1);
+  EXPECT_NEAR(q.z, 0.3f, 1e-6f);
+  EXPECT_FLOAT_EQ(q.x, 0.2f);
+}
+
+TEST(IvyRules, ARootStillBouncingInTheSixthPassDies) {
+  // Two big faces 0.1 apart, facing each other; the candidate keeps bouncing between them.
+  Scene s;
+  TriangleMesh m;
+  m.vertices = {{-5, -5, 0}, {5, -5, 0}, {0, 5, 0}, {-5, -5, 0.1f}, {0, 5, 0.1f}, {5, -5, 0.1f}};
+  m.triangles = {{0, 1, 2}, {3, 4, 5}};
+  s.meshes.push_back(m);
+  const ivy::TriangleTable table(s);
+  ASSERT_GT(table.tris[0].n.z, 0.9f);
+  ASSERT_LT(table.tris[1].n.z, -0.9f);
+  const std::uint32_t ids[] = {0, 1};
+  // Each pass mirrors across both faces and brings the candidate 0.2 closer: -0.813, -0.613, ...,
+  // -0.013 after five passes, +0.013 (between the faces) after the first mirror of the sixth. The
+  // seventh pass mirrors nothing, but Luft's counter kills the root after it all the same.
+  glm::vec3 q(0.0f, 0.0f, -1.013f);
+  const auto r = ivy::collide(table, ids, {0.0f, 0.0f, 0.05f}, q);
+  EXPECT_EQ(r.reflections, 11);
+  EXPECT_NEAR(q.z, 0.013f, 1e-5f);
+  EXPECT_FALSE(r.alive);
+  glm::vec3 q2(0.0f, 0.0f, -0.613f);  // resolved in the fourth pass: lives
+  EXPECT_TRUE(ivy::collide(table, ids, {0.0f, 0.0f, 0.05f}, q2).alive);
+}
+
+TEST(IvyBranching, ThinnedSamplerMatchesLuftsNodeLoop) {
+  // A root of 400 unequal segments; Luft's loop draws once per node and takes the first success.
+  std::vector<float> len(400);
+  for (std::size_t k = 1; k < len.size(); ++k) len[k] = len[k - 1] + 0.5f + static_cast<float>(k % 7) * 0.1f;
+  auto length = [&](std::size_t k) { return len[k]; };
+  for (const float b : {0.95f, 0.6f, 0.05f}) {
+    constexpr int kTrials = 40000;
+    std::vector<double> fast(len.size() + 1, 0.0), naive(len.size() + 1, 0.0);
+    for (int t = 0; t < kTrials; ++t) {
+      Rng r1(11, 1, static_cast<std::uint64_t>(t) << 20), r2(12, 2, static_cast<std::uint64_t>(t) << 20);
+      const auto k = ivy::sample_branch_node(len.size(), length, b, r1);
+      fast[k < 0 ? len.size() : static_cast<std::size_t>(k)] += 1.0;
+      std::size_t hit = len.size();
+      for (std::size_t j = 0; j < len.size(); ++j)
+        if (r2.uniform() * ivy::branch_weight(len[j] / len.back()) > b) {
+          hit = j;
+          break;
+        }
+      naive[hit] += 1.0;
+    }
+    // Compare the two distributions in 20 bins of node index plus "no branch": every bin within 5
+    // standard errors (a wrong window or acceptance shifts whole bins by far more).
+    std::vector<double> bf(21, 0.0), bn(21, 0.0);
+    for (std::size_t k = 0; k <= len.size(); ++k) {
+      const std::size_t bin = k == len.size() ? 20 : k * 20 / len.size();
+      bf[bin] += fast[k];
+      bn[bin] += naive[k];
+    }
+    for (std::size_t i = 0; i < 21; ++i) {
+      const double pf = bf[i] / kTrials, pn = bn[i] / kTrials;
+      const double se = std::sqrt((pf * (1 - pf) + pn * (1 - pn)) / kTrials) + 1e-9;
+      EXPECT_LT(std::abs(pf - pn), 5.0 * se + 1e-3) << "b=" << b << " bin " << i << ": " << pf << " vs " << pn;
+    }
+  }
+}
+
+// Luft's own algorithm: every triangle for the adhesion, every triangle as a collision candidate.
+class BruteForceGeometry final : public ivy::Geometry {
+ public:
+  BruteForceGeometry(const ivy::TriangleTable& t, const ivy::Config& c, const SceneQuery& q) : t_(t), c_(c), q_(q) {}
+  glm::vec3 adhesion(const glm::vec3& p, float gather, ivy::Candidates& candidates) const override {
+    ivy::AdhesionSearch s{p, c_.max_adhesion, c_.adhesion_mode == ivy::AdhesionMode::Luft};
+    for (std::uint32_t id = 0; id < t_.size(); ++id) {
+      s.offer(t_.tris[id], id, geom::closest_point_on_triangle);
+      if (gather > 0.0f) candidates.push(id);
+    }
+    return s.vector();
+  }
+  RayHit first_hit(const glm::vec3& o, const glm::vec3& d) const override { return q_.ray(o, d, 1.0f, 0.0f); }
+
+ private:
+  const ivy::TriangleTable& t_;
+  ivy::Config c_;
+  const SceneQuery& q_;
+};
+
+Plant grow_with(const Scene& scene, const SceneQuery& query, bool brute, std::uint64_t seed, int steps,
+                const std::vector<std::string>& sets = {}) {
+  Params p = default_params(find_algorithm("ivy"));
+  for (const auto& s : sets) p.set_assignment(s);
+  const ivy::TriangleTable table(scene);
+  const ivy::Config cfg = ivy::make_config(p, scene);
+  std::unique_ptr<ivy::Geometry> g;
+  if (brute) g = std::make_unique<BruteForceGeometry>(table, cfg, query);
+  else g = ivy::make_embree_geometry(query, table, cfg);
+  ivy::Grower grower(scene, *g, table, cfg, seed);
+  for (int i = 0; i < steps && grower.step(); ++i) {
+  }
+  grower.finish();
+  return grower.plant();
+}
+
+TEST(IvyReference, EmbreePathGrowsExactlyLuftsBruteForcePlant) {
+  // Small meshes (tens to a few thousand triangles) where looping over all of them stays cheap.
+  const std::vector<std::pair<std::string, std::vector<std::string>>> scenes = {
+      {"wall", {}}, {"column", {}}, {"boulder", {}}, {"corner", {}}};
+  for (const auto& [name, scene_params] : scenes) {
+    const Scene scene = load_scene(name, scene_params);
+    const SceneQuery query(scene, {.build_sdf = false});
+    for (const std::uint64_t seed : {1u, 2u, 3u}) {
+      const Plant fast = grow_with(scene, query, false, seed, 120);
+      const Plant slow = grow_with(scene, query, true, seed, 120);
+      ASSERT_GT(fast.nodes.size(), 200u) << name;
+      EXPECT_EQ(fast.nodes.size(), slow.nodes.size()) << name << " seed " << seed;
+      EXPECT_EQ(fast.geometry_hash(), slow.geometry_hash()) << name << " seed " << seed;
+    }
+  }
+}
+
+TEST(IvyReference, ClosestAdhesionModeAgreesWithBruteForceToo) {
+  const Scene scene = load_scene("boulder");
+  const SceneQuery query(scene, {.build_sdf = false});
+  const Plant fast = grow_with(scene, query, false, 4, 120, {"adhesion=closest"});
+  const Plant slow = grow_with(scene, query, true, 4, 120, {"adhesion=closest"});
+  EXPECT_EQ(fast.geometry_hash(), slow.geometry_hash());
+}
+
+std::size_t nodes_inside(const Plant& p, const SceneQuery& q) { return test::nodes_inside_solids(p, q).size(); }
+
+TEST(IvyScenes, NoNodeEndsInsideAClosedMesh) {
+  for (const std::string name : {"column", "boulder"}) {
+    const Scene scene = load_scene(name);
+    const SceneQuery q(scene);
+    const Plant p = test::grow("ivy", scene, q, {"max_root_length=1.5"}, 0, 5);
+    ASSERT_GT(p.nodes.size(), 1000u) << name;
+    EXPECT_EQ(nodes_inside(p, q), 0u) << name;
+  }
+  Scene bunny = load_scene("mesh:" + test::shared_mesh("stanford-bunny.obj"));
+  const SceneQuery q(bunny);
+  // The scan's lowest vertex (the default seed) is on the rim of a hole in its base; start on its flank.
+  bunny.seeds = {{q.closest_point({0.0f, 0.8f, 1.0f}).point, {0, 1, 0}, 0}};
+  const Plant luft = test::grow("ivy", bunny, q, {"max_root_length=1.5"}, 0, 7);
+  ASSERT_GT(luft.nodes.size(), 1000u);
+  EXPECT_EQ(nodes_inside(luft, q), 0u);
+  // Blender's collision mirrors once across the first face hit and never re-checks, so at a crease
+  // the mirrored candidate can land behind a second face: a few nodes do end inside, as in Blender.
+  const Plant blender = test::grow("ivy", bunny, q, {"preset=blender"}, 0, 7);
+  ASSERT_GT(blender.nodes.size(), 300u);
+  EXPECT_LT(static_cast<double>(nodes_inside(blender, q)), 0.01 * static_cast<double>(blender.nodes.size()));
+}
+
+TEST(IvyScenes, IvyClingsToTheWallAndItsLeavesFaceAway) {
+  const Scene scene = load_scene("wall");
+  const SceneQuery q(scene);
+  const Plant p = test::grow("ivy", scene, q, {}, 0, 1, 300);
+  ASSERT_GT(p.nodes.size(), 20000u);
+  std::size_t attached = 0;
+  for (const auto& n : p.nodes) attached += q.closest_point(n.position).distance < 0.02f ? 1 : 0;
+  EXPECT_GT(static_cast<double>(attached) / static_cast<double>(p.nodes.size()), 0.6) << "within 2 cm of a surface";
+  // Leaves on the wall's faces (not above its top or on the ground): their normal points away from
+  // the face they sit on.
+  std::size_t on_face = 0, away = 0;
+  for (const auto& o : p.organs) {
+    const glm::vec3 centre = o.position + 0.5f * o.size * (glm::mat3_cast(o.orientation) * glm::vec3(0, 0, 1));
+    const ClosestHit h = q.closest_point(centre);
+    if (std::abs(h.normal.z) < 0.9f || h.distance > 0.05f || centre.y < 0.2f || centre.y > 2.3f) continue;
+    ++on_face;
+    const glm::vec3 n = glm::mat3_cast(o.orientation) * glm::vec3(0, 1, 0);
+    away += glm::dot(n, h.normal) > 0.0f ? 1 : 0;
+  }
+  ASSERT_GT(on_face, 1000u);
+  EXPECT_GT(static_cast<double>(away) / static_cast<double>(on_face), 0.95);
+}
+
+TEST(IvyScenes, BlenderPresetStopsAtItsMaximumRootLength) {
+  Scene bunny = load_scene("mesh:" + test::shared_mesh("stanford-bunny.obj"));
+  const SceneQuery q(bunny, {.build_sdf = false});
+  bunny.seeds = {{q.closest_point({0.0f, 0.8f, 1.0f}).point, {0, 1, 0}, 0}};
+  std::vector<std::pair<std::string, double>> stats;
+  const Plant p = test::grow("ivy", bunny, q, {"preset=blender"}, 0, 1, 5000, &stats);
+  auto stat = [&](const std::string& k) {
+    for (const auto& [n, v] : stats)
+      if (n == k) return v;
+    return -1.0;
+  };
+  EXPECT_FLOAT_EQ(static_cast<float>(stat("step_m")), 0.02f) << "absolute units";
+  EXPECT_GE(stat("longest_root_m"), 1.0);
+  EXPECT_LT(stat("longest_root_m"), 1.0 + 2 * 0.02 * 2) << "one iteration past maxIvyLength at most";
+  EXPECT_EQ(stat("deaths_collision"), 0.0) << "Blender's collision never kills";
+  EXPECT_GT(stat("roots"), 10.0) << "it branches";
+  EXPECT_GT(p.leaf_count(), 100u);
+}
+
+TEST(IvyParams, PresetDefaultsGiveWayToExplicitValues) {
+  Params p = default_params(find_algorithm("ivy"));
+  EXPECT_DOUBLE_EQ(p.real("ivy_size"), 0.005);
+  p.set("ivy_size", "0.03");
+  p.set("preset", "blender");
+  EXPECT_DOUBLE_EQ(p.real("ivy_size"), 0.03) << "set before the preset, still wins";
+  EXPECT_DOUBLE_EQ(p.real("max_float_length"), 0.5);
+  EXPECT_EQ(p.text("units"), "absolute");
+  p.set("preset", "luft");
+  EXPECT_DOUBLE_EQ(p.real("max_float_length"), 0.1);
+  EXPECT_EQ(p.to_json()["units"], "relative") << "the record shows effective values";
+}
+
+TEST(IvyParams, AllZeroDirectionWeightsAreRejected) {
+  const Scene scene = load_scene("wall");
+  Params p = default_params(find_algorithm("ivy"));
+  p.set("primary_weight", "0");
+  p.set("random_weight", "0");
+  p.set("adhesion_weight", "0");
+  EXPECT_THROW(ivy::make_config(p, scene), InputError);
+}
+
+}  // namespace
+}  // namespace growbench
