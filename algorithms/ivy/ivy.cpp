@@ -126,11 +126,27 @@ class EmbreeGeometry final : public ivy::Geometry {
  public:
   EmbreeGeometry(const SceneQuery& q, const ivy::TriangleTable& t, const ivy::Config& c) : query_(q), table_(t), cfg_(c) {}
 
-  glm::vec3 adhesion(const glm::vec3& p, float gather, ivy::Candidates& candidates) const override {
+  glm::vec3 adhesion(const glm::vec3& p, float gather, ivy::Candidates& candidates,
+                     std::uint32_t& hint) const override {
     State st{this, {p, cfg_.max_adhesion, cfg_.adhesion_mode == ivy::AdhesionMode::Luft}, &candidates, gather,
              gather > 0.0f ? gather * gather : -1.0f};
-    const float r = std::max(cfg_.max_adhesion, gather) * (1.0f + 1e-4f) + cfg_.margin;
-    query_.visit_near(p, r, &EmbreeGeometry::visit, &st);
+    // A clinging root's next target is usually the same triangle: offered first, its distance bounds
+    // the traversal from the start. The visit offers it again; ties resolve the same either way.
+    if (hint != ivy::kNoTriangle) st.search.offer(table_.tris[hint], hint, geom::closest_point_on_triangle);
+    auto reach = [&](float d) { return d * (1.0f + 1e-4f) + cfg_.margin; };
+    // Growing balls (two steps, then eight): when the target is found inside one, every triangle that
+    // could beat or tie it was inside it too, so the answer is final. Otherwise the full adhesion ball.
+    for (const float steps : {2.0f, 8.0f}) {
+      const float near = std::max(gather, steps * cfg_.step);
+      if (near >= cfg_.max_adhesion) break;
+      query_.visit_near(p, reach(std::max(std::min(near, st.search.best), gather)), &EmbreeGeometry::visit, &st);
+      if (reach(st.search.best) <= reach(near)) {
+        hint = st.search.best_id;
+        return st.search.vector();
+      }
+    }
+    query_.visit_near(p, reach(std::max(std::min(cfg_.max_adhesion, st.search.best), gather)), &EmbreeGeometry::visit, &st);
+    hint = st.search.best_id;
     return st.search.vector();
   }
 
@@ -155,7 +171,7 @@ class EmbreeGeometry final : public ivy::Geometry {
     }
     if (st.search.offer(t, id, geom::closest_point_on_triangle)) {
       // Keep every triangle that could still tie or win (and every collision candidate) in reach.
-      *radius = std::max(st.gather, st.search.best) * (1.0f + 1e-4f) + st.self->cfg_.margin;
+      *radius = std::min(*radius, std::max(st.gather, st.search.best) * (1.0f + 1e-4f) + st.self->cfg_.margin);
     }
   }
   const SceneQuery& query_;
@@ -289,6 +305,7 @@ void Grower::add_seed_roots() {
     n.shoot = r.id;
     n.birth_step = static_cast<std::uint32_t>(iteration_);
     r.nodes.push_back(static_cast<std::uint32_t>(plant_.nodes.size()));
+    r.tip = s.position;
     plant_.nodes.push_back(n);
     adhesion_.emplace_back(0.0f);
     length_.push_back(0.0f);
@@ -300,13 +317,13 @@ void Grower::add_seed_roots() {
 }
 
 Grower::Grown Grower::grow_one(const Root& r) const {
-  const std::size_t k = r.nodes.size() - 1;
-  const glm::vec3 pos = plant_.nodes[r.nodes[k]].position;
-  const float floating = floating_at(r, k);
+  const glm::vec3 pos = r.tip;
+  const float floating = r.tip_floating;
   Grown g{};
+  g.hint = r.hint;
   g.floated_out = floating > cfg_.max_float;  // Luft: dies, but still grows this once
 
-  Rng rng(seed_, kGrowStream ^ r.id, 3 * static_cast<std::uint64_t>(k));
+  Rng rng(seed_, kGrowStream ^ r.id, 3 * static_cast<std::uint64_t>(r.nodes.size() - 1));
   glm::vec3 random = cube(rng) + glm::vec3(0.0f, 0.2f, 0.0f);
   const float rl = glm::length(random);
   random = rl > 0.0f ? random / rl : kUp;
@@ -317,7 +334,7 @@ Grower::Grown Grower::grow_one(const Root& r) const {
   // |grow| <= step (unit vectors, weights summing to 1) and |gravity| = step * fall: the farthest any
   // mirrored candidate can be from pos.
   const float gather = luft_collision ? cfg_.step * (1.0f + fall) * (1.0f + 1e-3f) + cfg_.margin : 0.0f;
-  const glm::vec3 adhesion = geometry_.adhesion(pos, gather, candidates);
+  const glm::vec3 adhesion = geometry_.adhesion(pos, gather, candidates, g.hint);
 
   glm::vec3 grow = cfg_.step * (r.dir * cfg_.primary + random * cfg_.random + adhesion * cfg_.adhesion);
   const glm::vec3 gravity = cfg_.step * fall * glm::vec3(0.0f, -1.0f, 0.0f);
@@ -345,7 +362,7 @@ Grower::Grown Grower::grow_one(const Root& r) const {
   g.pos = next;
   g.dir = dl > 0.0f ? dir / dl : r.dir;
   g.adhesion = adhesion;
-  g.length = length_at(r, k) + seg;
+  g.length = r.tip_length + seg;
   g.floating = g.climbing ? 0.0f : floating + seg;
   g.alive = ok && !g.floated_out;
   g.collision_death = !ok;
@@ -388,7 +405,7 @@ bool Grower::step() {
     n.order = r.depth;
     n.shoot = r.id;
     n.birth_step = static_cast<std::uint32_t>(iteration_ + 1);
-    total_length_ += glm::length(g.pos - plant_.nodes[r.nodes.back()].position);
+    total_length_ += glm::length(g.pos - r.tip);
     longest_root_ = std::max(longest_root_, static_cast<double>(g.length));
     r.nodes.push_back(static_cast<std::uint32_t>(plant_.nodes.size()));
     plant_.nodes.push_back(n);
@@ -396,6 +413,10 @@ bool Grower::step() {
     length_.push_back(g.length);
     floating_.push_back(g.floating);
     r.dir = g.dir;
+    r.tip = g.pos;
+    r.tip_length = g.length;
+    r.tip_floating = g.floating;
+    r.hint = g.hint;
     r.alive = g.alive;
     climbing_nodes_ += g.climbing ? 1 : 0;
     reflections_ += g.reflections;
@@ -418,6 +439,8 @@ bool Grower::step() {
     child.depth = static_cast<std::uint16_t>(roots_[ri].depth + 1);
     child.nodes.push_back(roots_[ri].nodes[static_cast<std::size_t>(k)]);
     child.first_floating = floating_at(roots_[ri], static_cast<std::size_t>(k));
+    child.tip = plant_.nodes[child.nodes[0]].position;
+    child.tip_floating = child.first_floating;
     child.dir = kUp;
     alive_.push_back(child.id);
     roots_.push_back(std::move(child));

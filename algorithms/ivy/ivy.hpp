@@ -17,6 +17,8 @@ std::unique_ptr<GrowthAlgorithm> make_ivy();
 
 namespace ivy {
 
+constexpr std::uint32_t kNoTriangle = 0xFFFFFFFFu;
+
 enum class AdhesionMode : std::uint8_t { Luft, Closest };
 enum class CollisionMode : std::uint8_t { Luft, Blender };
 enum class LeafMode : std::uint8_t { Luft, Blender, None };
@@ -79,8 +81,10 @@ class Geometry {
  public:
   virtual ~Geometry() = default;
   // The adhesion vector at p. With gather > 0 it also pushes every triangle that may come within
-  // `gather` of p (a superset) into `candidates` for the Luft collision test.
-  virtual glm::vec3 adhesion(const glm::vec3& p, float gather, Candidates& candidates) const = 0;
+  // `gather` of p (a superset) into `candidates` for the Luft collision test. `hint` is the triangle
+  // that attracted the previous node of the root (or kNoTriangle): offered first, it bounds the search
+  // radius without changing the answer. It returns holding this node's target.
+  virtual glm::vec3 adhesion(const glm::vec3& p, float gather, Candidates& candidates, std::uint32_t& hint) const = 0;
   // Blender's collision: the first hit on the segment o -> o + d (t in [0, 1]), any side.
   virtual RayHit first_hit(const glm::vec3& o, const glm::vec3& d) const = 0;
 };
@@ -111,6 +115,10 @@ class Grower {
     std::vector<std::uint32_t> nodes;  // plant node indices; [0] is the start (a branch root's parent node)
     glm::vec3 dir{0.0f, 1.0f, 0.0f};   // primary direction at the tip
     float first_floating = 0.0f;       // floating length of node [0] as this root sees it
+    // The tip's state, kept here so that growing a root reads one record instead of four arrays.
+    glm::vec3 tip{0.0f};
+    float tip_length = 0.0f, tip_floating = 0.0f;
+    std::uint32_t hint = kNoTriangle;  // the triangle that attracted the tip
     std::uint32_t id = 0;
     std::uint16_t depth = 0;
     bool alive = true;
@@ -118,7 +126,7 @@ class Grower {
   struct Grown {
     glm::vec3 pos, dir, adhesion;
     float length, floating;
-    std::uint32_t reflections;
+    std::uint32_t reflections, hint;
     bool alive, climbing, floated_out, collision_death;
   };
   [[nodiscard]] float length_at(const Root& r, std::size_t k) const { return k == 0 ? 0.0f : length_[r.nodes[k]]; }

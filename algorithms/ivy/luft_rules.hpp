@@ -150,9 +150,16 @@ struct AdhesionSearch {
   bool offer(const Triangle& t, std::uint32_t id, glm::vec3 (*closest)(const glm::vec3&, const glm::vec3&,
                                                                       const glm::vec3&, const glm::vec3&)) {
     if (!t.adhesive) return false;
+    // Cheap rejections first. They only drop triangles that are farther than the best so far by more
+    // than rounding, so the outcome never depends on the order triangles are offered in.
+    const float bound = best * (1.0f + 1e-5f);
+    const glm::vec3 out = glm::max(glm::vec3(0.0f), glm::max(t.lo - p, p - t.hi));
+    if (glm::dot(out, out) > bound * bound) return false;
     glm::vec3 f;
     float d;
     if (luft) {
+      const float nq = glm::dot(t.n, p - t.a);
+      if (nq < 0.0f || nq > bound) return false;
       d = adhesion_distance(t, p, f);
       if (d < 0.0f) return false;
     } else {

@@ -147,12 +147,14 @@ TEST(IvyBranching, ThinnedSamplerMatchesLuftsNodeLoop) {
 class BruteForceGeometry final : public ivy::Geometry {
  public:
   BruteForceGeometry(const ivy::TriangleTable& t, const ivy::Config& c, const SceneQuery& q) : t_(t), c_(c), q_(q) {}
-  glm::vec3 adhesion(const glm::vec3& p, float gather, ivy::Candidates& candidates) const override {
+  glm::vec3 adhesion(const glm::vec3& p, float gather, ivy::Candidates& candidates,
+                     std::uint32_t& hint) const override {
     ivy::AdhesionSearch s{p, c_.max_adhesion, c_.adhesion_mode == ivy::AdhesionMode::Luft};
     for (std::uint32_t id = 0; id < t_.size(); ++id) {
       s.offer(t_.tris[id], id, geom::closest_point_on_triangle);
       if (gather > 0.0f) candidates.push(id);
     }
+    hint = s.best_id;
     return s.vector();
   }
   RayHit first_hit(const glm::vec3& o, const glm::vec3& d) const override { return q_.ray(o, d, 1.0f, 0.0f); }
