@@ -105,8 +105,6 @@ class Grower {
   void finish();
   [[nodiscard]] const Plant& plant() const { return plant_; }
   [[nodiscard]] std::vector<std::pair<std::string, double>> stats() const;
-  [[nodiscard]] std::size_t root_count() const { return roots_.size(); }
-  [[nodiscard]] std::size_t alive_count() const { return alive_.size(); }
   // Bytes held per plant node by the growth state (plant nodes + per-node arrays + root lists).
   [[nodiscard]] double state_bytes_per_node() const;
 
