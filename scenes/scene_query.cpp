@@ -260,22 +260,18 @@ SceneQuery::SceneQuery(const Scene& scene, SceneQueryOptions options)
 
 SceneQuery::~SceneQuery() = default;
 
-ClosestHit SceneQuery::closest_point(const glm::vec3& p, float max_distance) const {
+namespace {
+void point_query(RTCScene scene, const glm::vec3& p, float radius, RTCPointQueryFunction f, void* user) {
   RTCPointQuery q{};
   q.x = p.x;
   q.y = p.y;
   q.z = p.z;
   q.time = 0.0f;
-  q.radius = std::isfinite(max_distance) ? max_distance : vertices_->upper_bound(p);
+  q.radius = radius;
   RTCPointQueryContext ctx;
   rtcInitPointQueryContext(&ctx);
-  PointQueryState st{&embree_->main->meshes, {}};
-  rtcPointQuery(embree_->main->scene, &q, &ctx, point_query_callback, &st);
-  if (st.best.found) st.best.normal = face_normal(scene_.meshes[st.best.mesh], st.best.triangle);
-  return st.best;
+  rtcPointQuery(scene, &q, &ctx, f, user);
 }
-
-namespace {
 struct VisitState {
   SceneQuery::TriangleVisitor visit;
   void* user;
@@ -288,17 +284,17 @@ bool visit_callback(RTCPointQueryFunctionArguments* args) {
 }
 }  // namespace
 
+ClosestHit SceneQuery::closest_point(const glm::vec3& p, float max_distance) const {
+  PointQueryState st{&embree_->main->meshes, {}};
+  point_query(embree_->main->scene, p, std::isfinite(max_distance) ? max_distance : vertices_->upper_bound(p),
+              point_query_callback, &st);
+  if (st.best.found) st.best.normal = face_normal(scene_.meshes[st.best.mesh], st.best.triangle);
+  return st.best;
+}
+
 void SceneQuery::visit_near(const glm::vec3& p, float radius, TriangleVisitor visit, void* user) const {
-  RTCPointQuery q{};
-  q.x = p.x;
-  q.y = p.y;
-  q.z = p.z;
-  q.time = 0.0f;
-  q.radius = radius;
-  RTCPointQueryContext ctx;
-  rtcInitPointQueryContext(&ctx);
   VisitState st{visit, user};
-  rtcPointQuery(embree_->main->scene, &q, &ctx, visit_callback, &st);
+  point_query(embree_->main->scene, p, radius, visit_callback, &st);
 }
 
 RayHit SceneQuery::ray(const glm::vec3& origin, const glm::vec3& dir, float tmax, float tmin) const {

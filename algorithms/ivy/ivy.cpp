@@ -165,11 +165,9 @@ class EmbreeGeometry final : public ivy::Geometry {
     const auto& table = st.self->table_;
     const std::uint32_t id = table.id(mesh, tri);
     const ivy::Triangle& t = table.tris[id];
-    if (st.gather2 >= 0.0f) {
-      const glm::vec3 d = glm::max(glm::vec3(0.0f), glm::max(t.lo - st.search.p, st.search.p - t.hi));
-      if (glm::dot(d, d) <= st.gather2) st.candidates->push(id);
-    }
-    if (st.search.offer(t, id, geom::closest_point_on_triangle)) {
+    const float box2 = ivy::box_distance2(t, st.search.p);
+    if (box2 <= st.gather2) st.candidates->push(id);  // gather2 < 0 when not gathering
+    if (st.search.offer(t, id, geom::closest_point_on_triangle, box2)) {
       // Keep every triangle that could still tie or win (and every collision candidate) in reach.
       *radius = std::min(*radius, std::max(st.gather, st.search.best) * (1.0f + 1e-4f) + st.self->cfg_.margin);
     }
@@ -301,7 +299,7 @@ void Grower::add_seed_roots() {
     r.dir = len > 0.0f ? s.direction / len : kUp;
     PlantNode n;
     n.position = s.position;
-    n.radius = 1.3f * 2.0f * cfg_.branch_size;
+    n.radius = 1.3f * base_radius(0);
     n.shoot = r.id;
     n.birth_step = static_cast<std::uint32_t>(iteration_);
     r.nodes.push_back(static_cast<std::uint32_t>(plant_.nodes.size()));
@@ -364,7 +362,6 @@ Grower::Grown Grower::grow_one(const Root& r) const {
   g.adhesion = adhesion;
   g.length = r.tip_length + seg;
   g.floating = g.climbing ? 0.0f : floating + seg;
-  g.alive = ok && !g.floated_out;
   g.collision_death = !ok;
   return g;
 }
@@ -401,7 +398,7 @@ bool Grower::step() {
     PlantNode n;
     n.position = g.pos;
     n.parent = static_cast<std::int32_t>(r.nodes.back());
-    n.radius = 1.3f * (1.0f / static_cast<float>(r.depth + 1) + 1.0f) * cfg_.branch_size;
+    n.radius = 1.3f * base_radius(r.depth);
     n.order = r.depth;
     n.shoot = r.id;
     n.birth_step = static_cast<std::uint32_t>(iteration_ + 1);
@@ -417,12 +414,11 @@ bool Grower::step() {
     r.tip_length = g.length;
     r.tip_floating = g.floating;
     r.hint = g.hint;
-    r.alive = g.alive;
     climbing_nodes_ += g.climbing ? 1 : 0;
     reflections_ += g.reflections;
     floated_out_ += g.floated_out ? 1 : 0;
     collision_deaths_ += g.collision_death ? 1 : 0;
-    if (r.alive) alive_[still++] = alive_[i];
+    if (!g.floated_out && !g.collision_death) alive_[still++] = alive_[i];
   }
   alive_.resize(still);
 
@@ -458,13 +454,11 @@ void Grower::finish() {
   // Per root: smooth the adhesion vectors, assign radii, place leaves. Roots are independent; each
   // writes its own slot and the slots are concatenated in root order.
   std::vector<std::vector<Organ>> leaves(roots_.size());
-  std::vector<std::vector<glm::vec3>> smooth(roots_.size());
   static constexpr float kGauss[11] = {1, 2, 4, 7, 9, 10, 9, 7, 4, 2, 1};
   auto per_root = [&](std::size_t ri) {
     const Root& r = roots_[ri];
     const std::size_t n = r.nodes.size();
-    std::vector<glm::vec3>& a = smooth[ri];
-    a.resize(n);
+    std::vector<glm::vec3> a(n);  // this root's (smoothed) adhesion vectors
     a[0] = glm::vec3(0.0f);  // the start node carries no adhesion (Luft's new-root node)
     for (std::size_t k = 1; k < n; ++k) a[k] = adhesion_[r.nodes[k]];
     std::vector<glm::vec3> tmp(n);
@@ -482,7 +476,7 @@ void Grower::finish() {
     }
     const float L = length_at(r, n - 1);
     if (n < 2 || !(L > 0.0f)) return;
-    const float base = (1.0f / static_cast<float>(r.depth + 1) + 1.0f) * cfg_.branch_size;
+    const float base = base_radius(r.depth);
     // Radii: the start node of a branch root belongs to its parent root and keeps the parent's.
     for (std::size_t k = (r.depth == 0 ? 0 : 1); k < n; ++k)
       plant_.nodes[r.nodes[k]].radius = base * (1.3f - length_at(r, k) / L);

@@ -119,13 +119,12 @@ class Grower {
     std::uint32_t hint = kNoTriangle;  // the triangle that attracted the tip
     std::uint32_t id = 0;
     std::uint16_t depth = 0;
-    bool alive = true;
   };
   struct Grown {
     glm::vec3 pos, dir, adhesion;
     float length, floating;
     std::uint32_t reflections, hint;
-    bool alive, climbing, floated_out, collision_death;
+    bool climbing, floated_out, collision_death;  // the root lives on unless one of the last two
   };
   [[nodiscard]] float length_at(const Root& r, std::size_t k) const { return k == 0 ? 0.0f : length_[r.nodes[k]]; }
   [[nodiscard]] float floating_at(const Root& r, std::size_t k) const {
@@ -133,6 +132,10 @@ class Grower {
   }
   void add_seed_roots();
   Grown grow_one(const Root& r) const;
+  // Luft's radius before birth() knows the root's length: the tip value, 1.3 x base.
+  [[nodiscard]] float base_radius(int depth) const {
+    return (1.0f / static_cast<float>(depth + 1) + 1.0f) * cfg_.branch_size;
+  }
   [[nodiscard]] std::ptrdiff_t pick_branch_node(const Root& r) const;
   [[nodiscard]] bool limits_reached() const;
 
@@ -145,7 +148,7 @@ class Grower {
   std::vector<glm::vec3> adhesion_;  // per plant node
   std::vector<float> length_, floating_;
   std::vector<Root> roots_;
-  std::vector<std::uint32_t> alive_;  // alive root indices, ascending
+  std::vector<std::uint32_t> alive_;  // alive root indices, ascending (the only record of which live)
   std::vector<Grown> grown_;          // per-iteration slots (reused)
   int iteration_ = 0;
   double total_length_ = 0.0, longest_root_ = 0.0;

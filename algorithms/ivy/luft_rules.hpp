@@ -70,6 +70,12 @@ struct TriangleTable {
 
 constexpr double kInsideTolerance = 1e-6;
 
+// Squared distance from p to t's bounding box (0 inside it).
+inline float box_distance2(const Triangle& t, const glm::vec3& p) {
+  const glm::vec3 out = glm::max(glm::vec3(0.0f), glm::max(t.lo - p, p - t.hi));
+  return glm::dot(out, out);
+}
+
 // Whether p (on or near t's plane) lies inside t, by barycentric coordinates.
 inline bool inside(const Triangle& t, const glm::vec3& p) {
   const glm::dvec3 a(t.a), v0 = glm::dvec3(t.b) - a, v1 = glm::dvec3(t.c) - a, v2 = glm::dvec3(p) - a;
@@ -147,14 +153,16 @@ struct AdhesionSearch {
   std::uint32_t best_id = std::numeric_limits<std::uint32_t>::max();
   glm::vec3 foot{0.0f};
 
-  bool offer(const Triangle& t, std::uint32_t id, glm::vec3 (*closest)(const glm::vec3&, const glm::vec3&,
-                                                                      const glm::vec3&, const glm::vec3&)) {
+  // `box2`: the squared distance from p to t's bounds when the caller has it already (else < 0).
+  bool offer(const Triangle& t, std::uint32_t id,
+             glm::vec3 (*closest)(const glm::vec3&, const glm::vec3&, const glm::vec3&, const glm::vec3&),
+             float box2 = -1.0f) {
     if (!t.adhesive) return false;
     // Cheap rejections first. They only drop triangles that are farther than the best so far by more
     // than rounding, so the outcome never depends on the order triangles are offered in.
     const float bound = best * (1.0f + 1e-5f);
-    const glm::vec3 out = glm::max(glm::vec3(0.0f), glm::max(t.lo - p, p - t.hi));
-    if (glm::dot(out, out) > bound * bound) return false;
+    if (box2 < 0.0f) box2 = box_distance2(t, p);
+    if (box2 > bound * bound) return false;
     glm::vec3 f;
     float d;
     if (luft) {
