@@ -31,6 +31,11 @@ class GrowthAlgorithm {
   // Advances one growth step; returns false when growth has ended by itself.
   virtual bool step() = 0;
   [[nodiscard]] virtual const Plant& plant() const = 0;
+  // What the harness checks after every step (budgets, the growth curve), without asking for the
+  // whole plant: an algorithm that assembles its Plant on demand (hadrich) answers from its own state.
+  // Must equal plant().nodes.size() and plant().organs.size().
+  [[nodiscard]] virtual std::size_t node_count() const { return plant().nodes.size(); }
+  [[nodiscard]] virtual std::size_t organ_count() const { return plant().organs.size(); }
   // Called once after the last step, before meshing (e.g. to assign pipe-model radii or place leaves).
   virtual void finish() {}
   // Algorithm-specific figures for the trial record (e.g. attraction points left).

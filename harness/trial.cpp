@@ -277,7 +277,7 @@ nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const P
     algo->start(scene, *query, params, spec.seed);
     const auto t0 = std::chrono::steady_clock::now();
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
-    curve.add(0, algo->plant().nodes.size(), algo->plant().organs.size(), elapsed());
+    curve.add(0, algo->node_count(), algo->organ_count(), elapsed());
     while (true) {
       if (steps >= spec.max_steps) {
         stopped_by = "max_steps";
@@ -287,20 +287,19 @@ nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const P
         stopped_by = "time_limit";
         break;
       }
-      const Plant& p = algo->plant();
-      if (spec.budget_nodes > 0 && p.nodes.size() >= spec.budget_nodes) {
+      if (spec.budget_nodes > 0 && algo->node_count() >= spec.budget_nodes) {
         stopped_by = "budget_nodes";
         break;
       }
-      if (spec.budget_length_m > 0.0 && p.total_length() >= spec.budget_length_m) {
+      if (spec.budget_length_m > 0.0 && algo->plant().total_length() >= spec.budget_length_m) {
         stopped_by = "budget_length";
         break;
       }
       const bool more = algo->step();
       ++steps;
       const double t = elapsed();
-      curve.add(steps, algo->plant().nodes.size(), algo->plant().organs.size(), t);
-      if (progress) progress({steps, algo->plant().nodes.size(), t});
+      curve.add(steps, algo->node_count(), algo->organ_count(), t);
+      if (progress) progress({steps, algo->node_count(), t});
       if (!more) break;
     }
     algo->finish();

@@ -124,10 +124,12 @@ struct BvhScene {
 struct PointQueryState {
   const std::vector<const TriangleMesh*>* meshes;
   ClosestHit best;
+  const std::vector<bool>* skip = nullptr;  // skip[mesh]: not a candidate
 };
 
 bool point_query_callback(RTCPointQueryFunctionArguments* args) {
   auto* st = static_cast<PointQueryState*>(args->userPtr);
+  if (st->skip && (*st->skip)[args->geomID]) return false;
   const TriangleMesh& m = *(*st->meshes)[args->geomID];
   const auto& t = m.triangles[args->primID];
   const glm::vec3 p(args->query->x, args->query->y, args->query->z);
@@ -216,6 +218,8 @@ SceneQuery::SceneQuery(const Scene& scene, SceneQueryOptions options)
   // Area CDF for surface sampling.
   bool any_climbable = false;
   for (const auto& m : scene.meshes) any_climbable = any_climbable || m.climbable;
+  if (any_climbable)
+    for (const auto& m : scene.meshes) not_climbable_.push_back(!m.climbable);
   double acc = 0.0;
   for (std::uint32_t mi = 0; mi < scene.meshes.size(); ++mi) {
     const auto& m = scene.meshes[mi];
@@ -284,10 +288,13 @@ bool visit_callback(RTCPointQueryFunctionArguments* args) {
 }
 }  // namespace
 
-ClosestHit SceneQuery::closest_point(const glm::vec3& p, float max_distance) const {
-  PointQueryState st{&embree_->main->meshes, {}};
-  point_query(embree_->main->scene, p, std::isfinite(max_distance) ? max_distance : vertices_->upper_bound(p),
-              point_query_callback, &st);
+ClosestHit SceneQuery::closest_point(const glm::vec3& p, float max_distance, bool climbable_only) const {
+  PointQueryState st{&embree_->main->meshes, {}, climbable_only && !not_climbable_.empty() ? &not_climbable_ : nullptr};
+  // The vertex bound counts every mesh, so it only bounds an unfiltered query.
+  const float radius = std::isfinite(max_distance) ? max_distance
+                       : st.skip                   ? std::numeric_limits<float>::infinity()
+                                                   : vertices_->upper_bound(p);
+  point_query(embree_->main->scene, p, radius, point_query_callback, &st);
   if (st.best.found) st.best.normal = face_normal(scene_.meshes[st.best.mesh], st.best.triangle);
   return st.best;
 }
@@ -318,6 +325,20 @@ float SceneQuery::signed_distance(const glm::vec3& p) const {
   // Beyond the band: exact distance from Embree, sign from the level set.
   const float d = closest_point(p).distance;
   return v < 0.0f ? -d : d;
+}
+
+SceneQuery::BandSample SceneQuery::band_sample(const glm::vec3& p) const {
+  if (!sdf_) throw std::logic_error("SceneQuery: the distance field was not built");
+  BandSample s;
+  glm::vec3 g;
+  s.distance = sdf_->sample_gradient(p, g);
+  const float band = sdf_->background();
+  const float len = glm::length(g);
+  // A cell with any corner at the background value is not resolved: treat it as outside the band.
+  s.in_band = std::abs(s.distance) < 0.999f * band - voxel_size_ && len > 1e-12f;
+  if (s.in_band) s.gradient = g / len;
+  else s.distance = s.distance < 0.0f ? -band : band;
+  return s;
 }
 
 glm::vec3 SceneQuery::gradient(const glm::vec3& p) const {

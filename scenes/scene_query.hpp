@@ -64,9 +64,10 @@ class SceneQuery {
   SceneQuery(const SceneQuery&) = delete;
   SceneQuery& operator=(const SceneQuery&) = delete;
 
-  // Closest surface point within max_distance (not found beyond it).
-  [[nodiscard]] ClosestHit closest_point(const glm::vec3& p,
-                                         float max_distance = std::numeric_limits<float>::infinity()) const;
+  // Closest surface point within max_distance (not found beyond it). climbable_only: among the climbable
+  // meshes only (when the scene marks any; otherwise all meshes count).
+  [[nodiscard]] ClosestHit closest_point(const glm::vec3& p, float max_distance = std::numeric_limits<float>::infinity(),
+                                         bool climbable_only = false) const;
   // First hit along origin + t dir for t in (tmin, tmax); dir need not be normalised (t is in its units).
   // Calls `visit` for every triangle in a BVH leaf that comes within `radius` of p (an Embree point
   // query: a conservative superset of the triangles within radius; a triangle may be visited twice
@@ -82,6 +83,16 @@ class SceneQuery {
   [[nodiscard]] bool light_visible(const glm::vec3& p, float bias = 1e-4f) const;
 
   [[nodiscard]] float signed_distance(const glm::vec3& p) const;
+  // The level set alone, for per-particle work every step: one read of eight voxels, no Embree
+  // fallback. Within the narrow band, `distance` is the trilinear signed distance and `gradient` its
+  // unit gradient (outwards). Beyond it, in_band is false, |distance| is the band width (the true
+  // distance is at least that) and the gradient is zero.
+  struct BandSample {
+    float distance = 0.0f;
+    glm::vec3 gradient{0.0f};
+    bool in_band = false;
+  };
+  [[nodiscard]] BandSample band_sample(const glm::vec3& p) const;
   // Unit gradient of the signed distance (points away from the nearest surface, outwards).
   [[nodiscard]] glm::vec3 gradient(const glm::vec3& p) const;
   [[nodiscard]] bool inside(const glm::vec3& p) const { return signed_distance(p) < 0.0f; }
@@ -112,6 +123,7 @@ class SceneQuery {
   std::unique_ptr<SdfGrid> sdf_;
   std::unique_ptr<VertexIndex> vertices_;
   std::vector<bool> solid_;
+  std::vector<bool> not_climbable_;  // per mesh; empty when no mesh is marked climbable
   float voxel_size_ = 0.0f;
   double bvh_seconds_ = 0.0, sdf_seconds_ = 0.0;
   // Surface sampling: cumulative areas over (mesh, triangle) pairs.

@@ -51,6 +51,27 @@ float SdfGrid::sample(const glm::vec3& p) const {
   return openvdb::tools::BoxSampler::sample(acc, ijk);
 }
 
+float SdfGrid::sample_gradient(const glm::vec3& p, glm::vec3& gradient) const {
+  openvdb::tree::ValueAccessor<const openvdb::FloatTree, false> acc(impl_->grid->constTree());
+  const openvdb::Vec3d xyz = impl_->grid->transform().worldToIndex(openvdb::Vec3d(p.x, p.y, p.z));
+  const openvdb::Coord ijk = openvdb::Coord::floor(xyz);
+  float v[2][2][2];
+  openvdb::tools::BoxSampler::getValues(v, acc, ijk);
+  const auto x = static_cast<float>(xyz.x() - ijk.x()), y = static_cast<float>(xyz.y() - ijk.y()),
+             z = static_cast<float>(xyz.z() - ijk.z());
+  // Bilinear faces of the cell along each axis, then their difference for the derivative.
+  auto lerp = [](float a, float b, float t) { return a + (b - a) * t; };
+  const float x0 = lerp(lerp(v[0][0][0], v[0][0][1], z), lerp(v[0][1][0], v[0][1][1], z), y);
+  const float x1 = lerp(lerp(v[1][0][0], v[1][0][1], z), lerp(v[1][1][0], v[1][1][1], z), y);
+  const float y0 = lerp(lerp(v[0][0][0], v[0][0][1], z), lerp(v[1][0][0], v[1][0][1], z), x);
+  const float y1 = lerp(lerp(v[0][1][0], v[0][1][1], z), lerp(v[1][1][0], v[1][1][1], z), x);
+  const float z0 = lerp(lerp(v[0][0][0], v[0][1][0], y), lerp(v[1][0][0], v[1][1][0], y), x);
+  const float z1 = lerp(lerp(v[0][0][1], v[0][1][1], y), lerp(v[1][0][1], v[1][1][1], y), x);
+  const auto inv = static_cast<float>(1.0 / impl_->grid->voxelSize().x());
+  gradient = glm::vec3(x1 - x0, y1 - y0, z1 - z0) * inv;
+  return lerp(x0, x1, x);
+}
+
 std::size_t SdfGrid::active_voxels() const { return impl_->grid->activeVoxelCount(); }
 
 }  // namespace growbench

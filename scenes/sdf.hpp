@@ -19,6 +19,9 @@ class SdfGrid {
   ~SdfGrid();
   // Trilinear sample in world space; returns +/- band width outside the narrow band (sign kept).
   [[nodiscard]] float sample(const glm::vec3& p) const;
+  // The same trilinear value and its exact gradient (the derivative of the trilinear interpolant, not
+  // normalised), from one read of the cell's eight voxels.
+  [[nodiscard]] float sample_gradient(const glm::vec3& p, glm::vec3& gradient) const;
   [[nodiscard]] float background() const { return background_; }
   [[nodiscard]] std::size_t active_voxels() const;
 

@@ -129,6 +129,35 @@ TEST(SceneQuery, SphereDistancesMatchAnalyticWithinAVoxel) {
   }
 }
 
+// The band sample is the same trilinear value as signed_distance inside the band, its gradient is the
+// sphere's radial direction, and outside the band it says so instead of guessing.
+TEST(SceneQuery, BandSampleMatchesTheSphereAndKnowsItsBand) {
+  const float r = 0.8f;
+  const glm::vec3 c(0.5f, 0.2f, -0.3f);
+  const Scene s = scene_with(geom::make_icosphere("sphere", c, r, 5));
+  SceneQuery q(s, {.voxel_size = 0.015f});
+  Rng rng(5, 0);
+  int in_band = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const glm::vec3 dir = rng.unit_vector();
+    const float offset = static_cast<float>(rng.uniform(-0.1, 0.1));
+    const glm::vec3 p = c + dir * (r + offset);
+    const auto b = q.band_sample(p);
+    if (std::abs(offset) < q.band_width() - 2.0f * q.voxel_size()) {
+      ASSERT_TRUE(b.in_band) << offset;
+      ++in_band;
+      EXPECT_NEAR(b.distance, q.signed_distance(p), 1e-6f);  // same voxels, another summation order
+      EXPECT_GT(glm::dot(b.gradient, dir), 0.99f) << offset;
+      EXPECT_NEAR(glm::length(b.gradient), 1.0f, 1e-5f);
+    } else if (std::abs(offset) > q.band_width()) {
+      EXPECT_FALSE(b.in_band) << offset;
+      EXPECT_EQ(b.distance, offset < 0.0f ? -q.band_width() : q.band_width());
+      EXPECT_EQ(b.gradient, glm::vec3(0.0f));
+    }
+  }
+  EXPECT_GT(in_band, 300);
+}
+
 TEST(SceneQuery, ClosestPointEqualsBruteForceOnStandardScenes) {
   for (const char* name : {"wall", "facade", "pergola", "boulder", "trunk"}) {
     const Scene s = load_scene(name);
