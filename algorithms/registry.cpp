@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "algorithms/algorithm.hpp"
+#include "algorithms/hadrich/hadrich.hpp"
 #include "algorithms/ivy/ivy.hpp"
 #include "algorithms/lsystem/lsystem.hpp"
 #include "algorithms/spacecol/spacecol.hpp"
@@ -14,6 +15,7 @@ const std::vector<AlgorithmEntry>& algorithm_registry() {
       {spacecol_info, make_spacecol},
       {lsystem_info, make_lsystem},
       {ivy_info, make_ivy},
+      {hadrich_info, make_hadrich},
   };
   return list;
 }

@@ -17,6 +17,7 @@ std::vector<std::string> invariant_params(const std::string& algorithm) {
   if (algorithm == "spacecol") return {"surface=avoid", "point_count=4000"};
   if (algorithm == "lsystem") return {"surface=wrap"};  // a free tree would pass through solids
   if (algorithm == "ivy") return {"max_root_length=1"};
+  if (algorithm == "hadrich") return {"max_particles=2000"};
   return {};
 }
 

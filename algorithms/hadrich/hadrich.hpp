@@ -1,0 +1,165 @@
+// Hädrich, Benes, Deussen, Pirk 2017, "Interactive Modeling and Authoring of Climbing Plants": a plant
+// is a tree of oriented particles that grow at the tips, turn toward surfaces and light, branch, carry
+// leaves, collide with the scene's distance field, anchor where they touch, and bend (and break) under
+// gravity and wind through oriented-particle shape matching.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "algorithms/algorithm.hpp"
+
+namespace growbench {
+
+const AlgorithmInfo& hadrich_info();
+std::unique_ptr<GrowthAlgorithm> make_hadrich();
+
+namespace hadrich {
+
+constexpr int kMaxChildren = 4;  // one successor + at most 3 laterals (max_laterals <= 3)
+
+// A cut during the run: at `step`, the particles whose head lies within `radius` of `point` (radius 0:
+// the one particle nearest to it) are removed with everything grown from them.
+struct Cut {
+  glm::vec3 point{0.0f};
+  float radius = 0.0f;
+  int step = 0;
+};
+// Parses "x,y,z,radius@step; ..." (the `prune` parameter). InputError naming the entry otherwise.
+std::vector<Cut> parse_cuts(const std::string& text);
+
+struct Config {
+  // growth
+  float particle_length = 0.02f;
+  std::size_t max_particles = 10000;
+  float growth_speed = 0.2f, shade_growth = 0.25f;
+  float tip_radius = 0.002f, max_radius = 0.012f, thickening = 0.002f, radius_falloff = 0.7f;
+  // tropisms (rates in 1/s, angles in radians)
+  float adaptation = 6.0f, attraction_range = 0.15f, approach_angle = 0.436f;
+  float phototropism = 1.5f;
+  int light_rays = 4;
+  float light_spread = 0.087f, direction_noise = 0.1f, zone_rate = 3.0f;
+  // branching and leaves
+  int max_laterals = 1, max_order = 3, leaf_step = 1;
+  float shoot_density = 0.08f, branch_variance = 0.8f;
+  float leaf_density = 0.7f, phyllotaxis = 2.4f, leaf_size = 0.05f, leaf_light = 0.7f;
+  // physics
+  float dt = 0.025f, gravity = 1.0f, stiffness = 0.8f, damping = 0.05f;
+  int iterations = 2;
+  float friction = 0.6f, elasticity = 0.1f, anchor_pull = 0.5f, anchor_release = 0.03f;
+  float break_sensitivity = 0.0f;
+  glm::vec3 wind{1.0f, 0.0f, 0.0f};
+  float wind_strength = 0.0f, wind_gusts = 0.5f, gust_period = 1.5f;
+  std::vector<Cut> cuts;
+};
+Config make_config(const Params& params);
+
+// The particle pool: a structure of arrays preallocated to max_particles, activated in order (a slot
+// is never reused, so a parent always has a lower index than its children). A particle is an
+// ellipsoid: semi-axis `half` along its forward axis (local +Z), `radius` across. It spans from its
+// tail (x - half f) to its head (x + half f); a child's tail sits at its parent's head.
+struct Particles {
+  enum Flag : std::uint8_t {
+    Active = 1,     // in the plant (not pruned)
+    Growing = 2,    // a tip still lengthening
+    Pinned = 4,     // a seed's first particle: its tail is fixed at the seed
+    Anchored = 8,   // pulled toward `anchor`
+    Touched = 16,   // touched a surface while growing: anchors when it matures
+    Contact = 32,   // pushed out of a surface in the last step
+  };
+  std::vector<glm::vec3> x, v, w;    // centre, velocity, angular velocity
+  std::vector<glm::quat> q;          // orientation (local +Z forward)
+  std::vector<glm::quat> rest;       // rest orientation relative to the parent's frame
+  std::vector<float> half, radius;
+  std::vector<std::int32_t> parent;  // -1: a seed's first particle, or broken off
+  std::vector<std::array<std::int32_t, kMaxChildren>> children;  // -1: empty
+  std::vector<std::uint32_t> shoot, birth, rank;  // shoot id, step of birth, position along the shoot
+  std::vector<std::uint16_t> order;
+  std::vector<std::uint8_t> flags;
+  std::vector<glm::vec3> anchor, normal;  // anchor point; last surface normal seen (zero: none near)
+  std::vector<float> light;               // 1 - O at the last evaluation (tips)
+  // Per-step scratch: predicted pose, shape-matching groups.
+  std::vector<glm::vec3> xp, xp2, group_c, group_cbar;
+  std::vector<glm::quat> qp, qp2, group_r;
+
+  void reserve(std::size_t n);
+  [[nodiscard]] std::size_t size() const { return x.size(); }
+  [[nodiscard]] static std::size_t bytes_per_particle();
+  [[nodiscard]] bool has(std::size_t i, Flag f) const { return (flags[i] & f) != 0; }
+};
+
+struct Leaf {
+  std::int32_t particle = -1;
+  float azimuth = 0.0f;  // around the particle's forward axis (phyllotaxis)
+  float size = 0.0f;
+};
+
+// The simulation. step() = light, tropisms and growth at the tips, new particles, then one physics
+// step for every particle. Deterministic for any thread count: parallel passes write only their own
+// particle's slots, and new particles are created serially in index order.
+class Simulator {
+ public:
+  Simulator(const Scene& scene, const SceneQuery& query, const Config& config, std::uint64_t seed);
+  bool step();
+  // Removes the particles whose head is within `radius` of `point` (radius 0: the nearest particle)
+  // and their subtrees; returns how many were removed.
+  std::size_t prune(const glm::vec3& point, float radius);
+  // Removes particle i and everything grown from it.
+  std::size_t prune_subtree(std::int32_t i);
+
+  [[nodiscard]] const Plant& plant() const;
+  [[nodiscard]] std::size_t node_count() const { return active_ + roots_; }
+  [[nodiscard]] std::size_t leaf_count() const { return live_leaves_; }
+  [[nodiscard]] const Particles& particles() const { return p_; }
+  [[nodiscard]] std::vector<std::pair<std::string, double>> stats() const;
+  [[nodiscard]] int steps() const { return step_; }
+  // Particle index of each plant node (-1 for a root's base node at its tail).
+  [[nodiscard]] const std::vector<std::int32_t>& node_particles() const {
+    (void)plant();
+    return node_particle_;
+  }
+  [[nodiscard]] glm::vec3 head(std::size_t i) const;
+  [[nodiscard]] glm::vec3 forward(std::size_t i) const { return p_.q[i] * glm::vec3(0.0f, 0.0f, 1.0f); }
+
+ private:
+  std::int32_t activate(std::int32_t parent, const glm::vec3& tail, const glm::quat& q, std::uint32_t shoot,
+                        std::uint16_t order, std::uint32_t rank, bool pinned);
+  void add_seeds();
+  void grow_tips();
+  void spawn();
+  void physics();
+  void group_pass();
+  void goal_pass();
+  void contact_pass();
+  void break_joints();
+  [[nodiscard]] float occlusion(std::size_t i, const glm::vec3& at) const;
+  [[nodiscard]] glm::vec3 wind(std::size_t i) const;
+  [[nodiscard]] float max_radius(std::uint16_t order) const;
+
+  const Scene& scene_;
+  const SceneQuery& query_;
+  Config cfg_;
+  std::uint64_t seed_;
+  Particles p_;
+  std::vector<Leaf> leaves_;
+  std::vector<std::int32_t> tips_;  // growing particles, ascending
+  std::vector<std::uint8_t> seed_started_;
+  int step_ = 0;
+  std::size_t active_ = 0, roots_ = 0, live_leaves_ = 0;
+  std::uint32_t next_shoot_ = 0;
+  bool pool_full_ = false;
+  std::uint64_t broken_ = 0, pruned_ = 0, anchors_made_ = 0;
+  mutable Plant plant_;
+  mutable std::vector<std::int32_t> node_particle_;
+  mutable std::uint64_t plant_version_ = 0;
+  std::uint64_t version_ = 0;  // bumped by every change (steps and prunes)
+};
+
+}  // namespace hadrich
+}  // namespace growbench

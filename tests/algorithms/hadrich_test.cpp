@@ -1,0 +1,308 @@
+// Hädrich climbing plants: adaptation, phototropism, shade, collision, pruning, breaking, stability
+// and determinism, each on a scene whose answer is known.
+#include "algorithms/hadrich/hadrich.hpp"
+
+#include <set>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include "grow_util.hpp"
+#include "scenes/geometry.hpp"
+#include "scenes/scene_library.hpp"
+#include "test_util.hpp"
+
+namespace growbench {
+namespace {
+
+using hadrich::Particles;
+using hadrich::Simulator;
+
+hadrich::Config config(const std::vector<std::string>& sets) {
+  Params p = default_params(find_algorithm("hadrich"));
+  for (const auto& s : sets) p.set_assignment(s);
+  return hadrich::make_config(p);
+}
+
+// A lone wall in the plane z = 0 (front face at z = 0.05), a seed `gap` in front of it, sun overhead.
+Scene wall_scene(float gap) {
+  Scene s;
+  s.name = "test-wall";
+  s.meshes.push_back(geom::make_box("wall", {-1.0f, 0.0f, -0.05f}, {1.0f, 3.0f, 0.05f}));
+  s.seeds.push_back({{0.0f, 0.05f, 0.05f + gap}, {0, 1, 0}, 0});
+  s.light.direction = {0.0f, 1.0f, 0.0f};
+  return s;
+}
+
+// Distance from each particle of shoot 0 to the wall's front face, in growth order.
+std::vector<float> main_shoot_gaps(const Simulator& sim) {
+  std::vector<float> gaps;
+  const Particles& p = sim.particles();
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p.shoot[i] == 0 && p.has(i, Particles::Active)) gaps.push_back(p.x[i].z - 0.05f);
+  return gaps;
+}
+
+TEST(Hadrich, PruneEntriesParseAndBadOnesAreNamed) {
+  const auto cuts = hadrich::parse_cuts("0.1, 0.5,-0.2,0@40; 1,2,3,0.25@7;");
+  ASSERT_EQ(cuts.size(), 2u);
+  EXPECT_EQ(cuts[0].point, glm::vec3(0.1f, 0.5f, -0.2f));
+  EXPECT_EQ(cuts[0].radius, 0.0f);
+  EXPECT_EQ(cuts[0].step, 40);
+  EXPECT_EQ(cuts[1].radius, 0.25f);
+  EXPECT_EQ(cuts[1].step, 7);
+  EXPECT_NE(test::error_of([] { hadrich::parse_cuts("1,2,3,0.1"); }).find("entry 1 '1,2,3,0.1': no '@step'"),
+            std::string::npos);
+  EXPECT_NE(test::error_of([] { hadrich::parse_cuts("1,2,3,0@4; 1,2,x,0@5"); }).find("entry 2"), std::string::npos);
+  EXPECT_NE(test::error_of([] { hadrich::parse_cuts("1,2,0@4"); }).find("3 numbers"), std::string::npos);
+  EXPECT_NE(test::error_of([] { hadrich::parse_cuts("1,2,3,-1@4"); }).find("negative radius"), std::string::npos);
+  EXPECT_NE(test::error_of([] { hadrich::parse_cuts("1,2,3,1@-4"); }).find("step '-4'"), std::string::npos);
+  // Through the parameter table, the error names the parameter.
+  EXPECT_NE(test::error_of([] { config({"prune=1,2,3@4"}); }).find("parameter 'prune'"), std::string::npos);
+}
+
+// A shoot started 8 cm in front of a wall, growing straight up (the light is overhead, so
+// phototropism does not push it either way), bends onto the wall and stays there.
+TEST(Hadrich, AdaptationPullsAShootOntoAWallAndKeepsItThere) {
+  const Scene s = wall_scene(0.08f);
+  SceneQuery q(s);
+  Simulator sim(s, q, config({"max_laterals=0", "max_particles=120", "direction_noise=0", "light_rays=0"}), 1);
+  for (int i = 0; i < 600 && sim.step(); ++i) {
+  }
+  const auto gaps = main_shoot_gaps(sim);
+  ASSERT_GE(gaps.size(), 100u);
+  EXPECT_GT(gaps.front(), 0.06f);  // it started away from the wall
+  // Every particle of the second half hugs the wall: centre within its contact distance plus a few mm.
+  for (std::size_t k = gaps.size() / 2; k < gaps.size(); ++k) EXPECT_LT(gaps[k], 0.015f) << "particle " << k;
+  for (const float g : gaps) EXPECT_GT(g, 0.0f);
+  // The same shoot with adaptation off stays where it started.
+  Simulator free(s, q, config({"max_laterals=0", "max_particles=120", "direction_noise=0", "light_rays=0", "adaptation=0"}), 1);
+  for (int i = 0; i < 600 && free.step(); ++i) {
+  }
+  const auto free_gaps = main_shoot_gaps(free);
+  EXPECT_GT(free_gaps.back(), 0.07f);
+}
+
+// In open space with the sun to the side (+x, up), the shoot turns toward it; with phototropism off it
+// keeps growing straight up.
+TEST(Hadrich, PhototropismTurnsTowardTheLight) {
+  Scene s;
+  s.name = "test-open";
+  s.meshes.push_back(geom::make_box("far", {10.0f, -0.1f, 10.0f}, {10.1f, 0.0f, 10.1f}));
+  s.seeds.push_back({{0.0f, 0.0f, 0.0f}, {0, 1, 0}, 0});
+  s.light.direction = {1.0f, 0.2f, 0.0f};
+  SceneQuery q(s);
+  auto tip_direction = [&](const std::vector<std::string>& sets) {
+    auto sets2 = sets;
+    for (const char* x : {"max_laterals=0", "max_particles=60", "direction_noise=0", "gravity=0"}) sets2.emplace_back(x);
+    Simulator sim(s, q, config(sets2), 1);
+    for (int i = 0; i < 400 && sim.step(); ++i) {
+    }
+    return sim.forward(sim.particles().size() - 1);
+  };
+  const glm::vec3 lit = tip_direction({});
+  const glm::vec3 none = tip_direction({"phototropism=0"});
+  const glm::vec3 l = glm::normalize(s.light.direction);
+  EXPECT_GT(glm::dot(lit, l), 0.99f);  // turned all the way to the light
+  EXPECT_NEAR(glm::dot(none, glm::vec3(0, 1, 0)), 1.0f, 1e-4f);
+}
+
+// A roof over one seed shades it: its tips see O = 1, it grows at shade_growth of the speed, and it
+// ends shorter than the seed in the sun after the same number of steps.
+TEST(Hadrich, GrowthSlowsInTheShade) {
+  Scene s;
+  s.name = "test-shade";
+  s.meshes.push_back(geom::make_box("roof", {-0.5f, 2.0f, -0.5f}, {0.5f, 2.1f, 0.5f}));
+  s.seeds.push_back({{0.0f, 0.0f, 0.0f}, {0, 1, 0}, 0});
+  s.seeds.push_back({{3.0f, 0.0f, 0.0f}, {0, 1, 0}, 0});
+  s.light.direction = {0.0f, 1.0f, 0.0f};
+  SceneQuery q(s);
+  Simulator sim(s, q, config({"max_laterals=0", "direction_noise=0", "phototropism=0", "gravity=0", "shade_growth=0.25"}), 1);
+  for (int i = 0; i < 100; ++i) sim.step();
+  const Particles& p = sim.particles();
+  float shaded = 0.0f, sunny = 0.0f;
+  for (std::size_t i = 0; i < p.size(); ++i) (p.shoot[i] == 0 ? shaded : sunny) += 2.0f * p.half[i];
+  EXPECT_NEAR(shaded / sunny, 0.25f, 0.02f);
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p.has(i, Particles::Growing)) {
+      EXPECT_EQ(p.light[i], p.shoot[i] == 0 ? 0.0f : 1.0f);
+    }
+}
+
+// Closed solids: no plant node inside the column, the boulder or the bunny.
+TEST(Hadrich, NoNodeInsideClosedSolids) {
+  for (const std::string name : {"column", "boulder"}) {
+    const Scene s = load_scene(name);
+    SceneQuery q(s);
+    const Plant plant = test::grow("hadrich", s, q, {"max_particles=3000"});
+    ASSERT_GT(plant.nodes.size(), 2000u) << name;
+    const auto inside = test::nodes_inside_solids(plant, q);
+    EXPECT_TRUE(inside.empty()) << name << ": " << inside.size() << " nodes inside";
+  }
+  Scene bunny = load_scene("mesh:" + test::shared_mesh("stanford-bunny.obj"));
+  SceneQuery q(bunny);
+  const Plant plant = test::grow("hadrich", bunny, q, {"max_particles=3000"});
+  ASSERT_GT(plant.nodes.size(), 2000u);
+  const auto inside = test::nodes_inside_solids(plant, q);
+  EXPECT_TRUE(inside.empty()) << inside.size() << " nodes inside the bunny";
+}
+
+// Pruning a particle removes it and exactly its descendants (found here independently, by walking up
+// the parent links of every particle), with their leaves, and nothing else.
+TEST(Hadrich, PruningRemovesExactlyTheSubtree) {
+  const Scene s = load_scene("wall");
+  SceneQuery q(s);
+  Simulator sim(s, q, config({"max_particles=6000"}), 3);
+  for (int i = 0; i < 250; ++i) ASSERT_TRUE(sim.step());
+  const Particles& p = sim.particles();
+  // A particle with a lateral among its descendants, a quarter of the way into the pool.
+  std::int32_t cut = -1;
+  for (std::size_t i = p.size() / 4; i < p.size() && cut < 0; ++i)
+    if (p.parent[i] >= 0 && std::count_if(p.children[i].begin(), p.children[i].end(), [](std::int32_t c) { return c >= 0; }) >= 2)
+      cut = static_cast<std::int32_t>(i);
+  ASSERT_GE(cut, 0);
+  std::set<std::size_t> expected_removed, survivors;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    bool below = false;
+    for (std::int32_t a = static_cast<std::int32_t>(i); a >= 0; a = p.parent[a]) below = below || a == cut;
+    (below ? expected_removed : survivors).insert(i);
+  }
+  ASSERT_GT(expected_removed.size(), 2u);
+  std::size_t leaves_kept = 0;
+  const Plant before = sim.plant();
+  const auto& node_particle = sim.node_particles();
+  for (const Organ& o : before.organs)
+    if (!expected_removed.count(static_cast<std::size_t>(node_particle[o.node]))) ++leaves_kept;
+
+  EXPECT_EQ(sim.prune_subtree(cut), expected_removed.size());
+  std::set<std::size_t> active;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p.has(i, Particles::Active)) active.insert(i);
+  EXPECT_EQ(active, survivors);
+  const Plant after = sim.plant();
+  EXPECT_EQ(after.validate(), "");
+  EXPECT_EQ(after.organs.size(), leaves_kept);
+  EXPECT_EQ(sim.node_count(), after.nodes.size());
+  EXPECT_EQ(sim.leaf_count(), after.organs.size());
+  // The parent of the cut particle no longer lists it; growth goes on.
+  const auto& ch = p.children[p.parent[cut]];
+  EXPECT_EQ(std::count(ch.begin(), ch.end(), cut), 0);
+  EXPECT_TRUE(sim.step());
+}
+
+// The `prune` parameter cuts during the run at its step: radius 0 takes the particle nearest the
+// point, a radius every particle whose head is within it. The point is a particle's head at that step,
+// found by a first run (runs are deterministic).
+TEST(Hadrich, PruneParameterCutsAtItsStep) {
+  const Scene s = load_scene("wall", {"seeds=1"});
+  SceneQuery q(s);
+  Simulator probe(s, q, config({"max_particles=2000"}), 1);
+  for (int i = 0; i < 150; ++i) probe.step();
+  const std::size_t before = probe.node_count();
+  std::vector<glm::vec3> heads;
+  for (std::size_t k = 0; k < probe.particles().size(); ++k) heads.push_back(probe.head(k));
+  const std::size_t target = heads.size() / 2;
+  const glm::vec3 at = heads[target];
+  for (const float radius : {0.0f, 0.1f}) {
+    Simulator sim(s, q, config({"max_particles=2000", fmt::format("prune={},{},{},{}@150", at.x, at.y, at.z, radius)}), 1);
+    for (int i = 0; i < 150; ++i) sim.step();
+    EXPECT_EQ(sim.node_count(), before);
+    sim.step();
+    double pruned = 0.0;
+    for (const auto& [k, v] : sim.stats())
+      if (k == "pruned") pruned = v;
+    EXPECT_GE(pruned, 1.0) << radius;
+    EXPECT_FALSE(sim.particles().has(target, Particles::Active));
+    for (std::size_t k = 0; k < heads.size(); ++k) {
+      if (glm::length(heads[k] - at) <= radius) {
+        EXPECT_FALSE(sim.particles().has(k, Particles::Active)) << k;
+      }
+    }
+  }
+}
+
+// Under a gale, joints break when breaking is on, and never when its sensitivity is 0.
+TEST(Hadrich, BreakingUnderLoadAndNeverWithSensitivityZero) {
+  Scene s;
+  s.name = "test-gale";
+  s.meshes.push_back(geom::make_box("ground", {-5.0f, -0.1f, -5.0f}, {5.0f, 0.0f, 5.0f}));
+  s.seeds.push_back({{0.0f, 0.02f, 0.0f}, {0, 1, 0}, 0});
+  SceneQuery q(s);
+  auto broken = [&](const char* sensitivity) {
+    Simulator sim(s, q,
+                  config({"max_particles=150", "max_laterals=0", "gravity=0", "wind_strength=400", "wind=1,0,0",
+                          sensitivity}),
+                  1);
+    for (int i = 0; i < 800; ++i) sim.step();
+    std::size_t roots = 0;
+    for (const auto& n : sim.plant().nodes) roots += n.parent == kNoParent ? 1 : 0;
+    for (const auto& [k, v] : sim.stats())
+      if (k == "broken") {
+        EXPECT_EQ(static_cast<double>(roots - 1), v);
+      }
+    EXPECT_EQ(sim.plant().validate(), "");
+    return roots - 1;
+  };
+  EXPECT_GT(broken("break_sensitivity=2"), 0u);
+  EXPECT_EQ(broken("break_sensitivity=0"), 0u);
+}
+
+// 10,000 steps at the default time step with wind and gusts: finite, bounded, nothing escapes.
+TEST(Hadrich, StableOverTenThousandSteps) {
+  const Scene s = load_scene("corner", {"seeds=1"});
+  SceneQuery q(s);
+  Simulator sim(s, q, config({"max_particles=400", "wind_strength=3", "wind_gusts=1"}), 2);
+  float worst = 0.0f;
+  const Aabb box = s.bounds();
+  for (int i = 0; i < 10000; ++i) {
+    sim.step();
+    if (i % 500 != 499) continue;
+    const Particles& p = sim.particles();
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      ASSERT_TRUE(std::isfinite(p.x[k].x + p.x[k].y + p.x[k].z + p.v[k].x + p.v[k].y + p.v[k].z)) << "step " << i;
+      worst = std::max(worst, glm::length(p.v[k]));
+      ASSERT_TRUE(box.contains(p.x[k]) || glm::length(p.x[k] - box.center()) < 10.0f) << "escaped at step " << i;
+    }
+  }
+  EXPECT_LT(worst, 5.0f);  // m/s; a shoot at rest under wind moves far slower
+  EXPECT_EQ(sim.plant().validate(), "");
+}
+
+TEST(Hadrich, SamePlantForAnyThreadCountAndRun) {
+  const Scene s = load_scene("corner");
+  SceneQuery q(s);
+  const std::vector<std::string> sets = {"max_particles=3000", "wind_strength=2", "break_sensitivity=1"};
+  const Plant one = test::grow("hadrich", s, q, sets, 1, 5);
+  const Plant two = test::grow("hadrich", s, q, sets, 2, 5);
+  const Plant again = test::grow("hadrich", s, q, sets, 2, 5);
+  EXPECT_EQ(one.geometry_hash(), two.geometry_hash());
+  EXPECT_EQ(two.geometry_hash(), again.geometry_hash());
+  EXPECT_GT(one.nodes.size(), 2000u);
+  EXPECT_NE(one.geometry_hash(), test::grow("hadrich", s, q, sets, 2, 6).geometry_hash());
+}
+
+// The leaves sit on their particles, face the light (the sun is in front of the wall) or away from
+// the surface, and the plant on the wall is mostly attached.
+TEST(Hadrich, WallPlantClimbsAndLeavesFaceOut) {
+  const Scene s = load_scene("wall");
+  SceneQuery q(s);
+  const Plant plant = test::grow("hadrich", s, q, {"max_particles=4000"});
+  ASSERT_GT(plant.organs.size(), 1000u);
+  std::size_t facing = 0, near = 0;
+  float top = 0.0f;
+  for (const Organ& o : plant.organs) {
+    const glm::vec3 up = o.orientation * glm::vec3(0, 1, 0);
+    facing += glm::dot(up, glm::vec3(0, 0, 1)) > 0.0f ? 1 : 0;
+    EXPECT_EQ(o.position, plant.nodes[o.node].position);
+  }
+  for (const auto& n : plant.nodes) {
+    near += q.closest_point(n.position, 0.03f, true).found ? 1 : 0;
+    top = std::max(top, n.position.y);
+  }
+  EXPECT_GT(static_cast<double>(facing) / plant.organs.size(), 0.9);
+  EXPECT_GT(static_cast<double>(near) / plant.nodes.size(), 0.5);
+  EXPECT_GT(top, 1.0f);  // it climbed
+}
+
+}  // namespace
+}  // namespace growbench
