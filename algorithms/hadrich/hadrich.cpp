@@ -138,16 +138,18 @@ glm::vec3 any_perpendicular(const glm::vec3& f) {
 }
 
 // Rotation part of A (columns), by the iteration of Müller et al. 2016 ("A robust method to extract
-// the rotational part of deformations"), warm-started at q.
+// the rotational part of deformations"), warm-started at q (the group owner's predicted orientation,
+// which is within a small angle of the answer, so a few iterations suffice). Each update turns by
+// omega; the quaternion (1, omega / 2) normalised is that turn to second order in |omega|, without a
+// sine and cosine, and the iteration corrects what it misses.
 glm::quat extract_rotation(const glm::mat3& A, glm::quat q) {
-  for (int it = 0; it < 6; ++it) {
+  for (int it = 0; it < 4; ++it) {
     const glm::mat3 R = glm::mat3_cast(q);
     const glm::vec3 num = glm::cross(R[0], A[0]) + glm::cross(R[1], A[1]) + glm::cross(R[2], A[2]);
     const float den = std::abs(glm::dot(R[0], A[0]) + glm::dot(R[1], A[1]) + glm::dot(R[2], A[2])) + 1e-20f;
-    const glm::vec3 omega = num / den;
-    const float w = glm::length(omega);
-    if (w < 1e-7f) break;
-    q = glm::normalize(glm::angleAxis(w, omega / w) * q);
+    const glm::vec3 half = num * (0.5f / den);
+    if (glm::dot(half, half) < 1e-10f) break;  // below 2e-5 rad
+    q = glm::normalize(glm::quat(1.0f, half.x, half.y, half.z) * q);
   }
   return q;
 }
@@ -546,19 +548,20 @@ void Simulator::group_pass() {
         std::size_t j;
         glm::vec3 rest_x;
         glm::quat rest_q;
+        float mass = 0.0f;
       };
       std::array<Member, kMaxChildren + 2> m;
       std::size_t k = 0;
-      m[k++] = {i, glm::vec3(0.0f), glm::quat(1, 0, 0, 0)};
+      m[k++] = {i, glm::vec3(0.0f), glm::quat(1, 0, 0, 0), 0.0f};
       if (const std::int32_t par = p_.parent[i]; par >= 0) {
         const glm::vec3 o = glm::vec3(0, 0, p_.half[par]) + p_.rest[i] * glm::vec3(0, 0, p_.half[i]);  // parent frame
         const glm::quat rq = glm::conjugate(p_.rest[i]);
-        m[k++] = {static_cast<std::size_t>(par), -(rq * o), rq};
+        m[k++] = {static_cast<std::size_t>(par), -(rq * o), rq, 0.0f};
       }
       for (const std::int32_t c : p_.children[i]) {
         if (c < 0) continue;
         const glm::vec3 o = glm::vec3(0, 0, p_.half[i]) + p_.rest[c] * glm::vec3(0, 0, p_.half[c]);
-        m[k++] = {static_cast<std::size_t>(c), o, p_.rest[c]};
+        m[k++] = {static_cast<std::size_t>(c), o, p_.rest[c], 0.0f};
       }
       if (k == 1) {  // a lone particle: nothing to match
         p_.group_c[i] = p_.xp[i];
@@ -570,7 +573,7 @@ void Simulator::group_pass() {
       glm::vec3 c(0.0f), cbar(0.0f);
       for (std::size_t a = 0; a < k; ++a) {
         const std::size_t j = m[a].j;
-        const float mj = p_.half[j] * p_.radius[j] * p_.radius[j];
+        const float mj = m[a].mass = p_.half[j] * p_.radius[j] * p_.radius[j];
         mass += mj;
         c += mj * p_.xp[j];
         cbar += mj * m[a].rest_x;
@@ -580,7 +583,7 @@ void Simulator::group_pass() {
       glm::mat3 A(0.0f);
       for (std::size_t a = 0; a < k; ++a) {
         const std::size_t j = m[a].j;
-        const float mj = p_.half[j] * p_.radius[j] * p_.radius[j];
+        const float mj = m[a].mass;
         A += mj * glm::outerProduct(p_.xp[j] - c, m[a].rest_x - cbar);
         // The ellipsoid's own moment (Müller & Chentanez 2011): m/5 R diag(r^2, r^2, h^2) Rbar^T.
         const float r2 = p_.radius[j] * p_.radius[j], h2 = p_.half[j] * p_.half[j];
