@@ -299,6 +299,10 @@ float Simulator::max_radius(std::uint16_t order) const {
   return cfg_.max_radius * std::pow(cfg_.radius_falloff, static_cast<float>(order));
 }
 
+glm::vec3 Simulator::rest_offset(std::size_t parent, std::size_t child) const {
+  return glm::vec3(0, 0, p_.half[parent]) + p_.rest[child] * glm::vec3(0, 0, p_.half[child]);
+}
+
 glm::vec3 Simulator::head(std::size_t i) const { return p_.x[i] + forward(i) * p_.half[i]; }
 
 std::int32_t Simulator::activate(std::int32_t parent, const glm::vec3& tail, const glm::quat& q, std::uint32_t shoot,
@@ -554,13 +558,13 @@ void Simulator::group_pass() {
       std::size_t k = 0;
       m[k++] = {i, glm::vec3(0.0f), glm::quat(1, 0, 0, 0), 0.0f};
       if (const std::int32_t par = p_.parent[i]; par >= 0) {
-        const glm::vec3 o = glm::vec3(0, 0, p_.half[par]) + p_.rest[i] * glm::vec3(0, 0, p_.half[i]);  // parent frame
+        const glm::vec3 o = rest_offset(static_cast<std::size_t>(par), i);
         const glm::quat rq = glm::conjugate(p_.rest[i]);
         m[k++] = {static_cast<std::size_t>(par), -(rq * o), rq, 0.0f};
       }
       for (const std::int32_t c : p_.children[i]) {
         if (c < 0) continue;
-        const glm::vec3 o = glm::vec3(0, 0, p_.half[i]) + p_.rest[c] * glm::vec3(0, 0, p_.half[c]);
+        const glm::vec3 o = rest_offset(i, static_cast<std::size_t>(c));
         m[k++] = {static_cast<std::size_t>(c), o, p_.rest[c], 0.0f};
       }
       if (k == 1) {  // a lone particle: nothing to match
@@ -621,11 +625,10 @@ void Simulator::goal_pass() {
       if (!has_group) continue;
       add(j, glm::vec3(0.0f), glm::quat(1, 0, 0, 0));
       if (const std::int32_t par = p_.parent[j]; par >= 0)
-        add(static_cast<std::size_t>(par), glm::vec3(0, 0, p_.half[par]) + p_.rest[j] * glm::vec3(0, 0, p_.half[j]),
-            p_.rest[j]);
+        add(static_cast<std::size_t>(par), rest_offset(static_cast<std::size_t>(par), j), p_.rest[j]);
       for (const std::int32_t c : p_.children[j]) {
         if (c < 0) continue;
-        const glm::vec3 o = glm::vec3(0, 0, p_.half[j]) + p_.rest[c] * glm::vec3(0, 0, p_.half[c]);
+        const glm::vec3 o = rest_offset(j, static_cast<std::size_t>(c));
         const glm::quat rq = glm::conjugate(p_.rest[c]);
         add(static_cast<std::size_t>(c), -(rq * o), rq);
       }

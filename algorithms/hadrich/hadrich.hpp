@@ -141,6 +141,8 @@ class Simulator {
   [[nodiscard]] float occlusion(std::size_t i, const glm::vec3& at) const;
   [[nodiscard]] glm::vec3 wind(std::size_t i) const;
   [[nodiscard]] float max_radius(std::uint16_t order) const;
+  // A child's centre at rest, in its parent's frame: its tail on the parent's head.
+  [[nodiscard]] glm::vec3 rest_offset(std::size_t parent, std::size_t child) const;
 
   const Scene& scene_;
   const SceneQuery& query_;
