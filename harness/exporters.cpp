@@ -1,6 +1,10 @@
 #include "harness/exporters.hpp"
 
 #include <bit>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <type_traits>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -10,13 +14,16 @@
 #include <fmt/format.h>
 #include <tiny_gltf.h>
 
+#include "core/errors.hpp"
+
 namespace growbench {
 namespace {
 
 static_assert(std::endian::native == std::endian::little, "the PLY writer assumes a little-endian host");
 
-// Writes a buffer to a file via a temporary and a rename, so a reader never sees half a file.
-std::uint64_t write_file(const std::string& path, const char* data, std::size_t size) {
+}  // namespace
+
+std::uint64_t write_file_atomic(const std::string& path, const char* data, std::size_t size) {
   const std::string tmp = path + ".tmp";
   std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(tmp.c_str(), "wb"), &std::fclose);
   if (!f) throw std::runtime_error(fmt::format("{}: cannot open for writing", tmp));
@@ -28,8 +35,10 @@ std::uint64_t write_file(const std::string& path, const char* data, std::size_t 
   return size;
 }
 
+namespace {
+
 std::uint64_t write_buffer(const std::string& path, const fmt::memory_buffer& b) {
-  return write_file(path, b.data(), b.size());
+  return write_file_atomic(path, b.data(), b.size());
 }
 
 }  // namespace
@@ -166,7 +175,7 @@ std::uint64_t write_glb(const std::string& path, const OutputMesh& m) {
   if (!writer.WriteGltfSceneToStream(&model, out, false, true))
     throw std::runtime_error(fmt::format("{}: glTF serialisation failed", path));
   const std::string data = out.str();
-  return write_file(path, data.data(), data.size());
+  return write_file_atomic(path, data.data(), data.size());
 }
 
 std::uint64_t write_skeleton_obj(const std::string& path, const Plant& plant) {
@@ -182,6 +191,128 @@ std::uint64_t write_skeleton_obj(const std::string& path, const Plant& plant) {
     fmt::format_to(out, "\n");
   }
   return write_buffer(path, b);
+}
+
+}  // namespace growbench
+
+namespace growbench {
+namespace {
+
+constexpr char kSnapshotMagic[8] = {'G', 'B', 'P', 'L', 'A', 'N', 'T', '1'};
+
+template <class T>
+void put(std::string& b, const T& v) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  b.append(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+
+class SnapshotReader {
+ public:
+  SnapshotReader(std::string path, std::string data) : path_(std::move(path)), data_(std::move(data)) {}
+  template <class T>
+  T get() {
+    T v{};
+    if (pos_ + sizeof(T) > data_.size())
+      throw InputError(fmt::format("{}: plant snapshot cut short at byte {} of {}", path_, pos_, data_.size()));
+    std::memcpy(&v, data_.data() + pos_, sizeof(T));
+    pos_ += sizeof(T);
+    return v;
+  }
+  glm::vec3 vec3() {
+    const float x = get<float>(), y = get<float>(), z = get<float>();
+    return {x, y, z};
+  }
+  // A count that the rest of the file can hold (each item at least `item_bytes`), so a corrupt
+  // count is an error instead of a huge allocation.
+  std::size_t count(std::size_t item_bytes) {
+    const auto n = get<std::uint64_t>();
+    if (n > (data_.size() - pos_) / std::max<std::size_t>(item_bytes, 1))
+      throw InputError(fmt::format("{}: plant snapshot count {} at byte {} exceeds the file", path_, n, pos_ - 8));
+    return static_cast<std::size_t>(n);
+  }
+  [[nodiscard]] bool at_end() const { return pos_ == data_.size(); }
+
+ private:
+  std::string path_, data_;
+  std::size_t pos_ = 0;
+};
+
+}  // namespace
+
+std::uint64_t write_plant_snapshot(const std::string& path, const Plant& plant) {
+  std::string b(kSnapshotMagic, sizeof(kSnapshotMagic));
+  b.reserve(64 + plant.nodes.size() * 32 + plant.organs.size() * 64);
+  put<std::uint64_t>(b, plant.nodes.size());
+  for (const auto& n : plant.nodes) {
+    put(b, n.position);
+    put(b, n.radius);
+    put(b, n.parent);
+    put(b, n.order);
+    put(b, n.shoot);
+    put(b, n.birth_step);
+  }
+  put<std::uint64_t>(b, plant.organs.size());
+  for (const auto& o : plant.organs) {
+    put(b, o.position);
+    put(b, o.orientation.w);
+    put(b, o.orientation.x);
+    put(b, o.orientation.y);
+    put(b, o.orientation.z);
+    put(b, o.size);
+    put(b, static_cast<std::uint8_t>(o.kind));
+    put(b, o.node);
+    put(b, o.stamp);
+  }
+  put<std::uint64_t>(b, plant.polygons.size());
+  for (const auto& p : plant.polygons) {
+    put<std::uint64_t>(b, p.vertices.size());
+    for (const auto& v : p.vertices) put(b, v);
+  }
+  return write_file_atomic(path, b.data(), b.size());
+}
+
+Plant read_plant_snapshot(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(fmt::format("{}: cannot open plant snapshot", path));
+  std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (data.size() < sizeof(kSnapshotMagic) || std::memcmp(data.data(), kSnapshotMagic, sizeof(kSnapshotMagic)) != 0)
+    throw InputError(fmt::format("{}: not a growbench plant snapshot (expected the magic GBPLANT1)", path));
+  SnapshotReader r(path, std::move(data));
+  for (std::size_t i = 0; i < sizeof(kSnapshotMagic); ++i) r.get<char>();
+  Plant plant;
+  plant.nodes.resize(r.count(30));
+  for (auto& n : plant.nodes) {
+    n.position = r.vec3();
+    n.radius = r.get<float>();
+    n.parent = r.get<std::int32_t>();
+    n.order = r.get<std::uint16_t>();
+    n.shoot = r.get<std::uint32_t>();
+    n.birth_step = r.get<std::uint32_t>();
+  }
+  plant.organs.resize(r.count(49));
+  for (auto& o : plant.organs) {
+    o.position = r.vec3();
+    o.orientation.w = r.get<float>();
+    o.orientation.x = r.get<float>();
+    o.orientation.y = r.get<float>();
+    o.orientation.z = r.get<float>();
+    o.size = r.get<float>();
+    const auto kind = r.get<std::uint8_t>();
+    if (kind > static_cast<std::uint8_t>(OrganKind::Bud))
+      throw InputError(fmt::format("{}: plant snapshot has an unknown organ kind {}", path, kind));
+    o.kind = static_cast<OrganKind>(kind);
+    o.node = r.get<std::int32_t>();
+    o.stamp = r.get<std::array<float, 3>>();
+  }
+  plant.polygons.resize(r.count(8));
+  for (auto& p : plant.polygons) {
+    p.vertices.resize(r.count(12));
+    for (auto& v : p.vertices) v = r.vec3();
+  }
+  if (!r.at_end()) throw InputError(fmt::format("{}: plant snapshot has trailing bytes", path));
+  if (const std::string bad = plant.validate(); !bad.empty())
+    throw InputError(fmt::format("{}: plant snapshot holds an invalid plant: {}", path, bad));
+  return plant;
 }
 
 }  // namespace growbench

@@ -13,6 +13,8 @@
 #include "algorithms/algorithm.hpp"
 #include "algorithms/lsystem/lsystem.hpp"
 #include "core/errors.hpp"
+#include "harness/render_results.hpp"
+#include "harness/report.hpp"
 #include "harness/suite.hpp"
 #include "harness/trial.hpp"
 #include "scenes/scene_library.hpp"
@@ -71,6 +73,12 @@ int main(int argc, char** argv) {
   run->add_option("-o,--out", out_dir, "output directory (default: out/ALGORITHM-SCENE)");
   bool quiet = false;
   run->add_flag("-q,--quiet", quiet, "no progress line");
+  std::string run_render;
+  run->add_option("--render", run_render, "render the plant with POV-Ray afterwards: preview or paper (render.png)");
+  run->add_option("--frames", spec.frame_every,
+                  "growth animation: keep the plant every K steps (frames/); with --render, render them and make "
+                  "animation.mp4 with ffmpeg")
+      ->default_val(0);
 
   auto* suite_cmd = app.add_subcommand(
       "suite", "Run a suite: algorithms x scenes x seeds x sweeps x repetitions, each trial in its own process");
@@ -81,6 +89,29 @@ int main(int argc, char** argv) {
   suite_cmd->add_flag("--resume", resume, "continue an interrupted run in --out, skipping finished trials");
   suite_cmd->add_option("--shard", shard, "run only shard I of N (I/N, 0-based): a deterministic slice of the cells");
   suite_cmd->add_flag("-q,--quiet", suite_quiet, "no progress lines");
+  std::string suite_render;
+  suite_cmd->add_option("--render", suite_render,
+                        "render every trial with POV-Ray afterwards (preview or paper) and compose grid.png");
+
+  auto* render_cmd = app.add_subcommand(
+      "render", "Render a suite's results directory (every trial, then grid.png) or a `run` directory with POV-Ray");
+  std::string render_dir, render_quality = "preview";
+  gb::RenderDirOptions render_opts;
+  render_cmd->add_option("dir", render_dir, "a directory with results.json (suite) or record.json (run)")->required();
+  render_cmd->add_option("--quality", render_quality, "preview (480x360, no anti-aliasing) or paper (1600x1200, "
+                         "anti-aliased, soft shadows, radiosity)")->default_val("preview");
+  render_cmd->add_option("-j,--jobs", render_opts.jobs, "POV-Ray processes at once (0: one per core)")->default_val(0);
+  render_cmd->add_option("--width", render_opts.render.width, "image width (0: the quality's)")->default_val(0);
+  render_cmd->add_option("--height", render_opts.render.height, "image height (0: the quality's)")->default_val(0);
+  render_cmd->add_option("--branches", render_opts.render.branches, "branches as cones (cone and sphere chains) or mesh "
+                         "(the mesher's tubes as mesh2)")->default_val("cones")->check(CLI::IsMember({"cones", "mesh"}));
+  render_cmd->add_flag("-q,--quiet", render_opts.quiet, "no progress lines");
+
+  auto* report_cmd = app.add_subcommand(
+      "report", "Figures (PNG, PDF), LaTeX and Markdown tables and index.html from a results file alone");
+  std::string report_results, report_out;
+  report_cmd->add_option("results", report_results, "results.json written by `growbench suite`")->required();
+  report_cmd->add_option("-o,--out", report_out, "report directory (default: report/ beside the results file)");
 
   auto* lsys_cmd = app.add_subcommand(
       "lsystem", "Derive an L-system's string without drawing it: symbol counts, and the string with --print");
@@ -156,11 +187,23 @@ int main(int argc, char** argv) {
       }
       fmt::print("suite {}: {} cells x {} repetitions (+{} warm-up)\n", suite.name, suite.configs.size(),
                  suite.repetitions, suite.warmup);
+      std::optional<gb::RenderQuality> quality;
+      if (!suite_render.empty()) quality = gb::parse_render_quality(suite_render, "--render");
       const std::string path = gb::run_suite(suite, o);
-      std::ifstream in(path);
-      const auto results = nlohmann::json::parse(in);
-      fmt::print("{}", gb::summarize_results(results));
-      fmt::print("\nwrote {} and results.csv beside it\n", path);
+      {
+        std::ifstream in(path);
+        const auto results = nlohmann::json::parse(in);
+        fmt::print("{}", gb::summarize_results(results));
+        fmt::print("\nwrote {} and results.csv beside it\n", path);
+      }
+      if (quality) {
+        gb::RenderDirOptions ro;
+        ro.render.quality = *quality;
+        ro.quiet = suite_quiet;
+        const auto r = gb::render_directory(std::filesystem::path(path).parent_path().string(), ro);
+        fmt::print("rendered {} trials ({} failed) in {:.0f} s; grid: {}\n", r["renders"].get<int>(), r["failed"].get<int>(),
+                   r["wall_s"].get<double>(), (std::filesystem::path(path).parent_path() / r.value("grid", "")).string());
+      }
       return 0;
     }
     if (*lsys_cmd) {
@@ -191,6 +234,19 @@ int main(int argc, char** argv) {
       for (const auto& [c, n] : d.counts) fmt::print(stderr, "  {}  {}\n", c, n);
       return 0;
     }
+    if (*render_cmd) {
+      render_opts.render.quality = gb::parse_render_quality(render_quality);
+      const auto r = gb::render_directory(render_dir, render_opts);
+      fmt::print("rendered {} images ({} failed, {} POV-Ray warnings) in {:.1f} s with {} POV-Ray processes at once\n",
+                 r["renders"].get<int>(), r["failed"].get<int>(), r["warnings"].get<int>(), r["wall_s"].get<double>(),
+                 r["jobs"].get<int>());
+      if (r.contains("grid")) fmt::print("grid: {}\n", (std::filesystem::path(render_dir) / r["grid"].get<std::string>()).string());
+      return r["failed"].get<int>() > 0 ? 1 : 0;
+    }
+    if (*report_cmd) {
+      if (report_out.empty()) report_out = (std::filesystem::path(report_results).parent_path() / "report").string();
+      return gb::run_report(report_results, report_out, {});
+    }
     if (*summary_cmd) {
       std::ifstream in(results_file);
       if (!in) throw gb::InputError(fmt::format("{}: cannot open results file", results_file));
@@ -214,6 +270,8 @@ int main(int argc, char** argv) {
         out_dir = fmt::format("out/{}-{}", spec.algorithm, name);
       }
       spec.out_dir = out_dir;
+      std::optional<gb::RenderQuality> quality;
+      if (!run_render.empty()) quality = gb::parse_render_quality(run_render, "--render");
       const bool tty = isatty(STDERR_FILENO) != 0;
       auto last = std::chrono::steady_clock::now();
       auto progress = [&](const gb::Progress& p) {
@@ -238,6 +296,27 @@ int main(int argc, char** argv) {
                  ph["export"]["wall_s"].get<double>(), rec["peak_rss_bytes"].get<double>() / (1024.0 * 1024.0));
       fmt::print("  wrote {}/plant.obj, plant.ply, plant.glb, skeleton.obj, record.json (geometry hash {})\n", out_dir,
                  rec["geometry_hash"].get<std::string>());
+      if (rec.contains("frames"))
+        fmt::print("  kept {} frames in {}/frames (capture took {:.3f} s, not counted in growth)\n",
+                   rec["frames"]["count"].get<int>(), out_dir, ph["growth"]["frame_capture_wall_s"].get<double>());
+      if (quality) {
+        gb::RenderDirOptions ro;
+        ro.render.quality = *quality;
+        ro.quiet = quiet;
+        const auto r = gb::render_directory(out_dir, ro);
+        std::ifstream in(std::filesystem::path(out_dir) / "record.json");
+        const auto updated = nlohmann::json::parse(in);
+        const auto& rr = updated["render"];
+        if (rr["status"] == "ok")
+          fmt::print("  rendered {}/render.png ({}x{}, {}) in {:.2f} s of POV-Ray{}\n", out_dir, rr["width"].get<int>(),
+                     rr["height"].get<int>(), gb::to_string(*quality), rr["wall_s"].get<double>(),
+                     updated.contains("animation") ? fmt::format(", {} frames: {}", updated["animation"]["frames"].get<int>(),
+                                                                 updated["animation"].value("file", updated["animation"]["status"].get<std::string>()))
+                                                   : "");
+        else
+          fmt::print(stderr, "growbench: render failed: {}\n", rr.value("message", rr["status"].get<std::string>()));
+        return r["failed"].get<int>() > 0 ? 1 : 0;
+      }
       return 0;
     }
   } catch (const gb::InputError& e) {

@@ -105,31 +105,36 @@ void add_tube(OutputMesh& m, const Plant& plant, const std::vector<std::int32_t>
   }
 }
 
-void add_organ(OutputMesh& m, const Organ& organ, const MesherOptions& o) {
+void add_organ(OutputMesh& m, const Organ& organ, const TriangleMesh& shape) {
   const glm::mat3 r = glm::mat3_cast(organ.orientation);
   const float L = organ.size;
-  auto emit = [&](const std::vector<glm::vec3>& local, const std::vector<glm::uvec3>& tris) {
-    const auto base = static_cast<std::uint32_t>(m.positions.size());
-    const glm::vec3 n = r * glm::vec3(0, 1, 0);
-    for (const auto& v : local) {
-      m.positions.push_back(organ.position + r * (v * L));
-      m.normals.push_back(n);
-    }
-    for (const auto& t : tris) m.triangles.push_back(t + glm::uvec3(base));
-  };
-  if (!o.leaf_mesh.triangles.empty()) {
-    emit(o.leaf_mesh.vertices, o.leaf_mesh.triangles);
-  } else if (o.leaf_shape == "quad") {
-    emit({{-0.25f, 0, 0}, {0.25f, 0, 0}, {0.25f, 0, 1}, {-0.25f, 0, 1}}, {{0, 2, 1}, {0, 3, 2}});
-  } else {
-    emit({{0, 0, 0}, {0.25f, 0, 0.4f}, {0, 0, 1}, {-0.25f, 0, 0.4f}}, {{0, 2, 1}, {0, 3, 2}});
+  const auto base = static_cast<std::uint32_t>(m.positions.size());
+  const glm::vec3 n = r * glm::vec3(0, 1, 0);
+  for (const auto& v : shape.vertices) {
+    m.positions.push_back(organ.position + r * (v * L));
+    m.normals.push_back(n);
   }
+  for (const auto& t : shape.triangles) m.triangles.push_back(t + glm::uvec3(base));
 }
 
 }  // namespace
 
+TriangleMesh organ_shape(const MesherOptions& o) {
+  if (!o.leaf_mesh.triangles.empty()) return o.leaf_mesh;
+  TriangleMesh shape;
+  shape.name = o.leaf_shape;
+  if (o.leaf_shape == "quad") {
+    shape.vertices = {{-0.25f, 0, 0}, {0.25f, 0, 0}, {0.25f, 0, 1}, {-0.25f, 0, 1}};
+  } else {
+    shape.vertices = {{0, 0, 0}, {0.25f, 0, 0.4f}, {0, 0, 1}, {-0.25f, 0, 0.4f}};
+  }
+  shape.triangles = {{0, 2, 1}, {0, 3, 2}};
+  return shape;
+}
+
 OutputMesh mesh_plant(const Plant& plant, const MesherOptions& o) {
   OutputMesh m;
+  const TriangleMesh shape = organ_shape(o);
   auto group = [&](const char* name, const char* material, auto&& body) {
     const auto first = static_cast<std::uint32_t>(m.triangles.size());
     body();
@@ -141,11 +146,11 @@ OutputMesh mesh_plant(const Plant& plant, const MesherOptions& o) {
   });
   group("leaves", "leaf", [&] {
     for (const auto& organ : plant.organs)
-      if (organ.kind == OrganKind::Leaf || organ.kind == OrganKind::YoungLeaf) add_organ(m, organ, o);
+      if (organ.kind == OrganKind::Leaf || organ.kind == OrganKind::YoungLeaf) add_organ(m, organ, shape);
   });
   group("flowers", "flower", [&] {
     for (const auto& organ : plant.organs)
-      if (organ.kind == OrganKind::Flower || organ.kind == OrganKind::Bud) add_organ(m, organ, o);
+      if (organ.kind == OrganKind::Flower || organ.kind == OrganKind::Bud) add_organ(m, organ, shape);
   });
   group("polygons", "leaf", [&] {
     for (const auto& poly : plant.polygons) {

@@ -37,6 +37,10 @@ struct MesherOptions {
 
 OutputMesh mesh_plant(const Plant& plant, const MesherOptions& options = {});
 
+// The shape every leaf and flower is instanced from (options.leaf_mesh, else the named leaf_shape), in
+// the organ's local frame at unit length. Shared with the POV-Ray writer so renders match the meshes.
+TriangleMesh organ_shape(const MesherOptions& options = {});
+
 // Chains of nodes along which tubes run: each starts at a root or a branching point and follows the
 // main child (the one that continues the parent's shoot, else the first). Shared with the skeleton
 // exporter so polylines and tubes agree.

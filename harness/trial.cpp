@@ -199,6 +199,7 @@ nlohmann::json to_json(const TrialSpec& s) {
           {"threads", s.threads},           {"voxel_size", s.voxel_size},
           {"sides", s.mesher.sides},        {"budget_nodes", s.budget_nodes},
           {"budget_length_m", s.budget_length_m}, {"metrics", s.metrics},
+          {"frame_every", s.frame_every},
           {"fault", s.fault}};
 }
 
@@ -219,6 +220,7 @@ TrialSpec trial_spec_from_json(const nlohmann::json& j) {
   s.budget_nodes = j.value("budget_nodes", std::size_t{0});
   s.budget_length_m = j.value("budget_length_m", 0.0);
   s.metrics = j.value("metrics", true);
+  s.frame_every = j.value("frame_every", 0);
   s.fault = j.value("fault", std::string{});
   return s;
 }
@@ -228,6 +230,8 @@ nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const P
   Params params = default_params(entry);
   for (const auto& a : spec.params) params.set_assignment(a);
   if (spec.max_steps < 0) throw InputError(fmt::format("--max-steps must be >= 0, got {}", spec.max_steps));
+  if (spec.frame_every < 0) throw InputError(fmt::format("--frames must be >= 0, got {}", spec.frame_every));
+  if (spec.frame_every > 0 && spec.out_dir.empty()) throw InputError("--frames needs an output directory");
 
   std::unique_ptr<tbb::global_control> threads;
   if (spec.threads > 0)
@@ -272,6 +276,24 @@ nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const P
   int steps = 0;
   std::string stopped_by = "finished";
   Curve curve;
+  // Frame capture (growth animations): its cost is measured and taken out of the growth phase.
+  int frames = 0, last_frame = -1;
+  double frame_wall = 0.0, frame_cpu = 0.0;
+  auto capture = [&](int step) {
+    if (spec.frame_every <= 0 || step == last_frame) return;
+    const auto w0 = std::chrono::steady_clock::now();
+    const double c0 = cpu_seconds();
+    const std::filesystem::path d = std::filesystem::path(spec.out_dir) / "frames";
+    if (frames == 0) {
+      std::filesystem::remove_all(d);
+      std::filesystem::create_directories(d);
+    }
+    write_plant_snapshot((d / fmt::format("step_{:06d}.gbplant", step)).string(), algo->plant());
+    ++frames;
+    last_frame = step;
+    frame_wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+    frame_cpu += cpu_seconds() - c0;
+  };
   timer.run("growth", [&] {
     inject_fault(spec.fault);
     algo->start(scene, *query, params, spec.seed);
@@ -300,10 +322,19 @@ nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const P
       const double t = elapsed();
       curve.add(steps, algo->node_count(), algo->organ_count(), t);
       if (progress) progress({steps, algo->node_count(), t});
+      if (spec.frame_every > 0 && steps % spec.frame_every == 0 && more) capture(steps);
       if (!more) break;
     }
     algo->finish();
+    capture(steps);
   });
+  if (spec.frame_every > 0) {
+    phases["growth"]["wall_s"] = phases["growth"]["wall_s"].get<double>() - frame_wall;
+    phases["growth"]["cpu_s"] = phases["growth"]["cpu_s"].get<double>() - frame_cpu;
+    phases["growth"]["frame_capture_wall_s"] = frame_wall;
+    phases["growth"]["frame_capture_cpu_s"] = frame_cpu;
+    rec["frames"] = {{"every", spec.frame_every}, {"count", frames}, {"dir", "frames"}};
+  }
   const Plant& plant = algo->plant();
   if (const std::string bad = plant.validate(); !bad.empty())
     throw std::logic_error(fmt::format("algorithm '{}' produced an invalid plant: {}", spec.algorithm, bad));
@@ -329,6 +360,9 @@ nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const P
     bytes["skeleton_obj"] = write_skeleton_obj((d / "skeleton.obj").string(), plant);
   });
   if (spec.metrics) rec["metrics"] = timer.run("metrics", [&] { return compute_metrics(plant, *query); });
+  // The plant itself, for rendering later (`growbench render`); not an output format, not timed.
+  if (!spec.out_dir.empty())
+    rec["snapshot_bytes"] = write_plant_snapshot((std::filesystem::path(spec.out_dir) / "plant.gbplant").string(), plant);
 
   std::size_t segments = 0;
   for (const auto& n : plant.nodes) segments += n.parent != kNoParent ? 1 : 0;

@@ -1,0 +1,541 @@
+#include "harness/render.hpp"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <numbers>
+#include <sstream>
+
+#include <cairo.h>
+#include <fmt/format.h>
+
+#include "core/errors.hpp"
+#include "harness/exporters.hpp"
+#include "harness/process.hpp"
+
+namespace growbench {
+namespace fs = std::filesystem;
+
+RenderQuality parse_render_quality(const std::string& text, const std::string& option) {
+  if (text == "preview") return RenderQuality::Preview;
+  if (text == "paper") return RenderQuality::Paper;
+  throw InputError(fmt::format("{} '{}': expected preview or paper", option, text));
+}
+
+const char* to_string(RenderQuality q) { return q == RenderQuality::Paper ? "paper" : "preview"; }
+
+int render_width(const RenderOptions& o) {
+  return o.width > 0 ? o.width : o.quality == RenderQuality::Paper ? 1600 : 480;
+}
+int render_height(const RenderOptions& o) {
+  return o.height > 0 ? o.height : o.quality == RenderQuality::Paper ? 1200 : 360;
+}
+
+namespace {
+
+using Out = std::back_insert_iterator<fmt::memory_buffer>;
+
+// growbench (right-handed) to POV-Ray (left-handed): negate Z.
+glm::vec3 pov(const glm::vec3& v) { return {v.x, v.y, -v.z}; }
+
+void vec(Out out, const glm::vec3& v) { fmt::format_to(out, "<{:.6g},{:.6g},{:.6g}>", v.x, v.y, v.z); }
+
+// Radii below this are drawn at it: a zero radius is a degenerate POV-Ray primitive.
+constexpr float kMinRadius = 1e-4f;
+
+// Per-vertex normals when the mesh is smooth everywhere (every vertex's faces within 60 degrees of
+// their average, as on the bunny or the boulder); empty otherwise (boxes and capped cylinders are
+// drawn flat, so their edges stay sharp).
+std::vector<glm::vec3> smooth_normals(const TriangleMesh& m) {
+  std::vector<glm::vec3> n(m.vertices.size(), glm::vec3(0.0f));
+  std::vector<glm::vec3> face(m.triangles.size());
+  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+    const auto& tri = m.triangles[t];
+    face[t] = glm::cross(m.vertices[tri.y] - m.vertices[tri.x], m.vertices[tri.z] - m.vertices[tri.x]);
+    for (int k = 0; k < 3; ++k) n[tri[k]] += face[t];
+  }
+  for (auto& v : n) {
+    const float l = glm::length(v);
+    if (!(l > 0.0f)) return {};
+    v /= l;
+  }
+  const float cos60 = 0.5f;
+  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+    const float l = glm::length(face[t]);
+    if (!(l > 0.0f)) continue;
+    for (int k = 0; k < 3; ++k)
+      if (glm::dot(face[t] / l, n[m.triangles[t][k]]) < cos60) return {};
+  }
+  return n;
+}
+
+void write_mesh2(Out out, const std::vector<glm::vec3>& vertices, const std::vector<glm::vec3>& normals,
+                 const std::vector<glm::uvec3>& triangles, std::uint32_t first, std::uint32_t count) {
+  // Only the vertices the triangles use, renumbered.
+  std::vector<std::int64_t> remap(vertices.size(), -1);
+  std::vector<std::uint32_t> used;
+  for (std::uint32_t t = first; t < first + count; ++t)
+    for (int k = 0; k < 3; ++k)
+      if (remap[triangles[t][k]] < 0) {
+        remap[triangles[t][k]] = static_cast<std::int64_t>(used.size());
+        used.push_back(triangles[t][k]);
+      }
+  fmt::format_to(out, "mesh2 {{\n  vertex_vectors {{ {}", used.size());
+  for (std::size_t i = 0; i < used.size(); ++i) {
+    fmt::format_to(out, "{}", i % 4 == 0 ? ",\n    " : ", ");
+    vec(out, pov(vertices[used[i]]));
+  }
+  fmt::format_to(out, "\n  }}\n");
+  if (!normals.empty()) {
+    fmt::format_to(out, "  normal_vectors {{ {}", used.size());
+    for (std::size_t i = 0; i < used.size(); ++i) {
+      const glm::vec3 v = pov(normals[used[i]]);
+      fmt::format_to(out, "{}<{:.4f},{:.4f},{:.4f}>", i % 4 == 0 ? ",\n    " : ", ", v.x, v.y, v.z);
+    }
+    fmt::format_to(out, "\n  }}\n");
+  }
+  fmt::format_to(out, "  face_indices {{ {}", count);
+  for (std::uint32_t t = first; t < first + count; ++t)
+    fmt::format_to(out, "{}<{},{},{}>", (t - first) % 6 == 0 ? ",\n    " : ", ", remap[triangles[t].x], remap[triangles[t].y],
+                   remap[triangles[t].z]);
+  fmt::format_to(out, "\n  }}\n");
+}
+
+// A group of objects with one texture: a union when there are two or more (POV-Ray warns about a union
+// of one), the object itself when there is one, nothing when there are none. The members are written
+// into a buffer first, so the group's form is known before it starts.
+template <class F>
+void group(Out out, const char* comment, const std::string& texture, F&& members) {
+  fmt::memory_buffer body;
+  const std::size_t n = members(std::back_inserter(body));
+  if (n == 0) return;
+  fmt::format_to(out, "// {}: {}\n", comment, n);
+  if (n == 1) fmt::format_to(out, "object {{\n{}  texture {{ {} }}\n}}\n", fmt::to_string(body), texture);
+  else fmt::format_to(out, "union {{\n{}  texture {{ {} }}\n}}\n", fmt::to_string(body), texture);
+}
+
+glm::vec3 any_perpendicular(const glm::vec3& d) {
+  const glm::vec3 a = std::abs(d.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
+  return glm::normalize(glm::cross(d, a));
+}
+
+std::string read_text_file(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+std::uint64_t write_pov(const std::string& path, const Scene& scene, const Plant& plant, const RenderOptions& o) {
+  fmt::memory_buffer b;
+  auto out = std::back_inserter(b);
+  const bool paper = o.quality == RenderQuality::Paper;
+  const int w = render_width(o), h = render_height(o);
+  const float aspect = static_cast<float>(w) / static_cast<float>(h);
+
+  Aabb bounds = scene.bounds();
+  for (const auto& n : plant.nodes) bounds.extend(n.position);
+  if (bounds.empty()) bounds.extend(glm::vec3(0.0f));
+  const glm::vec3 centre = bounds.center();
+  const float diag = std::max(glm::length(bounds.size()), 1.0f);
+
+  fmt::format_to(out,
+                 "// growbench render: scene '{}', {} nodes, {} organs, quality {}\n"
+                 "#version 3.7;\n"
+                 "global_settings {{\n  assumed_gamma 1.0\n  max_trace_level 8\n",
+                 scene.name, plant.nodes.size(), plant.organs.size(), to_string(o.quality));
+  if (paper)
+    fmt::format_to(out,
+                   "  radiosity {{ pretrace_start 0.08 pretrace_end 0.01 count 60 nearest_count 5 error_bound 0.8\n"
+                   "              recursion_limit 1 low_error_factor 0.5 gray_threshold 0 brightness 1 }}\n");
+  fmt::format_to(out, "}}\n");
+  // One material set for every algorithm. Colours are sRGB; with radiosity the sky lights the scene, so
+  // ambient is off; in the preview a little ambient stands in for it.
+  fmt::format_to(out,
+                 "#default {{ finish {{ ambient {} diffuse 0.75 }} }}\n"
+                 "#declare GB_Bark = texture {{ pigment {{ srgb <0.40,0.27,0.17> }} finish {{ specular 0.05 roughness 0.1 }} }}\n"
+                 "#declare GB_Leaf = texture {{ pigment {{ srgb <0.24,0.52,0.16> }} finish {{ specular 0.15 roughness 0.04 }} }}\n"
+                 "#declare GB_YoungLeaf = texture {{ pigment {{ srgb <0.52,0.72,0.24> }} finish {{ specular 0.15 roughness 0.04 }} }}\n"
+                 "#declare GB_Flower = texture {{ pigment {{ srgb <0.95,0.80,0.88> }} finish {{ specular 0.1 roughness 0.05 }} }}\n"
+                 "#declare GB_Surface = texture {{ pigment {{ srgb <0.80,0.78,0.74> }} }}\n"
+                 "#declare GB_Ground = texture {{ pigment {{ checker srgb <0.56,0.55,0.52> srgb <0.62,0.61,0.58> scale {:.4g} }} }}\n",
+                 paper ? 0.0 : 0.12, std::max(0.25f, 0.05f * diag));
+  fmt::format_to(out,
+                 "sky_sphere {{ pigment {{ gradient y color_map {{ [0.0 srgb <0.93,0.94,0.95>] [0.5 srgb <0.93,0.94,0.95>]\n"
+                 "  [1.0 srgb <0.50,0.66,0.86>] }} scale 2 translate -1 }} }}\n");
+
+  // Camera: the scene's, with its vertical field of view kept at the image's aspect.
+  const float vfov = glm::radians(scene.camera.fov_deg);
+  const float hfov = 2.0f * std::atan(std::tan(0.5f * vfov) * aspect);
+  fmt::format_to(out, "camera {{ perspective location ");
+  vec(out, pov(scene.camera.position));
+  fmt::format_to(out, " look_at ");
+  vec(out, pov(scene.camera.look_at));
+  fmt::format_to(out, " right x*{:.6g} up y angle {:.6g} }}\n", aspect, glm::degrees(hfov));
+
+  // The scene light: the sun as a parallel light from far along its direction, or the point light.
+  const bool sun = scene.light.kind == Light::Kind::Sun;
+  const glm::vec3 towards = sun ? glm::normalize(scene.light.direction) : glm::normalize(scene.light.position - centre);
+  const glm::vec3 lpos = sun ? centre + towards * (20.0f * diag) : scene.light.position;
+  fmt::format_to(out, "light_source {{ ");
+  vec(out, pov(lpos));
+  fmt::format_to(out, " color srgb <1.0,0.98,0.94>");
+  if (sun) {
+    fmt::format_to(out, " parallel point_at ");
+    vec(out, pov(centre));
+  }
+  if (paper) {
+    // Soft shadows: a square area light about 2 degrees across as seen from the scene.
+    const float side = 0.035f * glm::length(lpos - centre);
+    const glm::vec3 u = any_perpendicular(towards) * side, v = glm::cross(towards, any_perpendicular(towards)) * side;
+    fmt::format_to(out, " area_light ");
+    vec(out, pov(u));
+    fmt::format_to(out, ", ");
+    vec(out, pov(v));
+    fmt::format_to(out, ", 5, 5 adaptive 1 jitter");
+  }
+  fmt::format_to(out, " }}\n");
+  if (!paper) {
+    fmt::format_to(out, "light_source {{ ");
+    vec(out, pov(scene.camera.position));
+    fmt::format_to(out, " color srgb 0.35 shadowless }}\n");
+  }
+
+  // Ground: a plane under everything (the scene's own ground mesh, when it has one, sits on it).
+  fmt::format_to(out, "plane {{ y, {:.6g} texture {{ GB_Ground }} }}\n", bounds.min.y - 1e-3f);
+
+  // Scene meshes.
+  for (const auto& m : scene.meshes) {
+    if (m.triangles.empty()) continue;
+    fmt::format_to(out, "// scene mesh '{}': {} triangles\n", m.name, m.triangles.size());
+    write_mesh2(out, m.vertices, smooth_normals(m), m.triangles, 0, static_cast<std::uint32_t>(m.triangles.size()));
+    fmt::format_to(out, "  texture {{ {} }}\n}}\n", m.climbable ? "GB_Surface" : "GB_Ground");
+  }
+
+  if (o.draw_plant) {
+    // Branches.
+    if (o.branches == "mesh") {
+      const OutputMesh tubes = mesh_plant(Plant{plant.nodes, {}, {}, {}, {}}, o.mesher);
+      if (!tubes.triangles.empty()) {
+        fmt::format_to(out, "// branches: {} nodes as one mesh2\n", plant.nodes.size());
+        write_mesh2(out, tubes.positions, tubes.normals, tubes.triangles, 0,
+                    static_cast<std::uint32_t>(tubes.triangles.size()));
+        fmt::format_to(out, "  texture {{ GB_Bark }}\n}}\n");
+      }
+    } else if (o.branches == "cones") {
+      std::vector<std::uint8_t> has_child(plant.nodes.size(), 0);
+      for (const auto& n : plant.nodes)
+        if (n.parent != kNoParent) has_child[static_cast<std::size_t>(n.parent)] = 1;
+      group(out, "branches: cones with a sphere at each joint", "GB_Bark", [&](Out o2) {
+        std::size_t count = 0;
+        for (std::size_t i = 0; i < plant.nodes.size(); ++i) {
+          const PlantNode& n = plant.nodes[i];
+          const float r = std::max(n.radius, kMinRadius);
+          if (n.parent != kNoParent) {
+            const PlantNode& p = plant.nodes[static_cast<std::size_t>(n.parent)];
+            if (glm::length(n.position - p.position) > 1e-5f) {
+              fmt::format_to(o2, "  cone {{ ");
+              vec(o2, pov(p.position));
+              fmt::format_to(o2, ",{:.5g},", std::max(p.radius, kMinRadius));
+              vec(o2, pov(n.position));
+              fmt::format_to(o2, ",{:.5g} }}\n", r);
+              ++count;
+            }
+          }
+          // Joints and tips are rounded; a root without children is a lone point and is skipped.
+          if (n.parent != kNoParent || has_child[i]) {
+            fmt::format_to(o2, "  sphere {{ ");
+            vec(o2, pov(n.position));
+            fmt::format_to(o2, ",{:.5g} }}\n", r);
+            ++count;
+          }
+        }
+        return count;
+      });
+    } else {
+      throw InputError(fmt::format("render branches '{}': expected cones or mesh", o.branches));
+    }
+
+    // Leaves and flowers: one declared mesh, instanced with matrices (column i of the instance's
+    // linear map is row i of POV-Ray's matrix; both sides converted to POV-Ray's handedness).
+    if (!plant.organs.empty()) {
+      TriangleMesh shape = organ_shape(o.mesher);
+      fmt::format_to(out, "#declare GB_OrganShape =\n");
+      write_mesh2(out, shape.vertices, {}, shape.triangles, 0, static_cast<std::uint32_t>(shape.triangles.size()));
+      fmt::format_to(out, "}}\n");
+      const glm::mat3 flip(glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, 0, -1));
+      auto organs = [&](std::initializer_list<OrganKind> kinds, const char* comment, const char* texture) {
+        group(out, comment, texture, [&](Out o2) {
+          std::size_t count = 0;
+          for (const auto& organ : plant.organs) {
+            if (std::find(kinds.begin(), kinds.end(), organ.kind) == kinds.end() || !(organ.size > 0.0f)) continue;
+            const glm::mat3 a = flip * glm::mat3_cast(organ.orientation) * flip * organ.size;
+            const glm::vec3 t = pov(organ.position);
+            fmt::format_to(o2, "  object {{ GB_OrganShape matrix <{:.5g},{:.5g},{:.5g}, {:.5g},{:.5g},{:.5g}, "
+                               "{:.5g},{:.5g},{:.5g}, {:.6g},{:.6g},{:.6g}> }}\n",
+                           a[0].x, a[0].y, a[0].z, a[1].x, a[1].y, a[1].z, a[2].x, a[2].y, a[2].z, t.x, t.y, t.z);
+            ++count;
+          }
+          return count;
+        });
+      };
+      organs({OrganKind::Leaf}, "leaves", "GB_Leaf");
+      organs({OrganKind::YoungLeaf}, "young leaves", "GB_YoungLeaf");
+      organs({OrganKind::Flower, OrganKind::Bud}, "flowers and buds", "GB_Flower");
+    }
+
+    // L-system polygons: one mesh2 of fans.
+    std::vector<glm::vec3> pv;
+    std::vector<glm::uvec3> pt;
+    for (const auto& poly : plant.polygons) {
+      if (poly.vertices.size() < 3) continue;
+      const auto base = static_cast<std::uint32_t>(pv.size());
+      pv.insert(pv.end(), poly.vertices.begin(), poly.vertices.end());
+      for (std::uint32_t i = 1; i + 1 < poly.vertices.size(); ++i) {
+        const glm::vec3 e = glm::cross(poly.vertices[i] - poly.vertices[0], poly.vertices[i + 1] - poly.vertices[0]);
+        if (glm::length(e) > 1e-12f) pt.emplace_back(base, base + i, base + i + 1);  // POV-Ray warns on degenerate ones
+      }
+    }
+    if (!pt.empty()) {
+      fmt::format_to(out, "// polygons: {}\n", plant.polygons.size());
+      write_mesh2(out, pv, {}, pt, 0, static_cast<std::uint32_t>(pt.size()));
+      fmt::format_to(out, "  texture {{ GB_Leaf }}\n}}\n");
+    }
+  }
+  fs::create_directories(fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path());
+  return write_file_atomic(path, b.data(), b.size());
+}
+
+nlohmann::json RenderResult::to_json() const {
+  nlohmann::json j = {{"status", status}, {"png", png},       {"pov", pov},         {"width", width},
+                      {"height", height}, {"pov_bytes", pov_bytes}, {"write_s", write_s}, {"wall_s", wall_s},
+                      {"cpu_s", cpu_s},   {"warnings", warnings}};
+  if (!message.empty()) j["message"] = message;
+  return j;
+}
+
+std::string find_povray() {
+  const char* path = std::getenv("PATH");
+  std::stringstream ss(path ? path : "/usr/bin:/bin");
+  for (std::string dir; std::getline(ss, dir, ':');) {
+    const fs::path p = fs::path(dir.empty() ? "." : dir) / "povray";
+    if (access(p.c_str(), X_OK) == 0) return p.string();
+  }
+  return "";
+}
+
+std::string povray_version() {
+  const std::string bin = find_povray();
+  if (bin.empty()) return "";
+  std::string out;
+  if (FILE* p = popen(fmt::format("'{}' --version 2>&1", bin).c_str(), "r")) {
+    char buf[256];
+    if (std::fgets(buf, sizeof(buf), p)) out = buf;
+    while (std::fgets(buf, sizeof(buf), p)) {
+    }
+    pclose(p);
+  }
+  while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
+  return out;
+}
+
+RenderResult run_povray(const std::string& pov_path, const std::string& png_path, const RenderOptions& o) {
+  RenderResult r;
+  r.pov = pov_path;
+  r.png = png_path;
+  r.log = png_path + ".log";
+  r.width = render_width(o);
+  r.height = render_height(o);
+  const std::string bin = find_povray();
+  if (bin.empty()) {
+    r.status = "no_povray";
+    r.message = "povray is not installed (scripts/install-deps installs Debian's povray package)";
+    return r;
+  }
+  // POV-Ray runs in the output directory with relative file names: Debian's povray.conf restricts
+  // reading and writing to the working directory and below.
+  const fs::path png_abs = fs::absolute(png_path), pov_abs = fs::absolute(pov_path);
+  const fs::path dir = png_abs.parent_path();
+  std::error_code ec;
+  fs::remove(png_abs, ec);
+  fs::remove(r.log, ec);
+  std::vector<std::string> args = {bin,
+                                   "+I" + pov_abs.lexically_relative(dir).string(),
+                                   "+O" + png_abs.filename().string(),
+                                   fmt::format("+W{}", r.width),
+                                   fmt::format("+H{}", r.height),
+                                   "+FN",
+                                   "-D",  // no display window (and no ASCII-art preview in the log)
+                                   "-V",
+                                   "-P",
+                                   fmt::format("+WT{}", std::max(1, o.threads))};
+  if (o.quality == RenderQuality::Paper) {
+    args.insert(args.end(), {"+A0.1", "+AM2", "+R3"});
+  } else {
+    args.push_back("-A");
+  }
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const std::string dir_s = dir.string();
+  const auto t0 = std::chrono::steady_clock::now();
+  ChildResult cr;
+  try {
+    // Between fork and exec only async-signal-safe calls (chdir, execv): the caller may have threads.
+    cr = run_forked(
+        [&]() -> int {
+          if (chdir(dir_s.c_str()) != 0) return 126;
+          execv(argv[0], argv.data());
+          return 127;
+        },
+        {o.timeout_s, 0}, fs::absolute(r.log).string());
+  } catch (const std::exception& e) {
+    r.status = "failed";
+    r.message = e.what();
+    return r;
+  }
+  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.cpu_s = cr.user_s + cr.system_s;
+  const std::string log = read_text_file(r.log);
+  std::vector<std::string> errors;
+  {
+    std::stringstream ss(log);
+    for (std::string line; std::getline(ss, line);) {
+      // "Parse Warning: ...", "Possible Parse Error: ...", "Parse Error: ..." (the banner's "Warning Stream
+      // to console" lines have no colon after the word).
+      if (line.find("Warning:") != std::string::npos) r.warnings.push_back(line);
+      if (line.find("Error:") != std::string::npos || line.find("error:") != std::string::npos) errors.push_back(line);
+    }
+  }
+  if (cr.timed_out) {
+    r.status = "timeout";
+    r.message = fmt::format("POV-Ray was stopped after {:.0f} s", o.timeout_s);
+  } else if (cr.exit_code != 0 || cr.signal != 0 || !fs::exists(png_abs)) {
+    r.status = "failed";
+    std::string why = cr.signal != 0 ? fmt::format("killed by signal {}", cr.signal)
+                                     : fmt::format("exit status {}", cr.exit_code);
+    if (cr.exit_code == 127) why = fmt::format("cannot run {}", bin);
+    r.message = fmt::format("POV-Ray failed on {} ({})", pov_path, why);
+    for (std::size_t i = 0; i < errors.size() && i < 6; ++i) r.message += "\n  " + errors[i];
+    if (errors.empty()) r.message += fmt::format("; see {}", r.log);
+  }
+  return r;
+}
+
+RenderResult render_plant(const Scene& scene, const Plant& plant, const std::string& pov_path, const std::string& png_path,
+                          const RenderOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::uint64_t bytes = 0;
+  try {
+    bytes = write_pov(pov_path, scene, plant, o);
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    RenderResult r;
+    r.status = "failed";
+    r.message = fmt::format("cannot write {}: {}", pov_path, e.what());
+    r.pov = pov_path;
+    r.png = png_path;
+    return r;
+  }
+  const double write_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  RenderResult r = run_povray(pov_path, png_path, o);
+  r.pov_bytes = bytes;
+  r.write_s = write_s;
+  return r;
+}
+
+void write_grid(const std::string& png_path, const std::string& title, const std::vector<std::string>& row_labels,
+                const std::vector<std::string>& col_labels, const std::vector<std::vector<std::string>>& cells,
+                const std::vector<std::vector<std::string>>& notes, int cell_width) {
+  const int rows = static_cast<int>(row_labels.size()), cols = static_cast<int>(col_labels.size());
+  // The cell aspect follows the first image found (4:3 when there is none).
+  double aspect = 0.75;
+  for (const auto& row : cells)
+    for (const auto& c : row)
+      if (!c.empty() && fs::exists(c) && aspect == 0.75) {
+        cairo_surface_t* s = cairo_image_surface_create_from_png(c.c_str());
+        if (cairo_surface_status(s) == CAIRO_STATUS_SUCCESS)
+          aspect = static_cast<double>(cairo_image_surface_get_height(s)) / cairo_image_surface_get_width(s);
+        cairo_surface_destroy(s);
+      }
+  const int cw = cell_width, ch = static_cast<int>(std::lround(cell_width * aspect));
+  const int pad = 6, label_w = 170, header_h = 30, title_h = title.empty() ? 0 : 40;
+  const int W = label_w + cols * (cw + pad) + pad, H = title_h + header_h + rows * (ch + pad) + pad;
+  std::unique_ptr<cairo_surface_t, void (*)(cairo_surface_t*)> surface(
+      cairo_image_surface_create(CAIRO_FORMAT_RGB24, W, H), &cairo_surface_destroy);
+  std::unique_ptr<cairo_t, void (*)(cairo_t*)> cr(cairo_create(surface.get()), &cairo_destroy);
+  cairo_t* c = cr.get();
+  cairo_set_source_rgb(c, 1, 1, 1);
+  cairo_paint(c);
+  cairo_select_font_face(c, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
+  auto text = [&](const std::string& s, double x, double y, double size, double max_w) {
+    cairo_set_font_size(c, size);
+    cairo_text_extents_t e;
+    cairo_text_extents(c, s.c_str(), &e);
+    if (e.width > max_w && e.width > 0) {
+      cairo_set_font_size(c, size * max_w / e.width);
+      cairo_text_extents(c, s.c_str(), &e);
+    }
+    cairo_move_to(c, x - e.width / 2 - e.x_bearing, y - e.height / 2 - e.y_bearing);
+    cairo_show_text(c, s.c_str());
+  };
+  cairo_set_source_rgb(c, 0.1, 0.1, 0.1);
+  if (!title.empty()) text(title, W / 2.0, title_h / 2.0 + 4, 20, W - 20);
+  for (int j = 0; j < cols; ++j)
+    text(col_labels[static_cast<std::size_t>(j)], label_w + pad + j * (cw + pad) + cw / 2.0, title_h + header_h / 2.0, 15, cw - 8);
+  for (int i = 0; i < rows; ++i) {
+    const double y0 = title_h + header_h + i * (ch + pad);
+    cairo_set_source_rgb(c, 0.1, 0.1, 0.1);
+    text(row_labels[static_cast<std::size_t>(i)], label_w / 2.0, y0 + ch / 2.0, 15, label_w - 12);
+    for (int j = 0; j < cols; ++j) {
+      const double x0 = label_w + pad + j * (cw + pad);
+      const std::string& file = static_cast<std::size_t>(i) < cells.size() && static_cast<std::size_t>(j) < cells[i].size()
+                                    ? cells[i][j]
+                                    : std::string();
+      bool drawn = false;
+      if (!file.empty() && fs::exists(file)) {
+        cairo_surface_t* img = cairo_image_surface_create_from_png(file.c_str());
+        if (cairo_surface_status(img) == CAIRO_STATUS_SUCCESS) {
+          const double sx = cw / static_cast<double>(cairo_image_surface_get_width(img));
+          const double sy = ch / static_cast<double>(cairo_image_surface_get_height(img));
+          cairo_save(c);
+          cairo_translate(c, x0, y0);
+          cairo_scale(c, sx, sy);
+          cairo_set_source_surface(c, img, 0, 0);
+          cairo_pattern_set_filter(cairo_get_source(c), CAIRO_FILTER_GOOD);
+          cairo_paint(c);
+          cairo_restore(c);
+          drawn = true;
+        }
+        cairo_surface_destroy(img);
+      }
+      if (!drawn) {
+        cairo_set_source_rgb(c, 0.85, 0.85, 0.85);
+        cairo_rectangle(c, x0, y0, cw, ch);
+        cairo_fill(c);
+        cairo_set_source_rgb(c, 0.35, 0.35, 0.35);
+        std::string note = "no render";
+        if (static_cast<std::size_t>(i) < notes.size() && static_cast<std::size_t>(j) < notes[i].size() && !notes[i][j].empty())
+          note = notes[i][j];
+        text(note, x0 + cw / 2.0, y0 + ch / 2.0, 13, cw - 12);
+      }
+    }
+  }
+  cairo_surface_flush(surface.get());
+  const std::string tmp = png_path + ".tmp";
+  if (cairo_surface_write_to_png(surface.get(), tmp.c_str()) != CAIRO_STATUS_SUCCESS)
+    throw std::runtime_error(fmt::format("{}: cannot write the grid image", png_path));
+  fs::rename(tmp, png_path);
+}
+
+}  // namespace growbench

@@ -1,0 +1,82 @@
+// Rendering with POV-Ray: one scene writer for every algorithm (the same materials, camera, light, sky
+// and ground), POV-Ray run as a child process with its time recorded apart from the algorithm's, and
+// comparison grids composed with cairo.
+//
+// Coordinates: growbench is right-handed with Y up; POV-Ray is left-handed with Y up. The writer
+// negates Z everywhere (points, normals, instance matrices, camera and light), which mirrors nothing
+// in the image. The scene camera's fov_deg is the vertical field of view.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "algorithms/plant.hpp"
+#include "harness/mesher.hpp"
+#include "scenes/scene.hpp"
+
+namespace growbench {
+
+enum class RenderQuality { Preview, Paper };
+// "preview" or "paper"; anything else is an InputError naming the option.
+RenderQuality parse_render_quality(const std::string& text, const std::string& option = "--quality");
+const char* to_string(RenderQuality q);
+
+struct RenderOptions {
+  // preview: 480x360, no anti-aliasing, one sun with hard shadows and a weak fill light (CI, quick looks).
+  // paper: 1600x1200, adaptive anti-aliasing, an area light for soft shadows and radiosity.
+  RenderQuality quality = RenderQuality::Preview;
+  int width = 0, height = 0;  // 0: the preset's size
+  int threads = 1;            // POV-Ray's +WT for one render
+  // "cones": each segment a cone with a sphere at each joint (POV-Ray's own primitives, exactly round);
+  // "mesh": the shared mesher's tubes as one mesh2. Cones are the default: see CONTRIBUTING.md for the
+  // measured render times.
+  std::string branches = "cones";
+  bool draw_plant = true;  // false: the scene alone (the tests compare renders with and without the plant)
+  double timeout_s = 900.0;
+  MesherOptions mesher;    // tube sides (branches=mesh) and the leaf shape
+};
+
+[[nodiscard]] int render_width(const RenderOptions& o);
+[[nodiscard]] int render_height(const RenderOptions& o);
+
+// Writes a POV-Ray 3.7 scene file (`#version 3.7`, `assumed_gamma 1.0`): the scene's meshes as mesh2,
+// the plant's branches, its leaves and flowers instanced from one declared mesh each, the scene camera
+// and light, a sky and a ground plane. Returns the bytes written.
+std::uint64_t write_pov(const std::string& path, const Scene& scene, const Plant& plant, const RenderOptions& options);
+
+struct RenderResult {
+  std::string status = "ok";          // ok | failed | timeout | no_povray
+  std::string message;                // why it failed, with POV-Ray's own error lines
+  std::vector<std::string> warnings;  // POV-Ray's warning lines (a clean scene has none)
+  std::string pov, png, log;          // the files (paths as given)
+  int width = 0, height = 0;
+  std::uint64_t pov_bytes = 0;
+  double write_s = 0.0;               // writing the .pov file
+  double wall_s = 0.0, cpu_s = 0.0;   // the POV-Ray process (parse + render), apart from the trial's time
+  [[nodiscard]] bool ok() const { return status == "ok"; }
+  [[nodiscard]] nlohmann::json to_json() const;
+};
+
+// The povray binary on PATH ("" when there is none).
+std::string find_povray();
+// `povray --version`'s first line ("" when there is no povray).
+std::string povray_version();
+
+// Runs POV-Ray on POV_PATH writing PNG_PATH (its log beside the PNG, .log). Never throws for a POV-Ray
+// failure: the result's status and message say what happened. Safe to call from several threads.
+RenderResult run_povray(const std::string& pov_path, const std::string& png_path, const RenderOptions& options);
+
+// write_pov, then run_povray. The .pov file is kept beside the image for inspection.
+RenderResult render_plant(const Scene& scene, const Plant& plant, const std::string& pov_path, const std::string& png_path,
+                          const RenderOptions& options);
+
+// One labelled image: `cells` is rows x cols PNG paths (an empty path or a missing file draws a grey
+// box with `notes[r][c]`, if given). Throws std::runtime_error naming the file it cannot write.
+void write_grid(const std::string& png_path, const std::string& title, const std::vector<std::string>& row_labels,
+                const std::vector<std::string>& col_labels, const std::vector<std::vector<std::string>>& cells,
+                const std::vector<std::vector<std::string>>& notes = {}, int cell_width = 320);
+
+}  // namespace growbench

@@ -1,0 +1,327 @@
+#include "harness/render_results.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "core/errors.hpp"
+#include "harness/exporters.hpp"
+#include "harness/process.hpp"
+#include "scenes/scene_library.hpp"
+
+namespace growbench {
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+std::string safe_name(const std::string& s) {
+  std::string out;
+  for (const char ch : s) out += (std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '_' || ch == '.') ? ch : '-';
+  return out.empty() ? "unnamed" : out;
+}
+
+namespace {
+
+json read_json(const fs::path& p) {
+  std::ifstream in(p);
+  if (!in) throw InputError(fmt::format("{}: cannot open", p.string()));
+  try {
+    return json::parse(in);
+  } catch (const json::exception& e) {
+    throw InputError(fmt::format("{}: not valid JSON: {}", p.string(), e.what()));
+  }
+}
+
+void write_json(const fs::path& p, const json& j, int indent) {
+  const std::string text = j.dump(indent) + "\n";
+  write_file_atomic(p.string(), text.data(), text.size());
+}
+
+struct Job {
+  std::string key;          // trial id ("" for a run directory)
+  fs::path snapshot, pov, png;
+  std::string scene_spec;
+  std::vector<std::string> scene_params;
+  bool frame = false;
+  RenderResult result;
+  std::string error;        // a snapshot or scene that could not be read
+};
+
+std::string find_on_path(const std::string& name) {
+  const char* path = std::getenv("PATH");
+  std::stringstream ss(path ? path : "/usr/bin:/bin");
+  for (std::string dir; std::getline(ss, dir, ':');) {
+    const fs::path p = fs::path(dir.empty() ? "." : dir) / name;
+    if (access(p.c_str(), X_OK) == 0) return p.string();
+  }
+  return "";
+}
+
+// The frames of a trial directory, in step order.
+std::vector<fs::path> frame_snapshots(const fs::path& trial_dir) {
+  std::vector<fs::path> out;
+  const fs::path d = trial_dir / "frames";
+  if (!fs::is_directory(d)) return out;
+  for (const auto& e : fs::directory_iterator(d))
+    if (e.path().extension() == ".gbplant") out.push_back(e.path());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// ffmpeg: frames/step_*.png to animation.mp4 (H.264, even dimensions). Returns a record of the attempt.
+json make_animation(const fs::path& trial_dir, std::size_t frames) {
+  json a = {{"frames", frames}, {"frame_pattern", "frames/step_*.png"}};
+  const std::string ffmpeg = find_on_path("ffmpeg");
+  if (ffmpeg.empty()) {
+    a["status"] = "no_ffmpeg";
+    a["message"] = "ffmpeg is not installed: the numbered PNG frames are the animation";
+    return a;
+  }
+  std::vector<std::string> args = {ffmpeg, "-y", "-loglevel", "error", "-framerate", "12", "-pattern_type", "glob",
+                                   "-i", "frames/step_*.png", "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt",
+                                   "yuv420p", "animation.mp4"};
+  std::vector<char*> argv;
+  for (auto& s : args) argv.push_back(s.data());
+  argv.push_back(nullptr);
+  const std::string dir = trial_dir.string();
+  const ChildResult cr = run_forked(
+      [&]() -> int {
+        if (chdir(dir.c_str()) != 0) return 126;
+        execv(argv[0], argv.data());
+        return 127;
+      },
+      {600.0, 0}, (trial_dir / "animation.log").string());
+  if (cr.exit_code == 0 && fs::exists(trial_dir / "animation.mp4")) {
+    a["status"] = "ok";
+    a["file"] = "animation.mp4";
+    a["bytes"] = fs::file_size(trial_dir / "animation.mp4");
+  } else {
+    a["status"] = "failed";
+    a["message"] = fmt::format("ffmpeg failed (exit {}); see {}", cr.exit_code, (trial_dir / "animation.log").string());
+  }
+  return a;
+}
+
+}  // namespace
+
+json render_directory(const std::string& dir_arg, const RenderDirOptions& o) {
+  const fs::path dir(dir_arg);
+  const bool suite = fs::exists(dir / "results.json");
+  if (!suite && !fs::exists(dir / "record.json"))
+    throw InputError(fmt::format("{}: neither a suite results directory (results.json) nor a run directory (record.json)",
+                                 dir_arg));
+  json doc = read_json(suite ? dir / "results.json" : dir / "record.json");
+
+  std::vector<Job> jobs;
+  std::map<std::string, std::size_t> trial_index;  // id -> index in doc["trials"]
+  auto add_trial = [&](const std::string& key, const fs::path& tdir, const std::string& scene_spec,
+                       const std::vector<std::string>& scene_params) {
+    if (!fs::exists(tdir / "plant.gbplant")) return false;
+    jobs.push_back({key, tdir / "plant.gbplant", tdir / "render.pov", tdir / "render.png", scene_spec, scene_params, false, {}, {}});
+    for (const auto& f : frame_snapshots(tdir)) {
+      fs::path png = f;
+      png.replace_extension(".png");
+      fs::path pov = f;
+      pov.replace_extension(".pov");
+      jobs.push_back({key, f, pov, png, scene_spec, scene_params, true, {}, {}});
+    }
+    return true;
+  };
+  std::size_t skipped = 0;
+  if (suite) {
+    if (!doc.contains("trials")) throw InputError(fmt::format("{}: no trials", (dir / "results.json").string()));
+    for (std::size_t i = 0; i < doc["trials"].size(); ++i) {
+      const json& t = doc["trials"][i];
+      const std::string id = t.value("id", "");
+      trial_index[id] = i;
+      const json& spec = t.contains("spec") ? t["spec"] : json::object();
+      if (!add_trial(id, dir / "trials" / id, spec.value("scene", t.value("scene_spec", "")),
+                     spec.value("scene_params", std::vector<std::string>{})))
+        ++skipped;
+    }
+  } else {
+    const json& sc = doc.at("scene");
+    if (!add_trial("", dir, sc.value("spec", ""), sc.value("params", std::vector<std::string>{})))
+      throw InputError(fmt::format("{}: no plant.gbplant to render (written by growbench run and suite trials)", dir_arg));
+  }
+
+  const int cores = std::max(1u, std::thread::hardware_concurrency());
+  const int workers = std::max(1, std::min<int>(o.jobs > 0 ? o.jobs : cores, static_cast<int>(jobs.size())));
+  RenderOptions ro = o.render;
+  ro.threads = std::max(1, cores / workers);
+  if (!jobs.empty() && find_povray().empty())
+    throw InputError("povray is not installed: run scripts/install-deps (Debian's povray package) and render again");
+
+  std::mutex scene_mutex, print_mutex;
+  std::map<std::string, std::shared_ptr<const Scene>> scenes;
+  auto scene_for = [&](const Job& j) {
+    std::lock_guard lock(scene_mutex);
+    std::string key = j.scene_spec;
+    for (const auto& p : j.scene_params) key += "\n" + p;
+    auto& s = scenes[key];
+    if (!s) s = std::make_shared<const Scene>(load_scene(j.scene_spec, j.scene_params));
+    return s;
+  };
+  std::atomic<std::size_t> next{0}, done{0};
+  const bool tty = isatty(STDERR_FILENO) != 0 && !o.quiet;
+  const auto t0 = std::chrono::steady_clock::now();
+  auto worker = [&] {
+    for (std::size_t k; (k = next.fetch_add(1)) < jobs.size();) {
+      Job& j = jobs[k];
+      try {
+        const auto scene = scene_for(j);
+        const Plant plant = read_plant_snapshot(j.snapshot.string());
+        j.result = render_plant(*scene, plant, j.pov.string(), j.png.string(), ro);
+      } catch (const std::exception& e) {
+        j.error = e.what();
+        j.result.status = "failed";
+        j.result.message = e.what();
+      }
+      const std::size_t n = ++done;
+      if (!o.quiet) {
+        std::lock_guard lock(print_mutex);
+        const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        const std::string what = j.key.empty() ? j.png.filename().string() : j.key + (j.frame ? "/" + j.png.filename().string() : "");
+        const std::string line =
+            fmt::format("render [{}/{}] {}: {} ({:.1f} s), ETA {:.0f} s", n, jobs.size(), what, j.result.status,
+                        j.result.wall_s, el / static_cast<double>(n) * static_cast<double>(jobs.size() - n));
+        if (tty) fmt::print(stderr, "\r{:<110}", line.substr(0, 110));
+        else fmt::print(stderr, "{}\n", line);
+        if (!j.result.ok()) fmt::print(stderr, "{}growbench: render failed: {}\n", tty ? "\n" : "", j.result.message);
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int i = 0; i < workers; ++i) pool.emplace_back(worker);
+  for (auto& th : pool) th.join();
+  if (tty) fmt::print(stderr, "\r{:<110}\r", "");
+  const double total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  // Records: paths relative to DIR, so the directory can move.
+  auto rel = [&](const fs::path& p) { return p.lexically_relative(dir).string(); };
+  std::size_t ok = 0, failed = 0, warnings = 0;
+  double povray_s = 0.0;
+  std::map<std::string, std::size_t> frames_of;
+  std::map<std::string, std::vector<std::string>> frame_failures;
+  for (auto& j : jobs) {
+    j.result.ok() ? ++ok : ++failed;
+    warnings += j.result.warnings.size();
+    povray_s += j.result.wall_s;
+    if (j.frame) {
+      ++frames_of[j.key];
+      if (!j.result.ok()) frame_failures[j.key].push_back(j.result.message);
+      continue;
+    }
+    json r = j.result.to_json();
+    r["png"] = rel(j.png);
+    r["pov"] = rel(j.pov);
+    r["quality"] = to_string(ro.quality);
+    r["branches"] = ro.branches;
+    r["threads"] = ro.threads;
+    if (suite) doc["trials"][trial_index[j.key]]["render"] = r;
+    else doc["render"] = r;
+  }
+  for (const auto& [key, n] : frames_of) {
+    const fs::path tdir = suite ? dir / "trials" / key : dir;
+    json a = frame_failures.count(key) ? json{{"status", "failed"}, {"frames", n}, {"message", frame_failures[key].front()}}
+                                       : make_animation(tdir, n);
+    if (suite) {
+      if (a.contains("file")) a["file"] = rel(tdir / a["file"].get<std::string>());
+      doc["trials"][trial_index[key]]["animation"] = a;
+    } else {
+      doc["animation"] = a;
+    }
+    if (!o.quiet) fmt::print(stderr, "animation {}: {} frames, {}\n", key.empty() ? dir_arg : key, n, a["status"].get<std::string>());
+  }
+
+  json summary = {{"quality", to_string(ro.quality)},
+                  {"branches", ro.branches},
+                  {"width", render_width(ro)},
+                  {"height", render_height(ro)},
+                  {"povray", povray_version()},
+                  {"jobs", workers},
+                  {"threads_per_render", ro.threads},
+                  {"renders", ok + failed},
+                  {"ok", ok},
+                  {"failed", failed},
+                  {"warnings", warnings},
+                  {"skipped_without_snapshot", skipped},
+                  {"povray_s", povray_s},
+                  {"wall_s", total_s}};
+
+  if (suite) {
+    // Grid: one row per algorithm entry (and sweep value), one column per scene; the lowest seed's plant.
+    std::vector<std::string> rows, cols;
+    std::map<std::pair<std::string, std::string>, const json*> pick;
+    for (const auto& t : doc["trials"]) {
+      std::string row = t.value("label", t.value("algorithm", "?"));
+      if (t.contains("sweep") && t["sweep"].is_object() && !t["sweep"].empty()) {
+        std::vector<std::string> kv;
+        for (const auto& [k, v] : t["sweep"].items()) kv.push_back(fmt::format("{}={}", k, v.is_string() ? v.get<std::string>() : v.dump()));
+        row += fmt::format(" {}", fmt::join(kv, " "));
+      }
+      const std::string col = t.value("scene", "?");
+      if (std::find(rows.begin(), rows.end(), row) == rows.end()) rows.push_back(row);
+      if (std::find(cols.begin(), cols.end(), col) == cols.end()) cols.push_back(col);
+      const json*& p = pick[{row, col}];
+      if (!p || t.value("seed", 0ull) < p->value("seed", 0ull)) p = &t;
+    }
+    auto cell = [&](const std::string& r, const std::string& c, std::string& note) {
+      const auto it = pick.find({r, c});
+      if (it == pick.end()) {
+        note = "not in suite";
+        return std::string();
+      }
+      const json& t = *it->second;
+      if (t.value("status", "") != "ok") note = t.value("status", "not run");
+      else if (!t.contains("render")) note = "no snapshot";
+      else if (t["render"].value("status", "") != "ok") note = "render " + t["render"].value("status", "failed");
+      else return (dir / t["render"]["png"].get<std::string>()).string();
+      return std::string();
+    };
+    std::vector<std::vector<std::string>> cells(rows.size(), std::vector<std::string>(cols.size()));
+    std::vector<std::vector<std::string>> notes = cells;
+    for (std::size_t i = 0; i < rows.size(); ++i)
+      for (std::size_t k = 0; k < cols.size(); ++k) cells[i][k] = cell(rows[i], cols[k], notes[i][k]);
+    const std::string suite_name = doc.contains("suite") ? doc["suite"].value("name", "") : "";
+    const std::string title = fmt::format("growbench suite '{}': algorithm x scene (lowest seed), POV-Ray {}", suite_name,
+                                          to_string(ro.quality));
+    try {
+      write_grid((dir / "grid.png").string(), title, rows, cols, cells, notes);
+      summary["grid"] = "grid.png";
+      json per_scene = json::object();
+      for (std::size_t k = 0; k < cols.size(); ++k) {
+        std::vector<std::vector<std::string>> col_cells(1), col_notes(1);
+        for (std::size_t i = 0; i < rows.size(); ++i) {
+          col_cells[0].push_back(cells[i][k]);
+          col_notes[0].push_back(notes[i][k]);
+        }
+        const std::string name = "grid-" + safe_name(cols[k]) + ".png";
+        write_grid((dir / name).string(), fmt::format("{} (lowest seed)", cols[k]), {cols[k]}, rows, col_cells, col_notes);
+        per_scene[cols[k]] = name;
+      }
+      summary["grid_per_scene"] = per_scene;
+    } catch (const std::exception& e) {
+      summary["grid_error"] = e.what();
+      fmt::print(stderr, "growbench: {}\n", e.what());
+    }
+    doc["renders"] = summary;
+    write_json(dir / "results.json", doc, 1);
+  } else {
+    write_json(dir / "record.json", doc, 2);
+  }
+  return summary;
+}
+
+}  // namespace growbench

@@ -1,0 +1,32 @@
+// Rendering what trials grew, after the fact: every trial of a suite's results directory (or the one
+// trial of a `growbench run` directory) from its plant snapshot (plant.gbplant) and its scene, several
+// POV-Ray processes at once; then the comparison grids and, where frames were captured, the growth
+// animation.
+#pragma once
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "harness/render.hpp"
+
+namespace growbench {
+
+struct RenderDirOptions {
+  RenderOptions render;  // render.threads is set per job from `jobs`
+  int jobs = 0;          // POV-Ray processes at once (0: one per core)
+  bool quiet = false;    // no progress lines
+};
+
+// DIR holds results.json (a suite: renders each trial to trials/ID/render.png, writes grid.png with
+// algorithms as rows and scenes as columns, grid-SCENE.png per scene, and records every render in
+// results.json under "renders" and each trial's "render") or record.json (one run: render.png, recorded
+// in record.json). Frames captured with --frames (frames/step_*.gbplant) become frames/step_*.png and,
+// when ffmpeg is installed, animation.mp4. A failed render is recorded, never fatal; results already
+// written are kept. Throws InputError when DIR is neither. Returns the "renders" summary.
+nlohmann::json render_directory(const std::string& dir, const RenderDirOptions& options);
+
+// File-name-safe form of a label (letters, digits, '-', '_', '.'; anything else becomes '-').
+std::string safe_name(const std::string& s);
+
+}  // namespace growbench

@@ -1,0 +1,54 @@
+#include "harness/report.hpp"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+
+#include <fmt/format.h>
+
+#include "core/errors.hpp"
+#include "harness/process.hpp"
+
+#ifndef GROWBENCH_SOURCE_DIR
+#define GROWBENCH_SOURCE_DIR ""
+#endif
+
+namespace growbench {
+namespace fs = std::filesystem;
+
+std::string report_script() {
+  if (const char* s = std::getenv("GROWBENCH_REPORT_SCRIPT"); s && *s) return s;
+  return (fs::path(GROWBENCH_SOURCE_DIR) / "reports" / "report.py").string();
+}
+
+std::string report_python() {
+  if (const char* s = std::getenv("GROWBENCH_PYTHON"); s && *s) return s;
+  // Debian's python3-matplotlib and python3-numpy serve /usr/bin/python3; another python3 first on
+  // PATH may not see them.
+  if (access("/usr/bin/python3", X_OK) == 0) return "/usr/bin/python3";
+  return "python3";
+}
+
+int run_report(const std::string& results, const std::string& out_dir, const std::vector<std::string>& extra) {
+  const std::string script = report_script();
+  if (!fs::exists(script))
+    throw InputError(fmt::format("report script {} not found (set GROWBENCH_REPORT_SCRIPT to reports/report.py)", script));
+  if (!fs::exists(results)) throw InputError(fmt::format("{}: no such results file", results));
+  std::vector<std::string> args = {report_python(), script, results, "--out", out_dir};
+  args.insert(args.end(), extra.begin(), extra.end());
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const ChildResult r = run_forked(
+      [&]() -> int {
+        execvp(argv[0], argv.data());
+        return 127;
+      },
+      {0.0, 0}, "");
+  if (r.exit_code == 127) throw InputError(fmt::format("cannot run {} (install Debian's python3)", args[0]));
+  return r.signal != 0 ? 128 + r.signal : r.exit_code;
+}
+
+}  // namespace growbench

@@ -1,0 +1,271 @@
+// POV-Ray rendering: the scene writer, real renders through Debian's povray, failures recorded rather
+// than thrown, the plant snapshot that renders read back, and the comparison grid.
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <stb_image.h>
+
+#include "harness/exporters.hpp"
+#include "harness/render.hpp"
+#include "harness/render_results.hpp"
+#include "scenes/geometry.hpp"
+#include "test_util.hpp"
+
+namespace growbench {
+namespace {
+
+struct Image {
+  int w = 0, h = 0;
+  std::vector<unsigned char> rgb;
+};
+
+Image load_png(const std::string& path) {
+  Image im;
+  int n = 0;
+  unsigned char* data = stbi_load(path.c_str(), &im.w, &im.h, &n, 3);
+  if (!data) {
+    ADD_FAILURE() << "cannot read " << path;
+    return im;
+  }
+  im.rgb.assign(data, data + static_cast<std::size_t>(im.w) * im.h * 3);
+  stbi_image_free(data);
+  return im;
+}
+
+double luminance_variance(const Image& im) {
+  double s = 0, s2 = 0;
+  const std::size_t n = im.rgb.size() / 3;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double y = 0.299 * im.rgb[3 * i] + 0.587 * im.rgb[3 * i + 1] + 0.114 * im.rgb[3 * i + 2];
+    s += y;
+    s2 += y * y;
+  }
+  return s2 / static_cast<double>(n) - (s / static_cast<double>(n)) * (s / static_cast<double>(n));
+}
+
+std::string read_file(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// A wall 2 m wide and 2 m high in the plane z = 0, a camera in front of it, the default sun.
+Scene tiny_scene() {
+  Scene s = test::scene_with(geom::make_box("wall", {-1.0f, 0.0f, -0.1f}, {1.0f, 2.0f, 0.0f}));
+  s.name = "tiny";
+  s.camera = {{0.0f, 1.0f, 4.0f}, {0.0f, 1.0f, 0.0f}, 45.0f};
+  return s;
+}
+
+// A small plant in front of the wall: a stem up the middle with two side branches, four leaves and a
+// flower.
+Plant tiny_plant() {
+  Plant p;
+  auto add = [&](glm::vec3 pos, float r, int parent) {
+    PlantNode n;
+    n.position = pos;
+    n.radius = r;
+    n.parent = parent;
+    p.nodes.push_back(n);
+    return static_cast<int>(p.nodes.size()) - 1;
+  };
+  int prev = add({0.0f, 0.1f, 0.2f}, 0.04f, kNoParent);
+  for (int i = 1; i <= 8; ++i) prev = add({0.0f, 0.1f + 0.2f * i, 0.2f}, 0.04f - 0.004f * i, prev);
+  const int a = add({0.4f, 1.2f, 0.2f}, 0.015f, 4);
+  add({0.7f, 1.5f, 0.2f}, 0.01f, a);
+  const int b = add({-0.4f, 1.0f, 0.2f}, 0.015f, 3);
+  add({-0.6f, 1.4f, 0.2f}, 0.01f, b);
+  for (int i = 0; i < 4; ++i) {
+    Organ o;
+    o.position = p.nodes[static_cast<std::size_t>(2 + 2 * i)].position;
+    o.orientation = glm::angleAxis(glm::radians(90.0f * i), glm::vec3(0, 1, 0)) *
+                    glm::angleAxis(glm::radians(-60.0f), glm::vec3(1, 0, 0));
+    o.size = 0.25f;
+    o.node = 2 + 2 * i;
+    p.organs.push_back(o);
+  }
+  Organ f;
+  f.position = p.nodes[8].position;
+  f.kind = OrganKind::Flower;
+  f.size = 0.15f;
+  f.node = 8;
+  p.organs.push_back(f);
+  PlantPolygon poly;
+  poly.vertices = {{0.2f, 0.3f, 0.3f}, {0.4f, 0.3f, 0.3f}, {0.4f, 0.5f, 0.3f}, {0.2f, 0.5f, 0.3f}};
+  p.polygons.push_back(poly);
+  return p;
+}
+
+std::size_t count_of(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+TEST(PlantSnapshot, RoundTripsBitForBit) {
+  const auto dir = test::temp_dir("snapshot");
+  const Plant p = tiny_plant();
+  const auto bytes = write_plant_snapshot((dir / "p.gbplant").string(), p);
+  EXPECT_EQ(bytes, std::filesystem::file_size(dir / "p.gbplant"));
+  const Plant q = read_plant_snapshot((dir / "p.gbplant").string());
+  EXPECT_EQ(q.geometry_hash(), p.geometry_hash());
+  ASSERT_EQ(q.organs.size(), p.organs.size());
+  EXPECT_EQ(q.organs.back().kind, OrganKind::Flower);
+  EXPECT_EQ(q.polygons.size(), 1u);
+}
+
+TEST(PlantSnapshot, BadFilesAreClearErrors) {
+  const auto dir = test::temp_dir("snapshot_bad");
+  const std::string path = (dir / "p.gbplant").string();
+  write_plant_snapshot(path, tiny_plant());
+  std::string data = read_file(path);
+  test::write_text(dir / "cut.gbplant", data.substr(0, data.size() / 2));
+  EXPECT_NE(test::error_of([&] { read_plant_snapshot((dir / "cut.gbplant").string()); }).find("cut.gbplant: plant snapshot"),
+            std::string::npos);
+  test::write_text(dir / "obj.gbplant", "v 0 0 0\n");
+  EXPECT_NE(test::error_of([&] { read_plant_snapshot((dir / "obj.gbplant").string()); }).find("not a growbench plant snapshot"),
+            std::string::npos);
+  // A parent index past the node itself: the forest's invariant, checked on reading.
+  std::string bad = data;
+  const std::int32_t wrong = 5;
+  std::memcpy(bad.data() + 8 + 8 + 16, &wrong, 4);  // node 0's parent
+  test::write_text(dir / "bad.gbplant", bad);
+  EXPECT_NE(test::error_of([&] { read_plant_snapshot((dir / "bad.gbplant").string()); }).find("invalid plant"),
+            std::string::npos);
+}
+
+TEST(PovWriter, WritesEveryPartInPovRayHandedness) {
+  const auto dir = test::temp_dir("pov");
+  const Plant p = tiny_plant();
+  RenderOptions o;
+  const auto bytes = write_pov((dir / "s.pov").string(), tiny_scene(), p, o);
+  const std::string pov = read_file(dir / "s.pov");
+  EXPECT_EQ(bytes, pov.size());
+  EXPECT_NE(pov.find("#version 3.7;"), std::string::npos);
+  EXPECT_NE(pov.find("assumed_gamma 1.0"), std::string::npos);
+  EXPECT_EQ(count_of(pov, "\n  cone {"), p.nodes.size() - 1);  // one per segment
+  EXPECT_EQ(count_of(pov, "\n  sphere {"), p.nodes.size());  // every joint and tip, and the root (it has children)
+  EXPECT_EQ(count_of(pov, "#declare GB_OrganShape"), 1u);        // one declared leaf mesh ...
+  EXPECT_EQ(count_of(pov, "object { GB_OrganShape matrix"), 5u);  // ... instanced per organ
+  EXPECT_NE(pov.find("texture { GB_Flower }"), std::string::npos);
+  // Right-handed to left-handed: z negated. The root at (0, 0.1, 0.2) and the camera at z = 4.
+  EXPECT_NE(pov.find("sphere { <0,0.1,-0.2>,0.04 }"), std::string::npos);
+  EXPECT_NE(pov.find("location <0,1,-4>"), std::string::npos);
+  // The mesh form of the branches: one mesh2 more, no cones.
+  o.branches = "mesh";
+  write_pov((dir / "m.pov").string(), tiny_scene(), p, o);
+  const std::string mesh = read_file(dir / "m.pov");
+  EXPECT_EQ(count_of(mesh, "cone {"), 0u);
+  EXPECT_EQ(count_of(mesh, "mesh2 {"), count_of(pov, "mesh2 {") + 1);
+  o.branches = "tubes";
+  EXPECT_NE(test::error_of([&] { write_pov((dir / "x.pov").string(), tiny_scene(), p, o); }).find("expected cones or mesh"),
+            std::string::npos);
+}
+
+TEST(PovRender, TinySceneRendersWithThePlantInFrameAndNoWarnings) {
+  ASSERT_FALSE(find_povray().empty()) << "povray is not installed (scripts/install-deps installs it)";
+  const auto dir = test::temp_dir("render");
+  RenderOptions o;
+  o.width = 160;
+  o.height = 120;
+  const RenderResult with = render_plant(tiny_scene(), tiny_plant(), (dir / "with.pov").string(), (dir / "with.png").string(), o);
+  ASSERT_TRUE(with.ok()) << with.message;
+  EXPECT_TRUE(with.warnings.empty()) << with.warnings.front();
+  EXPECT_GT(with.wall_s, 0.0);
+  o.draw_plant = false;
+  const RenderResult without =
+      render_plant(tiny_scene(), tiny_plant(), (dir / "without.pov").string(), (dir / "without.png").string(), o);
+  ASSERT_TRUE(without.ok()) << without.message;
+  const Image a = load_png(with.png), b = load_png(without.png);
+  ASSERT_EQ(a.w, 160);
+  ASSERT_EQ(a.h, 120);
+  EXPECT_GT(luminance_variance(a), 50.0);  // not blank
+  // The plant is in frame: pixels differ from the render without it, around the image's centre column
+  // (the stem stands at x = 0, straight in front of the camera).
+  std::size_t differ = 0, centre = 0;
+  for (int y = 0; y < a.h; ++y)
+    for (int x = 0; x < a.w; ++x) {
+      const std::size_t i = 3 * (static_cast<std::size_t>(y) * a.w + x);
+      int d = 0;
+      for (int c = 0; c < 3; ++c) d += std::abs(a.rgb[i + c] - b.rgb[i + c]);
+      if (d > 30) {
+        ++differ;
+        if (std::abs(x - a.w / 2) < 6) ++centre;
+      }
+    }
+  EXPECT_GT(differ, 200u);
+  EXPECT_GT(centre, 20u);
+  EXPECT_LT(differ, static_cast<std::size_t>(a.w * a.h / 2));
+}
+
+TEST(PovRender, FailuresAreRecordedWithPovRaysMessage) {
+  const auto dir = test::temp_dir("render_fail");
+  test::write_text(dir / "bad.pov", "#version 3.7;\nsphere { <0,0,0>, 1 \n");
+  RenderOptions o;
+  o.width = 32;
+  o.height = 24;
+  const RenderResult r = run_povray((dir / "bad.pov").string(), (dir / "bad.png").string(), o);
+  EXPECT_EQ(r.status, "failed");
+  EXPECT_NE(r.message.find("POV-Ray failed on"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("Parse Error"), std::string::npos) << r.message;
+  // No povray on PATH: a clear status, not an exception.
+  const std::string path = std::getenv("PATH");
+  setenv("PATH", dir.c_str(), 1);
+  const RenderResult missing = run_povray((dir / "bad.pov").string(), (dir / "bad.png").string(), o);
+  setenv("PATH", path.c_str(), 1);
+  EXPECT_EQ(missing.status, "no_povray");
+  EXPECT_NE(missing.message.find("install-deps"), std::string::npos);
+}
+
+TEST(RenderGrid, LabelsCellsAndMarksMissingOnes) {
+  const auto dir = test::temp_dir("grid");
+  RenderOptions o;
+  o.width = 80;
+  o.height = 60;
+  const RenderResult r = render_plant(tiny_scene(), tiny_plant(), (dir / "a.pov").string(), (dir / "a.png").string(), o);
+  ASSERT_TRUE(r.ok()) << r.message;
+  write_grid((dir / "grid.png").string(), "title", {"alpha", "beta"}, {"s1", "s2", "s3"},
+             {{r.png, r.png, ""}, {r.png, "", (dir / "missing.png").string()}}, {{"", "", "timeout"}}, 100);
+  const Image g = load_png((dir / "grid.png").string());
+  EXPECT_EQ(g.w, 170 + 3 * 106 + 6);           // row labels, three cells with padding
+  EXPECT_EQ(g.h, 40 + 30 + 2 * (75 + 6) + 6);  // title, column labels, two rows of 4:3 cells
+  EXPECT_GT(luminance_variance(g), 100.0);
+}
+
+TEST(RenderCli, RunRendersThePlantAndItsGrowthFrames) {
+  const auto dir = test::temp_dir("cli_render");
+  const auto r = test::run_growbench("run -q -a spacecol -s wall --set point_count=800 --max-steps 30 --frames 10 "
+                                     "--render preview -o " + dir.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::ifstream in(dir / "record.json");
+  const auto rec = nlohmann::json::parse(in);
+  EXPECT_EQ(rec["render"]["status"], "ok");
+  EXPECT_EQ(rec["render"]["png"], "render.png");
+  EXPECT_TRUE(rec["render"]["warnings"].empty());
+  EXPECT_TRUE(std::filesystem::exists(dir / "render.png"));
+  // Frames at steps 10, 20, 30 (the last step is 30 too): three snapshots, three images.
+  EXPECT_EQ(rec["frames"]["count"], 3);
+  for (const char* f : {"frames/step_000010.png", "frames/step_000020.png", "frames/step_000030.png"})
+    EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
+  EXPECT_TRUE(rec["phases"]["growth"].contains("frame_capture_wall_s"));
+  if (!find_povray().empty() && std::system("command -v ffmpeg > /dev/null") == 0) {
+    EXPECT_EQ(rec["animation"]["status"], "ok") << rec["animation"].dump();
+    EXPECT_TRUE(std::filesystem::exists(dir / "animation.mp4"));
+  }
+  // Rendering again (another quality) rewrites the render record; a directory that is neither a run
+  // nor a suite is a clear error.
+  const auto again = test::run_growbench("render -q --width 64 --height 48 " + dir.string());
+  EXPECT_EQ(again.status, 0) << again.out;
+  const auto bad = test::run_growbench("render " + test::temp_dir("cli_render_empty").string());
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.out.find("neither a suite results directory"), std::string::npos) << bad.out;
+}
+
+}  // namespace
+}  // namespace growbench
