@@ -339,9 +339,9 @@ std::string povray_version() {
   std::string out;
   if (FILE* p = popen(fmt::format("'{}' --version 2>&1", bin).c_str(), "r")) {
     char buf[256];
-    if (std::fgets(buf, sizeof(buf), p)) out = buf;
-    while (std::fgets(buf, sizeof(buf), p)) {
-    }
+    // The first line naming the version (POV-Ray may first complain about a missing user config).
+    while (std::fgets(buf, sizeof(buf), p))
+      if (out.empty() && std::string(buf).find("Version") != std::string::npos) out = buf;
     pclose(p);
   }
   while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();

@@ -1,0 +1,575 @@
+#!/usr/bin/python3
+"""growbench report: figures, tables and an HTML page from one results file.
+
+Reads only the results JSON that `growbench suite` writes (and the render images it names); never the
+algorithms' code. Run with Debian's /usr/bin/python3, which sees python3-matplotlib and python3-numpy:
+
+    /usr/bin/python3 reports/report.py out/demo/results.json --out out/demo/report
+
+Writes into OUT: fig-*.png and fig-*.pdf, table.tex (booktabs), table.md, renders/ (copies of the
+comparison grids), and index.html, which needs nothing from the network.
+
+Statistics, the same as `growbench summary`:
+- medians over repetitions, with a distribution-free 95% interval from order statistics (the pair
+  x_(l), x_(n+1-l) with binomial coverage >= 95%; below 6 repetitions no pair reaches it, so the full
+  range is shown and marked '~');
+- scaling exponents: least squares of log(time) on log(nodes) over an algorithm's cells (their median
+  times), with a 95% interval from Student's t on the slope's standard error.
+"""
+
+import argparse
+import html
+import json
+import math
+import os
+import shutil
+import sys
+
+# The t quantiles t_{0.975, df} for df = 1..30 (beyond: 1.96).
+T975 = [12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160, 2.145, 2.131,
+        2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056, 2.052, 2.048, 2.045, 2.042]
+
+FORMATS = ["obj", "ply", "glb"]
+QUALITY = [("coverage", "surface coverage", "fraction"),
+           ("attached_fraction", "attached nodes", "fraction"),
+           ("penetration_samples", "penetration (segment samples inside)", "fraction"),
+           ("self_intersection_fraction", "self-intersecting segments", "fraction"),
+           ("leaf_overlap", "leaf overlap", "fraction"),
+           ("leaf_light_exposure", "leaf light exposure", "fraction")]
+
+
+class ReportError(Exception):
+    pass
+
+
+# ---------------------------------------------------------------- statistics (no matplotlib needed)
+
+def median(v):
+    s = sorted(v)
+    n = len(s)
+    if n == 0:
+        return float("nan")
+    return s[n // 2] if n % 2 else 0.5 * (s[n // 2 - 1] + s[n // 2])
+
+
+def median_ci(v):
+    """(low, high, exact): a distribution-free 95% interval for the median (see the module doc)."""
+    s = sorted(v)
+    n = len(s)
+    if n == 0:
+        return float("nan"), float("nan"), False
+    best = None
+    for lo in range(1, n // 2 + 1):  # 1-based order statistics x_(lo), x_(n+1-lo)
+        cover = sum(math.comb(n, k) for k in range(lo, n - lo + 1)) / 2.0 ** n
+        if cover >= 0.95:
+            best = lo
+    if best is None:
+        return s[0], s[-1], False
+    return s[best - 1], s[n - best], True
+
+
+def t975(df):
+    return T975[df - 1] if 1 <= df <= len(T975) else 1.96
+
+
+def fit_exponent(xs, ys):
+    """Least squares of log y on log x: (slope, (low, high) or None, intercept). None unless the sizes span
+    at least a factor of 2 (an exponent fitted over nearly equal sizes says nothing)."""
+    pts = [(math.log(x), math.log(y)) for x, y in zip(xs, ys) if x > 0 and y > 0]
+    n = len(pts)
+    if n < 2 or max(p[0] for p in pts) - min(p[0] for p in pts) < math.log(2.0):
+        return None
+    mx = sum(p[0] for p in pts) / n
+    my = sum(p[1] for p in pts) / n
+    sxx = sum((p[0] - mx) ** 2 for p in pts)
+    if sxx <= 1e-12:
+        return None
+    b = sum((p[0] - mx) * (p[1] - my) for p in pts) / sxx
+    a = my - b * mx
+    ci = None
+    if n >= 3:
+        rss = sum((p[1] - (a + b * p[0])) ** 2 for p in pts)
+        se = math.sqrt(rss / (n - 2) / sxx)
+        ci = (b - t975(n - 2) * se, b + t975(n - 2) * se)
+    return b, ci, a
+
+
+# ---------------------------------------------------------------- reading results
+
+def load_results(path):
+    try:
+        with open(path) as f:
+            doc = json.load(f)
+    except OSError as e:
+        raise ReportError(f"{path}: cannot open: {e.strerror}")
+    except json.JSONDecodeError as e:
+        raise ReportError(f"{path}: not valid JSON: line {e.lineno} column {e.colno}: {e.msg}")
+    if doc.get("kind") != "growbench-results" or "trials" not in doc:
+        raise ReportError(f"{path}: not a growbench results file (expected kind 'growbench-results' and trials)")
+    return doc
+
+
+def row_label(t):
+    label = t.get("label") or t.get("algorithm", "?")
+    sweep = t.get("sweep") or {}
+    if isinstance(sweep, dict) and sweep:
+        label += " " + " ".join(f"{k}={v}" for k, v in sweep.items())
+    return label
+
+
+class Cell:
+    """One trial cell (algorithm entry x scene x seed x sweep value) with its repetitions."""
+
+    def __init__(self, t):
+        self.t = t
+        self.label = t.get("label") or t.get("algorithm", "?")
+        self.row = row_label(t)
+        self.scene = t.get("scene", "?")
+        self.seed = t.get("seed", 0)
+        self.status = t.get("status", "?")
+        ok = [s for s in t.get("samples", []) if s.get("status") == "ok" and "phases" in s]
+        self.growth = [s["phases"]["growth"]["wall_s"] for s in ok]
+        self.growth_cpu = [s["phases"]["growth"]["cpu_s"] for s in ok]
+        self.total = [sum(p["wall_s"] for p in s["phases"].values()) for s in ok]
+        self.rss = [s.get("child_max_rss_bytes", 0) for s in ok]
+        self.growth_rss = [s["phases"]["growth"].get("peak_rss_bytes", 0) for s in ok]
+        counts = t.get("counts", {})
+        self.nodes = counts.get("nodes", 0)
+        self.leaves = counts.get("leaves", 0)
+        self.bytes = t.get("output_bytes", {})
+        self.metrics = t.get("metrics", {})
+        alloc = t.get("alloc", {}).get("growth", {})
+        self.alloc_bytes = alloc.get("bytes", 0)
+        self.alloc_count = alloc.get("count", 0)
+        self.ok = self.status == "ok" and len(self.growth) > 0
+
+
+def ordered(values):
+    out = []
+    for v in values:
+        if v not in out:
+            out.append(v)
+    return out
+
+
+# ---------------------------------------------------------------- formatting
+
+def fmt_seconds(s):
+    if s != s:
+        return "-"
+    if s < 1e-3:
+        return f"{s * 1e6:.0f} us"
+    if s < 1:
+        return f"{s * 1e3:.1f} ms"
+    return f"{s:.2f} s"
+
+
+def fmt_bytes(b):
+    if b is None or b != b:
+        return "-"
+    for unit, f in (("GiB", 2 ** 30), ("MiB", 2 ** 20), ("KiB", 2 ** 10)):
+        if b >= f:
+            return f"{b / f:.1f} {unit}"
+    return f"{b:.0f} B"
+
+
+def fmt_frac(x):
+    return "-" if x is None else f"{x:.3f}"
+
+
+def time_with_ci(v):
+    if not v:
+        return "-"
+    lo, hi, exact = median_ci(v)
+    return f"{fmt_seconds(median(v))} [{'' if exact else '~'}{fmt_seconds(lo)}, {fmt_seconds(hi)}]"
+
+
+# ---------------------------------------------------------------- tables
+
+TABLE_HEAD = ["algorithm", "scene", "seeds", "growth time median [95% CI]", "peak memory", "GLB size", "nodes",
+              "coverage", "attached", "penetration"]
+
+
+def table_rows(cells):
+    """One row per algorithm entry x scene (seeds pooled): repetition times of every seed together."""
+    rows = []
+    for scene in ordered(c.scene for c in cells):
+        for label in ordered(c.row for c in cells):
+            group = [c for c in cells if c.scene == scene and c.row == label]
+            if not group:
+                continue
+            good = [c for c in group if c.ok]
+            bad = [c for c in group if not c.ok]
+            if not good:
+                rows.append([label, scene, str(len(group)), ", ".join(sorted({c.status for c in bad})), "-", "-", "-",
+                             "-", "-", "-"])
+                continue
+            times = [x for c in good for x in c.growth]
+            rss = median([x for c in good for x in c.rss])
+            glb = median([c.bytes.get("glb", 0) for c in good])
+            nodes = median([c.nodes for c in good])
+            m = lambda k: median([c.metrics[k] for c in good if k in c.metrics]) if any(k in c.metrics for c in good) else None
+            seeds = f"{len(good)}" + (f" ({len(bad)} failed: {', '.join(sorted({c.status for c in bad}))})" if bad else "")
+            rows.append([label, scene, seeds, time_with_ci(times), fmt_bytes(rss), fmt_bytes(glb), f"{nodes:.0f}",
+                         fmt_frac(m("coverage")), fmt_frac(m("attached_fraction")), fmt_frac(m("penetration_samples"))])
+    return rows
+
+
+def latex_escape(s):
+    return (s.replace("\\", "\\textbackslash{}").replace("&", "\\&").replace("%", "\\%").replace("_", "\\_")
+            .replace("#", "\\#").replace("~", "$\\sim$").replace("[", "{[}").replace("]", "{]}"))
+
+
+def write_latex(path, rows, caption):
+    lines = ["% growbench report table; needs \\usepackage{booktabs}",
+             "\\begin{table}[t]", "\\centering", "\\small",
+             "\\begin{tabular}{ll" + "r" * (len(TABLE_HEAD) - 2) + "}", "\\toprule",
+             " & ".join(latex_escape(h) for h in TABLE_HEAD) + " \\\\", "\\midrule"]
+    prev_scene = None
+    for r in rows:
+        if prev_scene is not None and r[1] != prev_scene:
+            lines.append("\\midrule")
+        prev_scene = r[1]
+        lines.append(" & ".join(latex_escape(x) for x in r) + " \\\\")
+    lines += ["\\bottomrule", "\\end{tabular}", f"\\caption{{{latex_escape(caption)}}}", "\\end{table}", ""]
+    with open(path, "w") as f:
+        f.write("\n".join(lines))
+
+
+def write_markdown(path, rows, caption):
+    lines = ["| " + " | ".join(TABLE_HEAD) + " |", "|" + "|".join(["---"] * 2 + ["---:"] * (len(TABLE_HEAD) - 2)) + "|"]
+    for r in rows:
+        lines.append("| " + " | ".join(x.replace("|", "\\|") for x in r) + " |")
+    lines += ["", caption, ""]
+    with open(path, "w") as f:
+        f.write("\n".join(lines))
+
+
+# ---------------------------------------------------------------- figures
+
+def figures(cells, out, formats):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    plt.rcParams.update({"font.size": 9, "axes.grid": True, "grid.alpha": 0.3, "figure.dpi": 110,
+                         "savefig.bbox": "tight", "pdf.fonttype": 42})
+    labels = ordered(c.label for c in cells)
+    colours = {l: plt.cm.tab10(i % 10) for i, l in enumerate(labels)}
+    markers = "osD^v<>ph*"
+    written = []
+
+    def save(fig, name, caption):
+        for ext in formats:
+            fig.savefig(os.path.join(out, f"{name}.{ext}"), metadata={"CreationDate": None} if ext == "pdf" else None)
+        plt.close(fig)
+        written.append((name, caption))
+
+    good = [c for c in cells if c.ok and c.nodes > 0]
+
+    # 1. Growth time vs output size, log-log, with fitted exponents.
+    fig, ax = plt.subplots(figsize=(6.4, 4.6))
+    for i, label in enumerate(labels):
+        pts = [c for c in good if c.label == label]
+        if not pts:
+            continue
+        x = np.array([c.nodes for c in pts], dtype=float)
+        med = np.array([median(c.growth) for c in pts])
+        cis = [median_ci(c.growth) for c in pts]
+        lo = med - np.array([ci[0] for ci in cis])
+        hi = np.array([ci[1] for ci in cis]) - med
+        fit = fit_exponent(x, med)
+        name = label
+        if fit:
+            b, ci, a = fit
+            name += f": exponent {b:.2f}" + (f" [{ci[0]:.2f}, {ci[1]:.2f}]" if ci else " (2 sizes, no interval)")
+            xs = np.geomspace(x.min(), x.max(), 20)
+            ax.plot(xs, np.exp(a) * xs ** b, "-", color=colours[label], alpha=0.6, lw=1)
+        else:
+            name += ": sizes within 2x, no fit"
+        ax.errorbar(x, med, yerr=[lo, hi], fmt=markers[i % len(markers)], color=colours[label], ms=4, capsize=2,
+                    label=name)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("plant nodes (output size)")
+    ax.set_ylabel("growth wall time (s), median and 95% interval")
+    ax.set_title("Growth time against output size")
+    ax.legend(fontsize=7, loc="best")
+    save(fig, "fig-time-vs-size", "Growth wall time against plant size, log-log: one point per cell (median over "
+         "repetitions, bars: distribution-free 95% interval of the median), lines: least-squares fits with the "
+         "exponent and its 95% interval in the legend.")
+
+    # 2. Memory and allocations vs size.
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    for i, label in enumerate(labels):
+        pts = [c for c in good if c.label == label]
+        if not pts:
+            continue
+        x = [c.nodes for c in pts]
+        axes[0].plot(x, [median(c.rss) / 2 ** 20 for c in pts], markers[i % len(markers)], color=colours[label], ms=4,
+                     label=label)
+        axes[1].plot(x, [max(c.alloc_bytes, 1) / 2 ** 20 for c in pts], markers[i % len(markers)], color=colours[label],
+                     ms=4, label=label)
+    for a, t in zip(axes, ["peak resident memory of the trial process (MiB)", "bytes allocated during growth (MiB)"]):
+        a.set_xscale("log")
+        a.set_yscale("log")
+        a.set_xlabel("plant nodes")
+        a.set_ylabel(t)
+    axes[0].legend(fontsize=7)
+    fig.suptitle("Memory against output size")
+    save(fig, "fig-memory-vs-size", "Peak resident memory (wait4's ru_maxrss of each trial's own process, median over "
+         "repetitions) and bytes allocated in the growth phase (counted by a replaced operator new), against plant size.")
+
+    # 3. Output file size per format.
+    fig, ax = plt.subplots(figsize=(7, 4))
+    width = 0.8 / len(FORMATS)
+    for k, fmt in enumerate(FORMATS):
+        meds, los, his = [], [], []
+        for label in labels:
+            v = [c.bytes.get(fmt, 0) / 2 ** 20 for c in good if c.label == label and fmt in c.bytes]
+            m = median(v) if v else 0
+            meds.append(m)
+            los.append(m - (min(v) if v else 0))
+            his.append((max(v) if v else 0) - m)
+        ax.bar(np.arange(len(labels)) + (k - (len(FORMATS) - 1) / 2) * width, meds, width, yerr=[los, his], capsize=2,
+               label=fmt.upper())
+    ax.set_xticks(np.arange(len(labels)))
+    ax.set_xticklabels(labels, rotation=20, ha="right")
+    ax.set_yscale("log")
+    ax.set_ylabel("file size (MiB), median over cells, bars: range")
+    ax.set_title("Output file size per format")
+    ax.legend()
+    save(fig, "fig-file-size", "Output file size per format (OBJ with MTL, binary PLY, binary glTF), median over every "
+         "scene and seed of each algorithm entry; bars span the smallest to the largest.")
+
+    # 4. Boxplots across seeds, per scene.
+    scenes = ordered(c.scene for c in cells)
+    ncol = min(3, len(scenes))
+    nrow = math.ceil(len(scenes) / ncol)
+    fig, axes = plt.subplots(nrow, ncol, figsize=(4.2 * ncol, 3.2 * nrow), squeeze=False)
+    for idx, scene in enumerate(scenes):
+        a = axes[idx // ncol][idx % ncol]
+        data, names = [], []
+        for label in labels:
+            v = [median(c.growth) for c in good if c.scene == scene and c.label == label]
+            if v:
+                data.append(v)
+                names.append(label)
+        if data:
+            a.boxplot(data, showfliers=False)
+            for j, v in enumerate(data):
+                a.plot(np.full(len(v), j + 1.0), v, ".", color="k", ms=3, alpha=0.6)
+            a.set_xticks(range(1, len(names) + 1))
+            a.set_xticklabels(names, rotation=30, ha="right", fontsize=7)
+            a.set_yscale("log")
+        a.set_title(scene)
+        a.set_ylabel("growth time (s)")
+    for idx in range(len(scenes), nrow * ncol):
+        axes[idx // ncol][idx % ncol].axis("off")
+    fig.suptitle("Growth time across seeds (each point: one seed's median over repetitions)")
+    fig.tight_layout()
+    save(fig, "fig-seeds-boxplot", "Growth time across seeds for each algorithm entry and scene: boxes over the seeds' "
+         "medians, points are the seeds.")
+
+    # 5. Quality metrics side by side.
+    fig, axes = plt.subplots(2, 3, figsize=(13, 7), squeeze=False)
+    width = 0.8 / max(1, len(labels))
+    for idx, (key, title, _) in enumerate(QUALITY):
+        a = axes[idx // 3][idx % 3]
+        for i, label in enumerate(labels):
+            vals = []
+            for scene in scenes:
+                v = [c.metrics[key] for c in good if c.scene == scene and c.label == label and key in c.metrics]
+                vals.append(median(v) if v else 0.0)
+            a.bar(np.arange(len(scenes)) + (i - (len(labels) - 1) / 2) * width, vals, width, color=colours[label],
+                  label=label)
+        a.set_xticks(np.arange(len(scenes)))
+        a.set_xticklabels(scenes, rotation=30, ha="right", fontsize=7)
+        a.set_title(title)
+        a.set_ylim(0, 1.05)
+    axes[0][0].legend(fontsize=7)
+    fig.suptitle("Quality metrics (median over seeds; the same definitions for every algorithm)")
+    fig.tight_layout()
+    save(fig, "fig-quality", "Quality metrics computed identically for every algorithm (harness/metrics.hpp): "
+         "coverage of the climbable surface, fraction of nodes attached, penetration into solids, self-intersection, "
+         "leaf overlap and leaf light exposure; median over seeds.")
+
+    # 6. Growth curves: nodes against step, one panel per scene, the lowest seed.
+    fig, axes = plt.subplots(nrow, ncol, figsize=(4.2 * ncol, 3.0 * nrow), squeeze=False)
+    for idx, scene in enumerate(scenes):
+        a = axes[idx // ncol][idx % ncol]
+        for label in labels:
+            pts = sorted((c for c in good if c.scene == scene and c.label == label), key=lambda c: c.seed)
+            curve = pts[0].t.get("curve") if pts else None
+            if curve and curve.get("step"):
+                a.plot(curve["step"], [max(n, 1) for n in curve["nodes"]], color=colours[label], label=label, lw=1.2)
+        a.set_yscale("log")
+        a.set_title(scene)
+        a.set_xlabel("step")
+        a.set_ylabel("nodes")
+    for idx in range(len(scenes), nrow * ncol):
+        axes[idx // ncol][idx % ncol].axis("off")
+    axes[0][0].legend(fontsize=7)
+    fig.tight_layout()
+    save(fig, "fig-growth-curves", "Growth curves: plant nodes after each step (lowest seed of each cell).")
+    return written
+
+
+# ---------------------------------------------------------------- HTML
+
+CSS = """
+body { font-family: DejaVu Sans, sans-serif; margin: 2em auto; padding: 0 2em; max-width: 1400px; color: #222; }
+h1 { font-size: 1.5em; } h2 { font-size: 1.2em; border-bottom: 1px solid #ccc; margin-top: 2em; }
+table { border-collapse: collapse; font-size: 0.85em; }
+th, td { padding: 3px 8px; border-bottom: 1px solid #ddd; text-align: right; }
+th:nth-child(-n+2), td:nth-child(-n+2) { text-align: left; }
+th { border-bottom: 2px solid #555; }
+tr.scene-start td { border-top: 2px solid #999; }
+.context td, .context th { text-align: left; }
+figure { margin: 1em 0; } figcaption { font-size: 0.85em; color: #444; max-width: 1000px; }
+img { max-width: 100%; border: 1px solid #ddd; }
+.missing { outline: 4px solid #c00; }
+#image-check { font-weight: bold; }
+.note { color: #555; font-size: 0.9em; }
+"""
+
+# Marks any image that did not load, and records the count on <body> (a headless browser test reads it).
+CHECK_SCRIPT = """
+window.addEventListener('load', function () {
+  var imgs = document.querySelectorAll('img'), missing = [];
+  imgs.forEach(function (im) {
+    if (!im.complete || im.naturalWidth === 0) { im.classList.add('missing'); missing.push(im.getAttribute('src')); }
+  });
+  document.body.setAttribute('data-images', imgs.length);
+  document.body.setAttribute('data-missing-images', missing.length);
+  var el = document.getElementById('image-check');
+  el.textContent = missing.length ? ('Missing images: ' + missing.join(', ')) : ('All ' + imgs.length + ' images loaded.');
+  el.style.color = missing.length ? '#c00' : '#070';
+});
+"""
+
+
+def write_html(path, doc, results_path, rows, figs, grids, failed, caption):
+    e = html.escape
+    ctx = doc.get("context", {})
+    suite = doc.get("suite", {})
+    renders = doc.get("renders", {})
+    parts = ["<!DOCTYPE html>", "<html lang='en'><head><meta charset='utf-8'>",
+             f"<title>growbench report: {e(suite.get('name', ''))}</title>", f"<style>{CSS}</style>",
+             f"<script>{CHECK_SCRIPT}</script></head><body>",
+             f"<h1>growbench report: suite '{e(suite.get('name', '?'))}'</h1>",
+             f"<p>{e(suite.get('description', ''))}</p>", "<p id='image-check'>Checking images...</p>"]
+    parts.append("<h2>Context</h2><table class='context'>")
+    deps = ctx.get("dependencies", {})
+    for k, v in [("results file", os.path.abspath(results_path)),
+                 ("commit", f"{ctx.get('growbench_commit', '?')} (uncommitted changes: {ctx.get('dirty', '?')})"),
+                 ("date (UTC)", ctx.get("date", "?")),
+                 ("machine", f"{ctx.get('cpu_model', '?')}, {ctx.get('hardware_threads', '?')} hardware threads"),
+                 ("build", f"{ctx.get('compiler', '?')}, {ctx.get('build_type', '?')}, flags '{ctx.get('cxx_flags', '').strip()}'"),
+                 ("libraries", ", ".join(f"{k} {v}" for k, v in deps.items())),
+                 ("repetitions", f"{doc.get('repetitions', '?')} per cell, each trial in its own process"),
+                 ("renders", f"POV-Ray {renders.get('quality', '-')} ({renders.get('povray', 'not rendered')}), "
+                             f"{renders.get('ok', 0)} ok, {renders.get('failed', 0)} failed" if renders else "not rendered")]:
+        parts.append(f"<tr><th>{e(k)}</th><td>{e(str(v))}</td></tr>")
+    parts.append("</table>")
+    if failed:
+        parts.append("<p class='note'>Cells that did not finish: " +
+                     ", ".join(e(f"{c.row} on {c.scene} seed {c.seed}: {c.status}") for c in failed) + "</p>")
+
+    parts.append("<h2>Renders</h2>")
+    if grids:
+        # The full grid, then one row per scene (larger cells side by side), folded away.
+        src, title = grids[0]
+        parts.append(f"<figure><img src='{e(src)}' alt='{e(title)}'><figcaption>{e(title)}</figcaption></figure>")
+        if len(grids) > 1:
+            parts.append("<details><summary>Per scene</summary>")
+            for src, title in grids[1:]:
+                parts.append(f"<figure><img src='{e(src)}' alt='{e(title)}'><figcaption>{e(title)}</figcaption></figure>")
+            parts.append("</details>")
+    else:
+        parts.append("<p class='note'>No renders in this results file: run <code>growbench render DIR</code> on the "
+                     "results directory, then the report again.</p>")
+
+    parts.append("<h2>Table</h2>")
+    parts.append("<table><tr>" + "".join(f"<th>{e(h)}</th>" for h in TABLE_HEAD) + "</tr>")
+    prev = None
+    for r in rows:
+        cls = " class='scene-start'" if prev is not None and r[1] != prev else ""
+        prev = r[1]
+        parts.append(f"<tr{cls}>" + "".join(f"<td>{e(x)}</td>" for x in r) + "</tr>")
+    parts.append("</table>")
+    parts.append(f"<p class='note'>{e(caption)} Also as <a href='table.tex'>LaTeX (booktabs)</a> and "
+                 "<a href='table.md'>Markdown</a>.</p>")
+
+    parts.append("<h2>Figures</h2>")
+    for name, cap in figs:
+        parts.append(f"<figure><img src='{e(name)}.png' alt='{e(name)}'><figcaption>{e(cap)} "
+                     f"<a href='{e(name)}.pdf'>PDF</a></figcaption></figure>")
+    parts.append("<p class='note'>Generated by reports/report.py from the results file alone. Intervals: "
+                 "distribution-free 95% intervals of the median from order statistics ('~': fewer than 6 repetitions, "
+                 "the full range). Exponents: least squares on log-log medians, 95% interval from Student's t.</p>")
+    parts.append("</body></html>")
+    with open(path, "w") as f:
+        f.write("\n".join(parts) + "\n")
+
+
+# ---------------------------------------------------------------- main
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("results", help="results.json written by `growbench suite`")
+    ap.add_argument("--out", required=True, help="report directory (created)")
+    ap.add_argument("--formats", default="png,pdf", help="figure formats (comma-separated; default png,pdf)")
+    args = ap.parse_args(argv)
+    try:
+        doc = load_results(args.results)
+        cells = [Cell(t) for t in doc["trials"]]
+        if not cells:
+            raise ReportError(f"{args.results}: no trials to report")
+        os.makedirs(args.out, exist_ok=True)
+        formats = [f for f in args.formats.split(",") if f]
+        if "png" not in formats:
+            formats.insert(0, "png")  # the HTML page shows the PNGs
+        print(f"report: {len(cells)} cells from {args.results}", file=sys.stderr)
+        figs = figures(cells, args.out, formats)
+
+        rows = table_rows(cells)
+        caption = ("Median growth wall time over all repetitions of all seeds [distribution-free 95% interval; '~': "
+                   "the full range, fewer than 6 samples], peak memory of the trial process, GLB file size, nodes, and "
+                   "quality metrics (median over seeds).")
+        write_latex(os.path.join(args.out, "table.tex"), rows, caption)
+        write_markdown(os.path.join(args.out, "table.md"), rows, caption)
+
+        # Renders: the grids named in the results file, copied beside the page so it stands alone.
+        grids = []
+        renders = doc.get("renders", {})
+        base = os.path.dirname(os.path.abspath(args.results))
+        names = ([(renders["grid"], "Every algorithm entry (rows) on every scene (columns), the lowest seed, rendered "
+                                    "the same way (POV-Ray, shared materials, the scene's camera and light).")]
+                 if renders.get("grid") else []) + \
+                [(f, f"{scene}: every algorithm entry") for scene, f in renders.get("grid_per_scene", {}).items()]
+        for name, title in names:
+            src = os.path.join(base, name)
+            if os.path.exists(src):
+                os.makedirs(os.path.join(args.out, "renders"), exist_ok=True)
+                shutil.copyfile(src, os.path.join(args.out, "renders", os.path.basename(name)))
+                grids.append(("renders/" + os.path.basename(name), title))
+            else:
+                print(f"report: warning: render grid {src} is missing", file=sys.stderr)
+        failed = [c for c in cells if not c.ok]
+        write_html(os.path.join(args.out, "index.html"), doc, args.results, rows, figs, grids, failed, caption)
+        print(f"report: wrote {len(figs)} figures ({', '.join(formats)}), table.tex, table.md and index.html "
+              f"in {args.out}", file=sys.stderr)
+    except ReportError as e:
+        print(f"report: error: {e}", file=sys.stderr)
+        return 2
+    except ImportError as e:
+        print(f"report: error: {e}; install Debian's python3-matplotlib and python3-numpy (scripts/install-deps) "
+              f"and run with /usr/bin/python3", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
