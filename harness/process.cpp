@@ -17,6 +17,8 @@
 #include <string>
 #include <stdexcept>
 
+#include <sstream>
+
 #include <fmt/format.h>
 
 namespace growbench {
@@ -107,6 +109,31 @@ ChildResult run_forked(const std::function<int()>& body, const ChildLimits& limi
   if (WIFEXITED(status)) r.exit_code = WEXITSTATUS(status);
   if (WIFSIGNALED(status)) r.signal = WTERMSIG(status);
   return r;
+}
+
+std::string find_program(const std::string& name) {
+  const char* path = std::getenv("PATH");
+  std::stringstream ss(path ? path : "/usr/bin:/bin");
+  for (std::string dir; std::getline(ss, dir, ':');) {
+    const std::filesystem::path p = std::filesystem::path(dir.empty() ? "." : dir) / name;
+    if (access(p.c_str(), X_OK) == 0) return p.string();
+  }
+  return "";
+}
+
+ChildResult run_program(const std::vector<std::string>& args, const std::string& cwd, const ChildLimits& limits,
+                        const std::string& log_path) {
+  std::vector<std::string> copy = args;  // argv is built before the fork: no allocation in the child
+  std::vector<char*> argv;
+  for (auto& a : copy) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  return run_forked(
+      [&]() -> int {
+        if (!cwd.empty() && chdir(cwd.c_str()) != 0) return 126;
+        execv(argv[0], argv.data());
+        return 127;
+      },
+      limits, log_path);
 }
 
 }  // namespace growbench

@@ -34,4 +34,13 @@ int process_thread_count();
 
 ChildResult run_forked(const std::function<int()>& body, const ChildLimits& limits, const std::string& log_path);
 
+// The executable NAME on PATH ("" when there is none).
+std::string find_program(const std::string& name);
+
+// Runs the program args[0] (a path) with `args`, in directory `cwd` ("" : this one), its output appended
+// to `log_path` (exit status 127: it could not be started). Only async-signal-safe calls run between
+// fork and exec, so this is safe from a process with threads, and from several threads at once.
+ChildResult run_program(const std::vector<std::string>& args, const std::string& cwd, const ChildLimits& limits,
+                        const std::string& log_path);
+
 }  // namespace growbench

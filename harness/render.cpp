@@ -1,7 +1,5 @@
 #include "harness/render.hpp"
 
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -323,15 +321,7 @@ nlohmann::json RenderResult::to_json() const {
   return j;
 }
 
-std::string find_povray() {
-  const char* path = std::getenv("PATH");
-  std::stringstream ss(path ? path : "/usr/bin:/bin");
-  for (std::string dir; std::getline(ss, dir, ':');) {
-    const fs::path p = fs::path(dir.empty() ? "." : dir) / "povray";
-    if (access(p.c_str(), X_OK) == 0) return p.string();
-  }
-  return "";
-}
+std::string find_povray() { return find_program("povray"); }
 
 std::string povray_version() {
   const std::string bin = find_povray();
@@ -339,9 +329,9 @@ std::string povray_version() {
   std::string out;
   if (FILE* p = popen(fmt::format("'{}' --version 2>&1", bin).c_str(), "r")) {
     char buf[256];
-    // The first line naming the version (POV-Ray may first complain about a missing user config).
+    // The first line that starts with "POV-Ray" (it may first complain about a missing user config).
     while (std::fgets(buf, sizeof(buf), p))
-      if (out.empty() && std::string(buf).find("Version") != std::string::npos) out = buf;
+      if (out.empty() && std::string(buf).rfind("POV-Ray", 0) == 0) out = buf;
     pclose(p);
   }
   while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
@@ -383,21 +373,10 @@ RenderResult run_povray(const std::string& pov_path, const std::string& png_path
   } else {
     args.push_back("-A");
   }
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  const std::string dir_s = dir.string();
   const auto t0 = std::chrono::steady_clock::now();
   ChildResult cr;
   try {
-    // Between fork and exec only async-signal-safe calls (chdir, execv): the caller may have threads.
-    cr = run_forked(
-        [&]() -> int {
-          if (chdir(dir_s.c_str()) != 0) return 126;
-          execv(argv[0], argv.data());
-          return 127;
-        },
-        {o.timeout_s, 0}, fs::absolute(r.log).string());
+    cr = run_program(args, dir.string(), {o.timeout_s, 0}, fs::absolute(r.log).string());
   } catch (const std::exception& e) {
     r.status = "failed";
     r.message = e.what();

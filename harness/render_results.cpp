@@ -11,7 +11,6 @@
 #include <map>
 #include <memory>
 #include <mutex>
-#include <sstream>
 #include <thread>
 
 #include <fmt/format.h>
@@ -58,16 +57,6 @@ struct Job {
   std::string error;        // a snapshot or scene that could not be read
 };
 
-std::string find_on_path(const std::string& name) {
-  const char* path = std::getenv("PATH");
-  std::stringstream ss(path ? path : "/usr/bin:/bin");
-  for (std::string dir; std::getline(ss, dir, ':');) {
-    const fs::path p = fs::path(dir.empty() ? "." : dir) / name;
-    if (access(p.c_str(), X_OK) == 0) return p.string();
-  }
-  return "";
-}
-
 // The frames of a trial directory, in step order.
 std::vector<fs::path> frame_snapshots(const fs::path& trial_dir) {
   std::vector<fs::path> out;
@@ -82,7 +71,7 @@ std::vector<fs::path> frame_snapshots(const fs::path& trial_dir) {
 // ffmpeg: frames/step_*.png to animation.mp4 (H.264, even dimensions). Returns a record of the attempt.
 json make_animation(const fs::path& trial_dir, std::size_t frames) {
   json a = {{"frames", frames}, {"frame_pattern", "frames/step_*.png"}};
-  const std::string ffmpeg = find_on_path("ffmpeg");
+  const std::string ffmpeg = find_program("ffmpeg");
   if (ffmpeg.empty()) {
     a["status"] = "no_ffmpeg";
     a["message"] = "ffmpeg is not installed: the numbered PNG frames are the animation";
@@ -91,17 +80,7 @@ json make_animation(const fs::path& trial_dir, std::size_t frames) {
   std::vector<std::string> args = {ffmpeg, "-y", "-loglevel", "error", "-framerate", "12", "-pattern_type", "glob",
                                    "-i", "frames/step_*.png", "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt",
                                    "yuv420p", "animation.mp4"};
-  std::vector<char*> argv;
-  for (auto& s : args) argv.push_back(s.data());
-  argv.push_back(nullptr);
-  const std::string dir = trial_dir.string();
-  const ChildResult cr = run_forked(
-      [&]() -> int {
-        if (chdir(dir.c_str()) != 0) return 126;
-        execv(argv[0], argv.data());
-        return 127;
-      },
-      {600.0, 0}, (trial_dir / "animation.log").string());
+  const ChildResult cr = run_program(args, trial_dir.string(), {600.0, 0}, (trial_dir / "animation.log").string());
   if (cr.exit_code == 0 && fs::exists(trial_dir / "animation.mp4")) {
     a["status"] = "ok";
     a["file"] = "animation.mp4";

@@ -38,15 +38,9 @@ int run_report(const std::string& results, const std::string& out_dir, const std
   if (!fs::exists(results)) throw InputError(fmt::format("{}: no such results file", results));
   std::vector<std::string> args = {report_python(), script, results, "--out", out_dir};
   args.insert(args.end(), extra.begin(), extra.end());
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  const ChildResult r = run_forked(
-      [&]() -> int {
-        execvp(argv[0], argv.data());
-        return 127;
-      },
-      {0.0, 0}, "");
+  if (args[0].find('/') == std::string::npos) args[0] = find_program(args[0]);
+  if (args[0].empty()) throw InputError("no python3 found (install Debian's python3: scripts/install-deps)");
+  const ChildResult r = run_program(args, "", {0.0, 0}, "");
   if (r.exit_code == 127) throw InputError(fmt::format("cannot run {} (install Debian's python3)", args[0]));
   return r.signal != 0 ? 128 + r.signal : r.exit_code;
 }

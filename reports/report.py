@@ -298,7 +298,9 @@ def figures(cells, out, formats):
     ax.legend(fontsize=7, loc="best")
     save(fig, "fig-time-vs-size", "Growth wall time against plant size, log-log: one point per cell (median over "
          "repetitions, bars: distribution-free 95% interval of the median), lines: least-squares fits with the "
-         "exponent and its 95% interval in the legend.")
+         "exponent and its 95% interval in the legend. The fit spans every cell of an algorithm entry in this "
+         "suite, so where cells differ in scene as well as size it mixes both; the scaling suite "
+         "(bench/suites/scaling.json) varies only the size, on one scene.")
 
     # 2. Memory and allocations vs size.
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
