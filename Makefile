@@ -6,7 +6,7 @@ BUILD := build/$(PRESET)
 GROWBENCH := $(BUILD)/harness/growbench
 JOBS ?= $(shell nproc)
 
-.PHONY: all deps configure build test demo bench clean
+.PHONY: all deps configure build test demo bench gate baseline clean
 
 all: build
 
@@ -24,6 +24,21 @@ test: build
 
 demo: build
 	bash scripts/demo $(GROWBENCH) out/demo
+
+# The deterministic regression gate (CI runs it after the tests): the quick suite once, single-threaded,
+# under callgrind, compared with the committed baseline. Instruction counts depend on the compiler flags:
+# the baseline is made with the CI preset (make baseline PRESET=ci).
+GATE := $(BUILD)/gate
+gate: build
+	rm -rf $(GATE)
+	$(GROWBENCH) suite bench/suites/quick.json --instructions --out $(GATE) -q > $(BUILD)/gate.log
+	$(GROWBENCH) compare reports/baselines/quick.json $(GATE)/results.json
+
+# Accept an intended change: rewrite reports/baselines/quick.json from a fresh gate run (commit it).
+baseline: build
+	rm -rf $(GATE)
+	$(GROWBENCH) suite bench/suites/quick.json --instructions --out $(GATE) -q > $(BUILD)/gate.log
+	$(GROWBENCH) baseline update $(GATE)/results.json --baseline reports/baselines/quick.json
 
 bench: build
 	$(BUILD)/bench/growbench_bench

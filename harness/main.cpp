@@ -13,6 +13,7 @@
 #include "algorithms/algorithm.hpp"
 #include "algorithms/lsystem/lsystem.hpp"
 #include "core/errors.hpp"
+#include "harness/compare.hpp"
 #include "harness/render_results.hpp"
 #include "harness/report.hpp"
 #include "harness/suite.hpp"
@@ -89,6 +90,10 @@ int main(int argc, char** argv) {
   suite_cmd->add_flag("--resume", resume, "continue an interrupted run in --out, skipping finished trials");
   suite_cmd->add_option("--shard", shard, "run only shard I of N (I/N, 0-based): a deterministic slice of the cells");
   suite_cmd->add_flag("-q,--quiet", suite_quiet, "no progress lines");
+  bool suite_instructions = false;
+  suite_cmd->add_flag("--instructions", suite_instructions,
+                      "run each trial once, single-threaded, under valgrind's callgrind, and record instructions per "
+                      "phase (the deterministic regression gate: see `growbench compare`)");
   std::string suite_render;
   suite_cmd->add_option("--render", suite_render,
                         "render every trial with POV-Ray afterwards (preview or paper) and compose grid.png");
@@ -106,6 +111,30 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--branches", render_opts.render.branches, "branches as cones (cone and sphere chains) or mesh "
                          "(the mesher's tubes as mesh2)")->default_val("cones")->check(CLI::IsMember({"cones", "mesh"}));
   render_cmd->add_flag("-q,--quiet", render_opts.quiet, "no progress lines");
+
+  auto* trial_cmd = app.add_subcommand("trial", "Run one trial from a spec file written by a suite (internal)");
+  trial_cmd->group("");  // not listed in --help: suites call it under callgrind
+  std::string trial_spec_file;
+  trial_cmd->add_option("spec", trial_spec_file, "spec.json")->required();
+
+  auto* compare_cmd = app.add_subcommand(
+      "compare", "Compare two results files (or a baseline): behaviour, allocations, output bytes, instructions; exit 1 "
+                 "on a regression");
+  std::string cmp_base, cmp_new;
+  gb::CompareOptions cmp_opts;
+  compare_cmd->add_option("base", cmp_base, "the base: a results.json or a baseline (reports/baselines/*.json)")->required();
+  compare_cmd->add_option("new", cmp_new, "the new results.json")->required();
+  compare_cmd->add_option("--threshold", cmp_opts.instructions_threshold,
+                          "fail when a phase's instruction count rises by more than this fraction")
+      ->default_val(0.02);
+
+  auto* baseline_cmd = app.add_subcommand("baseline", "Manage the committed baselines of the regression gate");
+  auto* baseline_update = baseline_cmd->add_subcommand(
+      "update", "Accept an intended change: rewrite the baseline from a results file and print what changed");
+  baseline_cmd->require_subcommand(1);
+  std::string bl_results, bl_file = "reports/baselines/quick.json";
+  baseline_update->add_option("results", bl_results, "results.json of `growbench suite --instructions`")->required();
+  baseline_update->add_option("--baseline", bl_file, "the baseline file to rewrite")->default_val("reports/baselines/quick.json");
 
   auto* report_cmd = app.add_subcommand(
       "report", "Figures (PNG, PDF), LaTeX and Markdown tables and index.html from a results file alone");
@@ -173,6 +202,7 @@ int main(int argc, char** argv) {
       o.out_dir = suite_out;
       o.resume = resume;
       o.quiet = suite_quiet;
+      o.instructions = suite_instructions;
       if (!shard.empty()) {
         const auto slash = shard.find('/');
         try {
@@ -185,8 +215,12 @@ int main(int argc, char** argv) {
         if (o.shard_count < 1 || o.shard_index < 0 || o.shard_index >= o.shard_count)
           throw gb::InputError(fmt::format("--shard '{}': expected I/N with 0 <= I < N", shard));
       }
-      fmt::print("suite {}: {} cells x {} repetitions (+{} warm-up)\n", suite.name, suite.configs.size(),
-                 suite.repetitions, suite.warmup);
+      if (o.instructions)
+        fmt::print("suite {}: {} cells, each once, single-threaded, under callgrind (instruction counts per phase)\n",
+                   suite.name, suite.configs.size());
+      else
+        fmt::print("suite {}: {} cells x {} repetitions (+{} warm-up)\n", suite.name, suite.configs.size(),
+                   suite.repetitions, suite.warmup);
       std::optional<gb::RenderQuality> quality;
       if (!suite_render.empty()) quality = gb::parse_render_quality(suite_render, "--render");
       const std::string path = gb::run_suite(suite, o);
@@ -232,6 +266,35 @@ int main(int argc, char** argv) {
       fmt::print(stderr, "generation {}: {} modules, {} parameters, {:.1f} MiB, derived in {:.3f} s\n", d.generations,
                  d.modules, d.params, d.bytes / (1024.0 * 1024.0), secs);
       for (const auto& [c, n] : d.counts) fmt::print(stderr, "  {}  {}\n", c, n);
+      return 0;
+    }
+    if (*trial_cmd) {
+      std::ifstream in(trial_spec_file);
+      if (!in) throw gb::InputError(fmt::format("{}: cannot open", trial_spec_file));
+      const gb::TrialSpec ts = gb::trial_spec_from_json(nlohmann::json::parse(in));
+      return gb::run_trial_child(ts, ts.out_dir);
+    }
+    if (*compare_cmd) {
+      const auto r = gb::compare_results(gb::read_results_file(cmp_base), gb::read_results_file(cmp_new), cmp_opts);
+      fmt::print("{}", r.table());
+      return r.fails() ? 1 : 0;
+    }
+    if (*baseline_update) {
+      const auto results = gb::read_results_file(bl_results);
+      if (results.value("mode", "") != "instructions")
+        fmt::print(stderr, "growbench: warning: {} was not run with --instructions: the baseline will hold no instruction "
+                           "counts\n", bl_results);
+      const auto fresh = gb::baseline_of(results);
+      if (std::filesystem::exists(bl_file)) {
+        const auto r = gb::compare_results(gb::read_results_file(bl_file), fresh, {});
+        fmt::print("changes accepted into {}:\n{}", bl_file, r.changes.empty() && r.missing_cells.empty() && r.new_cells.empty()
+                                                            ? std::string("(none)\n") : r.table());
+      } else {
+        fmt::print("new baseline {} with {} cells\n", bl_file, fresh["trials"].size());
+      }
+      std::filesystem::create_directories(std::filesystem::path(bl_file).parent_path().empty()
+                                              ? std::filesystem::path(".") : std::filesystem::path(bl_file).parent_path());
+      std::ofstream(bl_file) << fresh.dump(1) << "\n";
       return 0;
     }
     if (*render_cmd) {

@@ -355,7 +355,37 @@ std::string results_csv(const json& results) {
 // The per-cell fields taken from the first successful repetition's record.
 const char* const kCellFields[] = {"geometry_hash", "counts",         "output_bytes", "metrics",   "total_length_m", "steps",
                                    "stopped_by",    "curve",          "params",       "algorithm_stats", "threads", "scene_hash",
-                                   "alloc"};
+                                   "alloc", "instructions"};
+
+// Under callgrind a trial runs this many times slower; its timeout grows with it.
+constexpr double kCallgrindSlowdown = 60.0;
+
+// The per-phase instruction counts of a trial run under callgrind: every CALLGRIND_DUMP_STATS_AT(phase)
+// wrote DIR/callgrind.out.N with "desc: Trigger: Client Request: PHASE" and "totals: IR". The files are
+// removed once read (the final dump at program exit is not a phase).
+json read_callgrind_phases(const fs::path& dir) {
+  json out = json::object();
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().filename().string().rfind("callgrind.out", 0) == 0) files.push_back(e.path());
+  for (const auto& f : files) {
+    std::ifstream in(f);
+    std::string line, phase;
+    std::uint64_t ir = 0;
+    bool have = false;
+    const std::string trigger = "desc: Trigger: Client Request: ";
+    while (std::getline(in, line)) {
+      if (line.rfind(trigger, 0) == 0) phase = line.substr(trigger.size());
+      if (line.rfind("totals:", 0) == 0 || line.rfind("summary:", 0) == 0) {
+        ir = std::stoull(line.substr(line.find(':') + 1));
+        have = true;
+      }
+    }
+    if (!phase.empty() && have) out[phase] = ir;
+    fs::remove(f);
+  }
+  return out;
+}
 
 // Adds one finished repetition to its cell: the live run and the journal replay both come here.
 // `cell` holds the record's per-cell fields (all of them for the cell's first success, else just the
@@ -386,7 +416,41 @@ Suite load_suite(const std::string& path) {
   return SuiteReader(path).read();
 }
 
-std::string run_suite(const Suite& suite, const SuiteRunOptions& o) {
+int run_trial_child(const TrialSpec& spec, const std::string& dir_name) {
+  const fs::path dir(dir_name);
+  auto write_error = [&](const std::string& msg) { std::ofstream(dir / "error.txt") << msg; };
+  const auto started = std::chrono::steady_clock::now();
+  try {
+    run_trial(spec);
+    // steady_clock is CLOCK_MONOTONIC, comparable with the parent's clock; integer nanoseconds
+    // (a default-formatted double would keep only 6 significant digits).
+    std::ofstream(dir / "timing.txt") << started.time_since_epoch().count() << " "
+                                      << std::chrono::steady_clock::now().time_since_epoch().count();
+    return kExitOk;
+  } catch (const InputError& e) {
+    write_error(e.what());
+    return kExitInvalid;
+  } catch (const std::bad_alloc&) {
+    write_error("out of memory (allocation refused under the address-space limit)");
+    return kExitOom;
+  } catch (const std::exception& e) {
+    write_error(e.what());
+    return kExitError;
+  }
+}
+
+std::string run_suite(const Suite& suite_in, const SuiteRunOptions& o) {
+  // Instruction counts: one repetition (they repeat exactly), no warm-up, one thread.
+  Suite suite = suite_in;
+  std::string valgrind, self_exe;
+  if (o.instructions) {
+    suite.repetitions = 1;
+    suite.warmup = 0;
+    for (auto& c : suite.configs) c.spec.threads = 1;
+    valgrind = find_program("valgrind");
+    if (valgrind.empty()) throw InputError("--instructions needs valgrind (Debian's valgrind package; scripts/install-deps)");
+    self_exe = fs::read_symlink("/proc/self/exe").string();
+  }
   const fs::path out = o.out_dir.empty() ? fs::path("out/suites") / suite.name : fs::path(o.out_dir);
   const fs::path results_path = out / "results.json";
   fs::create_directories(out / "trials");
@@ -410,6 +474,7 @@ std::string run_suite(const Suite& suite, const SuiteRunOptions& o) {
   } else {
     results = {{"schema_version", 1},
                {"kind", "growbench-results"},
+               {"mode", o.instructions ? "instructions" : "timing"},
                {"suite", {{"name", suite.name}, {"file", suite.file}, {"description", suite.description}}},
                {"suite_hash", suite.hash},
                {"repetitions", suite.repetitions},
@@ -517,29 +582,28 @@ std::string run_suite(const Suite& suite, const SuiteRunOptions& o) {
     spec.context = false;       // recorded once for the whole suite
     spec.skip_teardown = true;  // the child exits right after
     const auto t0 = std::chrono::steady_clock::now();
-    const ChildResult cr = run_forked(
-        [&]() -> int {
-          auto write_error = [&](const std::string& msg) { std::ofstream(err_path) << msg; };
-          const auto started = std::chrono::steady_clock::now();
-          try {
-            run_trial(spec);
-            // steady_clock is CLOCK_MONOTONIC, comparable with the parent's clock; integer nanoseconds
-            // (a default-formatted double would keep only 6 significant digits).
-            std::ofstream(dir / "timing.txt") << started.time_since_epoch().count() << " "
-                                              << std::chrono::steady_clock::now().time_since_epoch().count();
-            return kExitOk;
-          } catch (const InputError& e) {
-            write_error(e.what());
-            return kExitInvalid;
-          } catch (const std::bad_alloc&) {
-            write_error("out of memory (allocation refused under the address-space limit)");
-            return kExitOom;
-          } catch (const std::exception& e) {
-            write_error(e.what());
-            return kExitError;
-          }
-        },
-        {suite.timeout_s, suite.memory_limit_bytes}, (dir / "log.txt").string());
+    ChildResult cr;
+    if (o.instructions) {
+      // Under callgrind: the trial runs in a fresh growbench process (`growbench trial`), single-threaded,
+      // and dumps its instruction count at the end of every phase (harness/trial.cpp).
+      json child = to_json(spec);
+      child["out_dir"] = spec.out_dir;
+      child["context"] = spec.context;
+      child["skip_teardown"] = spec.skip_teardown;
+      write_atomic(dir / "spec.json", child.dump() + "\n");
+      for (const auto& e : fs::directory_iterator(dir))
+        if (e.path().filename().string().rfind("callgrind.out", 0) == 0) fs::remove(e.path());
+      std::vector<std::string> args = {valgrind, "--tool=callgrind", "--callgrind-out-file=" + (dir / "callgrind.out").string(),
+                                       // Ir do not depend on the cache model; it is pinned anyway, so a
+                                       // run with --cache-sim=yes would be comparable across hosts.
+                                       "--cache-sim=no", "--I1=32768,8,64", "--D1=32768,8,64", "--LL=8388608,16,64",
+                                       "--instr-atstart=no",  // the trial turns it on per phase
+                                       self_exe, "trial", (dir / "spec.json").string()};
+      cr = run_program(args, "", {suite.timeout_s * kCallgrindSlowdown, 0}, (dir / "log.txt").string());
+    } else {
+      cr = run_forked([&]() -> int { return run_trial_child(spec, dir.string()); },
+                      {suite.timeout_s, suite.memory_limit_bytes}, (dir / "log.txt").string());
+    }
 
     json sample = {{"repetition", job.repetition},
                    {"child_wall_s", cr.wall_s},
@@ -558,6 +622,10 @@ std::string run_suite(const Suite& suite, const SuiteRunOptions& o) {
     } else if (cr.exit_code == kExitOk && fs::exists(rec_path)) {
       rec = json::parse(read_text(rec_path.string()));
       status = "ok";
+      if (o.instructions) {
+        rec["instructions"] = read_callgrind_phases(dir);
+        sample["instructions"] = rec["instructions"];
+      }
     } else {
       message = fs::exists(err_path) ? read_text(err_path.string()) : fmt::format("exit code {}", cr.exit_code);
       status = cr.exit_code == kExitInvalid ? "invalid_input" : cr.exit_code == kExitOom ? "out_of_memory" : "crashed";

@@ -41,7 +41,15 @@ struct SuiteRunOptions {
   bool resume = false;
   int shard_index = 0, shard_count = 1;  // run configs with (index % count) == shard_index
   bool quiet = false;
+  // Run each trial once, single-threaded, under valgrind's callgrind, recording instructions per phase
+  // ("instructions" in each cell): the deterministic measure the regression gate compares.
+  bool instructions = false;
 };
+
+// The body of a trial's own process: runs the trial into DIR (record.json, timing.txt) and returns the
+// exit status the suite reads (0 ok, 2 invalid input, 3 out of memory, 4 other error; error.txt says why).
+// `growbench trial SPEC.json` calls it too (the callgrind mode runs trials that way).
+int run_trial_child(const TrialSpec& spec, const std::string& dir);
 
 // Runs the suite and returns the path of results.json. Throws InputError if results already exist
 // and resume is off.

@@ -1,0 +1,47 @@
+// The deterministic regression gate: two results files (or a committed baseline and a new run) compared
+// on what must not change by accident: behaviour (geometry hash, counts, quality metrics), allocations
+// (count and bytes per phase), output bytes per format, and instruction counts per phase (from
+// `growbench suite --instructions`, callgrind). Wall-clock times are not compared here: on a shared
+// 2-core VM they move by tens of percent between runs.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace growbench {
+
+struct CompareOptions {
+  double instructions_threshold = 0.02;  // a phase's Ir more than this fraction above the base fails ...
+  // ... and by more than this many instructions: the smallest phases (a scene load of 50k instructions)
+  // move by a few hundred with the heap layout (path lengths differ between checkouts).
+  double instructions_floor = 1e5;
+};
+
+struct Change {
+  std::string cell, quantity;  // e.g. "hadrich/wall/s1", "instructions.growth"
+  std::string old_value, new_value;
+  double ratio = 0.0;          // new / old for numbers (0 when not numeric)
+  bool fails = false;
+  std::string why;             // "behaviour", "allocations", "output bytes", "instructions +3.1%", ...
+};
+
+struct CompareResult {
+  std::vector<Change> changes;  // every changed quantity, failing or not
+  std::size_t cells_compared = 0;
+  std::vector<std::string> missing_cells, new_cells;
+  [[nodiscard]] bool fails() const;
+  // A readable table of the changes and a one-line verdict.
+  [[nodiscard]] std::string table() const;
+};
+
+CompareResult compare_results(const nlohmann::json& base, const nlohmann::json& now, const CompareOptions& options = {});
+
+// The deterministic part of a results file (no timings, no paths): what a committed baseline holds.
+nlohmann::json baseline_of(const nlohmann::json& results);
+
+// Reads a results or baseline file; InputError naming the file when it is neither.
+nlohmann::json read_results_file(const std::string& path);
+
+}  // namespace growbench

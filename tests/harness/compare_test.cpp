@@ -1,0 +1,169 @@
+// The deterministic regression gate: what `growbench compare` flags, and what it lets pass.
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "harness/compare.hpp"
+#include "test_util.hpp"
+
+namespace growbench {
+namespace {
+using json = nlohmann::json;
+
+json cell(const std::string& id, int threads = 1) {
+  return {{"id", id},
+          {"status", "ok"},
+          {"threads", threads},
+          {"geometry_hash", "0123456789abcdef"},
+          {"counts", {{"nodes", 100}, {"leaves", 10}}},
+          {"metrics", {{"coverage", 0.25}, {"attached_fraction", 0.5}}},
+          {"output_bytes", {{"obj", 1000}, {"glb", 400}}},
+          {"alloc", {{"growth", {{"count", 50}, {"bytes", 4096}}}}},
+          {"instructions", {{"growth", 10000000}, {"query_build", 5000000}}},
+          {"samples", json::array({{{"repetition", 0}, {"child_wall_s", 0.5}}})}};
+}
+
+json results(std::vector<json> cells) {
+  return {{"kind", "growbench-results"}, {"mode", "instructions"}, {"trials", cells}};
+}
+
+TEST(Compare, IdenticalResultsPass) {
+  const json a = results({cell("a/wall/s1"), cell("b/wall/s1")});
+  const auto r = compare_results(a, a);
+  EXPECT_FALSE(r.fails());
+  EXPECT_TRUE(r.changes.empty());
+  EXPECT_EQ(r.cells_compared, 2u);
+  EXPECT_NE(r.table().find("OK"), std::string::npos);
+}
+
+TEST(Compare, AnyBehaviourChangeFails) {
+  const json a = results({cell("a/wall/s1")});
+  for (const auto& [path, value] : std::vector<std::pair<std::string, json>>{
+           {"/geometry_hash", "fedcba9876543210"}, {"/counts/nodes", 101}, {"/metrics/coverage", 0.2500001},
+           {"/status", "timeout"}}) {
+    json b = a;
+    b["trials"][0][json::json_pointer(path)] = value;
+    const auto r = compare_results(a, b);
+    EXPECT_TRUE(r.fails()) << path;
+    ASSERT_EQ(r.changes.size(), 1u) << path;
+    EXPECT_EQ(r.changes[0].why, "behaviour") << path;
+    EXPECT_NE(r.table().find("REGRESSION"), std::string::npos);
+  }
+}
+
+TEST(Compare, InstructionsFailOnlyPastTheThreshold) {
+  const json a = results({cell("a/wall/s1")});
+  auto with_growth = [&](std::int64_t ir) {
+    json b = a;
+    b["trials"][0]["instructions"]["growth"] = ir;
+    return compare_results(a, b);
+  };
+  auto r = with_growth(10190000);  // +1.9%: shown, passes
+  EXPECT_FALSE(r.fails());
+  ASSERT_EQ(r.changes.size(), 1u);
+  EXPECT_NEAR(r.changes[0].ratio, 1.019, 1e-12);
+  EXPECT_EQ(r.changes[0].quantity, "instructions.growth");
+  r = with_growth(10210000);  // +2.1% (210,000 instructions): fails
+  EXPECT_TRUE(r.fails());
+  EXPECT_NE(r.changes[0].why.find("+2.10%"), std::string::npos) << r.changes[0].why;
+  r = with_growth(9000000);  // faster: passes
+  EXPECT_FALSE(r.fails());
+  json b = a;
+  b["trials"][0]["instructions"]["growth"] = 10210000;
+  EXPECT_FALSE(compare_results(a, b, {0.05}).fails());  // a looser threshold
+  // A tiny phase: +10% of 50,000 instructions is under the absolute floor.
+  json c = a;
+  c["trials"][0]["instructions"]["scene_load"] = 50000;
+  json d = c;
+  d["trials"][0]["instructions"]["scene_load"] = 55000;
+  r = compare_results(c, d);
+  EXPECT_FALSE(r.fails());
+  EXPECT_NE(r.changes[0].why.find("below the floor"), std::string::npos);
+}
+
+TEST(Compare, AllocationsAndBytesGateOnlyWhenDeterministic) {
+  json a = results({cell("a/wall/s1", 1), cell("b/wall/s1", 2)});
+  json b = a;
+  b["trials"][0]["alloc"]["growth"]["count"] = 51;
+  b["trials"][1]["alloc"]["growth"]["count"] = 51;
+  auto r = compare_results(a, b);
+  ASSERT_EQ(r.changes.size(), 2u);
+  EXPECT_TRUE(r.changes[0].fails);   // one thread: deterministic, gated
+  EXPECT_FALSE(r.changes[1].fails);  // two threads: shown, not gated
+  b = a;
+  b["trials"][1]["output_bytes"]["glb"] = 401;
+  r = compare_results(a, b);
+  EXPECT_TRUE(r.fails());
+  EXPECT_EQ(r.changes[0].why, "output bytes");
+}
+
+TEST(Compare, MissingCellsFailNewCellsAreListed) {
+  const json a = results({cell("a/wall/s1"), cell("b/wall/s1")});
+  const json b = results({cell("a/wall/s1"), cell("c/wall/s1")});
+  const auto r = compare_results(a, b);
+  EXPECT_TRUE(r.fails());
+  EXPECT_EQ(r.missing_cells, std::vector<std::string>{"b/wall/s1"});
+  EXPECT_EQ(r.new_cells, std::vector<std::string>{"c/wall/s1"});
+}
+
+TEST(Compare, BaselineKeepsWhatTheGateComparesAndDropsTimings) {
+  const json a = results({cell("a/wall/s1")});
+  const json base = baseline_of(a);
+  EXPECT_EQ(base["kind"], "growbench-baseline");
+  EXPECT_EQ(base["mode"], "instructions");
+  EXPECT_FALSE(base["trials"][0].contains("samples"));
+  EXPECT_EQ(base["trials"][0]["instructions"], a["trials"][0]["instructions"]);
+  EXPECT_TRUE(compare_results(base, a).changes.empty());
+}
+
+
+// The gate end to end, under the real callgrind: an unchanged rerun passes; a planted slowdown of about
+// 5% in one algorithm's growth phase (the test-only fault slow:N, which leaves the plant alone) fails.
+TEST(RegressionGate, CatchesAPlantedFivePercentSlowdownAndNotAnUnchangedRerun) {
+  const auto dir = test::temp_dir("gate");
+  auto suite = [&](const std::string& name, const std::string& fault) {
+    nlohmann::json entry = {{"name", "spacecol"}, {"label", "spacecol"}, {"params", {{"point_count", 400}}}};
+    if (!fault.empty()) entry["fault"] = fault;
+    const nlohmann::json s = {{"schema_version", 1}, {"name", name},      {"seeds", {1}},
+                              {"scenes", {"wall"}},  {"algorithms", {entry}}};
+    return test::write_text(dir / (name + ".json"), s.dump());
+  };
+  auto run = [&](const std::string& name, const std::string& fault) {
+    const auto r = test::run_growbench("suite -q --instructions " + suite(name, fault) + " --out " + (dir / name).string());
+    EXPECT_EQ(r.status, 0) << r.out;
+    return (dir / name / "results.json").string();
+  };
+  // Equal-length output names: paths are allocated, and allocations must match exactly.
+  const std::string base = run("run1", "");
+  std::ifstream in(base);
+  const auto results = nlohmann::json::parse(in);
+  const auto& cell = results["trials"][0];
+  ASSERT_EQ(cell["status"], "ok");
+  EXPECT_EQ(cell["threads"], 1);
+  for (const char* phase : {"scene_load", "growth", "meshing", "export", "metrics"})
+    EXPECT_GT(cell["instructions"].value(phase, 0ull), 0ull) << phase;
+  EXPECT_FALSE(cell["instructions"].contains("query_build"));  // left uninstrumented (see trial.cpp)
+
+  const auto same = test::run_growbench("compare " + base + " " + run("run2", ""));
+  EXPECT_EQ(same.status, 0) << same.out;
+  EXPECT_NE(same.out.find("0 changed quantities"), std::string::npos) << same.out;
+
+  // About 8 instructions per iteration of the planted loop (measured): 5% of the growth phase.
+  const auto growth = cell["instructions"]["growth"].get<std::uint64_t>();
+  const std::string slow = run("run3", "slow:" + std::to_string(growth / 20 / 8));
+  const auto caught = test::run_growbench("compare " + base + " " + slow);
+  EXPECT_EQ(caught.status, 1) << caught.out;
+  EXPECT_NE(caught.out.find("instructions.growth"), std::string::npos) << caught.out;
+  EXPECT_NE(caught.out.find("REGRESSION"), std::string::npos) << caught.out;
+  std::ifstream sin(slow);
+  const auto slowed = nlohmann::json::parse(sin)["trials"][0];
+  const double ratio = slowed["instructions"]["growth"].get<double>() / static_cast<double>(growth);
+  EXPECT_GT(ratio, 1.03);
+  EXPECT_LT(ratio, 1.08);
+  EXPECT_EQ(slowed["geometry_hash"], cell["geometry_hash"]);  // the plant is the same: only the cost changed
+}
+
+}  // namespace
+}  // namespace growbench
