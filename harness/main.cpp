@@ -127,6 +127,9 @@ int main(int argc, char** argv) {
   compare_cmd->add_option("--threshold", cmp_opts.instructions_threshold,
                           "fail when a phase's instruction count rises by more than this fraction")
       ->default_val(0.02);
+  compare_cmd->add_option("--floor", cmp_opts.instructions_floor,
+                          "... and by more than this many instructions (tiny phases move with the heap layout)")
+      ->default_val(1e5);
 
   auto* baseline_cmd = app.add_subcommand("baseline", "Manage the committed baselines of the regression gate");
   auto* baseline_update = baseline_cmd->add_subcommand(

@@ -54,7 +54,6 @@ struct Job {
   std::vector<std::string> scene_params;
   bool frame = false;
   RenderResult result;
-  std::string error;        // a snapshot or scene that could not be read
 };
 
 // The frames of a trial directory, in step order.
@@ -107,13 +106,13 @@ json render_directory(const std::string& dir_arg, const RenderDirOptions& o) {
   auto add_trial = [&](const std::string& key, const fs::path& tdir, const std::string& scene_spec,
                        const std::vector<std::string>& scene_params) {
     if (!fs::exists(tdir / "plant.gbplant")) return false;
-    jobs.push_back({key, tdir / "plant.gbplant", tdir / "render.pov", tdir / "render.png", scene_spec, scene_params, false, {}, {}});
+    jobs.push_back({key, tdir / "plant.gbplant", tdir / "render.pov", tdir / "render.png", scene_spec, scene_params, false, {}});
     for (const auto& f : frame_snapshots(tdir)) {
       fs::path png = f;
       png.replace_extension(".png");
       fs::path pov = f;
       pov.replace_extension(".pov");
-      jobs.push_back({key, f, pov, png, scene_spec, scene_params, true, {}, {}});
+      jobs.push_back({key, f, pov, png, scene_spec, scene_params, true, {}});
     }
     return true;
   };
@@ -163,7 +162,6 @@ json render_directory(const std::string& dir_arg, const RenderDirOptions& o) {
         const Plant plant = read_plant_snapshot(j.snapshot.string());
         j.result = render_plant(*scene, plant, j.pov.string(), j.png.string(), ro);
       } catch (const std::exception& e) {
-        j.error = e.what();
         j.result.status = "failed";
         j.result.message = e.what();
       }
@@ -205,6 +203,7 @@ json render_directory(const std::string& dir_arg, const RenderDirOptions& o) {
     json r = j.result.to_json();
     r["png"] = rel(j.png);
     r["pov"] = rel(j.pov);
+    r["log"] = rel(fs::path(j.result.log));
     r["quality"] = to_string(ro.quality);
     r["branches"] = ro.branches;
     r["threads"] = ro.threads;

@@ -1,6 +1,5 @@
 #include "harness/report.hpp"
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdlib>
