@@ -131,6 +131,13 @@ int main(int argc, char** argv) {
                           "... and by more than this many instructions (tiny phases move with the heap layout)")
       ->default_val(1e5);
 
+  auto* merge_cmd = app.add_subcommand(
+      "merge", "Join the results of a suite's shards (--shard I/N) into one results file, in the unsharded order");
+  std::vector<std::string> merge_inputs;
+  std::string merge_out;
+  merge_cmd->add_option("shards", merge_inputs, "results.json of every shard")->required();
+  merge_cmd->add_option("-o,--out", merge_out, "the merged results.json")->required();
+
   auto* baseline_cmd = app.add_subcommand("baseline", "Manage the committed baselines of the regression gate");
   auto* baseline_update = baseline_cmd->add_subcommand(
       "update", "Accept an intended change: rewrite the baseline from a results file and print what changed");
@@ -281,6 +288,16 @@ int main(int argc, char** argv) {
       const auto r = gb::compare_results(gb::read_results_file(cmp_base), gb::read_results_file(cmp_new), cmp_opts);
       fmt::print("{}", r.table());
       return r.fails() ? 1 : 0;
+    }
+    if (*merge_cmd) {
+      std::vector<nlohmann::json> shards;
+      for (const auto& f : merge_inputs) shards.push_back(gb::read_results_file(f));
+      const auto merged = gb::merge_results(shards, merge_inputs);
+      const auto parent = std::filesystem::path(merge_out).parent_path();
+      if (!parent.empty()) std::filesystem::create_directories(parent);
+      std::ofstream(merge_out) << merged.dump(1) << "\n";
+      fmt::print("merged {} shards, {} cells, into {}\n", shards.size(), merged["trials"].size(), merge_out);
+      return 0;
     }
     if (*baseline_update) {
       const auto results = gb::read_results_file(bl_results);

@@ -416,6 +416,51 @@ Suite load_suite(const std::string& path) {
   return SuiteReader(path).read();
 }
 
+json merge_results(const std::vector<json>& shards, const std::vector<std::string>& names) {
+  if (shards.empty()) throw InputError("merge: no shard results given");
+  const json& first = shards.front();
+  const int count = first.at("shard").value("count", 1);
+  if (count < 1) throw InputError(fmt::format("{}: shard count {} (expected at least 1)", names[0], count));
+  std::vector<std::size_t> slot(static_cast<std::size_t>(std::max(count, 1)), shards.size());  // shard index -> argument
+  for (std::size_t k = 0; k < shards.size(); ++k) {
+    const json& s = shards[k];
+    if (s.value("kind", "") != "growbench-results")
+      throw InputError(fmt::format("{}: not a growbench results file", names[k]));
+    if (s.value("suite_hash", "") != first.value("suite_hash", ""))
+      throw InputError(fmt::format("{}: a shard of another suite (suite_hash {} vs {} in {})", names[k], s.value("suite_hash", ""),
+                                   first.value("suite_hash", ""), names[0]));
+    if (s.value("mode", "timing") != first.value("mode", "timing"))
+      throw InputError(fmt::format("{}: mode '{}' differs from {}'s", names[k], s.value("mode", "timing"), names[0]));
+    const int n = s.at("shard").value("count", 1), i = s.at("shard").value("index", 0);
+    if (n != count) throw InputError(fmt::format("{}: shard of {} but {} is a shard of {}", names[k], n, names[0], count));
+    if (i < 0 || i >= n) throw InputError(fmt::format("{}: shard index {} outside 0..{}", names[k], i, n - 1));
+    if (slot[static_cast<std::size_t>(i)] != shards.size())
+      throw InputError(fmt::format("{}: shard {}/{} given twice", names[k], i, n));
+    slot[static_cast<std::size_t>(i)] = k;
+  }
+  for (int i = 0; i < count; ++i)
+    if (slot[static_cast<std::size_t>(i)] == shards.size()) throw InputError(fmt::format("merge: shard {}/{} is missing", i, count));
+  // Cell k of the suite ran in shard k % count, as its (k / count)-th cell.
+  json merged = first;
+  merged["shard"] = {{"index", 0}, {"count", 1}};
+  merged["trials"] = json::array();
+  merged["shards"] = json::array();
+  std::size_t total = 0;
+  for (int i = 0; i < count; ++i) {
+    const std::size_t a = slot[static_cast<std::size_t>(i)];
+    merged["shards"].push_back({{"index", i}, {"file", names[a]}, {"context", shards[a].value("context", json::object())}});
+    total += shards[a].at("trials").size();
+  }
+  for (std::size_t k = 0; k < total; ++k) {
+    const json& trials = shards[slot[k % static_cast<std::size_t>(count)]].at("trials");
+    const std::size_t at = k / static_cast<std::size_t>(count);
+    if (at >= trials.size()) throw InputError(fmt::format("merge: shard {} has fewer cells than its suite gives it", k % count));
+    merged["trials"].push_back(trials[at]);
+  }
+  merged.erase("renders");  // per-shard render summaries do not describe the merged grid
+  return merged;
+}
+
 int run_trial_child(const TrialSpec& spec, const std::string& dir_name) {
   const fs::path dir(dir_name);
   auto write_error = [&](const std::string& msg) { std::ofstream(dir / "error.txt") << msg; };

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <thread>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -215,6 +216,46 @@ TEST(Suite, QuickSuiteEndToEndAndSummary) {
   EXPECT_NE(s.out.find("== scene wall"), std::string::npos) << s.out;
   EXPECT_NE(s.out.find("growth median [95% CI]"), std::string::npos) << s.out;
   EXPECT_EQ(growbench("summary /nonexistent.json").status, 2);
+}
+
+TEST(Suite, ShardsMergeIntoTheUnshardedRun) {
+  const auto dir = test::temp_dir("suite_merge");
+  const nlohmann::json suite = {
+      {"schema_version", 1}, {"name", "merge"}, {"repetitions", 1}, {"warmup", 0}, {"threads", 1}, {"seeds", {1, 2}},
+      {"scenes", {"wall", "column"}},
+      {"algorithms", {{{"name", "spacecol"}, {"params", {{"point_count", 300}}}}, {{"name", "lsystem"}, {"params", {{"generations", 3}}}}}}};
+  const std::string file = test::write_text(dir / "merge.json", suite.dump());
+  // Equal-length output paths (allocations include them): "full", "sh_0", "sh_1", "sh_2".
+  ASSERT_EQ(growbench("suite -q " + file + " --out " + (dir / "full").string()).status, 0);
+  std::string inputs;
+  for (int i = 0; i < 3; ++i) {
+    const auto out = dir / ("sh_" + std::to_string(i));
+    ASSERT_EQ(growbench(fmt::format("suite -q {} --shard {}/3 --out {}", file, i, out.string())).status, 0);
+    inputs = (out / "results.json").string() + " " + inputs;  // given out of order on purpose
+  }
+  const auto merged = growbench("merge " + inputs + "--out " + (dir / "merged.json").string());
+  ASSERT_EQ(merged.status, 0) << merged.out;
+  std::ifstream fa(dir / "full" / "results.json"), fb(dir / "merged.json");
+  const auto a = nlohmann::json::parse(fa), b = nlohmann::json::parse(fb);
+  ASSERT_EQ(a["trials"].size(), 8u);
+  ASSERT_EQ(b["trials"].size(), 8u);
+  for (std::size_t k = 0; k < 8; ++k) {
+    const auto& x = a["trials"][k];
+    const auto& y = b["trials"][k];
+    EXPECT_EQ(x["id"], y["id"]) << k;
+    for (const char* f : {"geometry_hash", "counts", "metrics", "output_bytes", "alloc", "spec", "status"}) EXPECT_EQ(x[f], y[f]) << k << " " << f;
+  }
+  EXPECT_EQ(b["shards"].size(), 3u);
+  const auto cmp = growbench("compare " + (dir / "full" / "results.json").string() + " " + (dir / "merged.json").string());
+  EXPECT_EQ(cmp.status, 0) << cmp.out;
+  // A shard given twice, or one missing: clear errors.
+  const std::string s0 = (dir / "sh_0" / "results.json").string(), s1 = (dir / "sh_1" / "results.json").string();
+  auto r = growbench("merge " + s0 + " " + s0 + " " + s1 + " --out " + (dir / "x.json").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("given twice"), std::string::npos) << r.out;
+  r = growbench("merge " + s0 + " " + s1 + " --out " + (dir / "x.json").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("shard 2/3 is missing"), std::string::npos) << r.out;
 }
 
 }  // namespace
