@@ -1,5 +1,5 @@
 # The two entry points of the README. Both install dependencies (Debian packages), configure and build.
-#   make demo   grow plants on standard scenes and write them under out/demo
+#   make demo   the standard suite, rendered, with the report: out/demo/report/index.html
 #   make test   run the test suite
 PRESET ?= release
 BUILD := build/$(PRESET)
