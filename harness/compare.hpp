@@ -17,6 +17,10 @@ struct CompareOptions {
   // ... and by more than this many instructions: the smallest phases (a scene load of 50k instructions)
   // move by a few hundred with the heap layout (path lengths differ between checkouts).
   double instructions_floor = 1e5;
+  // Allocated bytes may differ by this much without failing (counts must match exactly): where code
+  // builds absolute paths (the L-system's example grammars), the checkout's path length enters them,
+  // 90 bytes between /work/main and /work/cleancheck.
+  double alloc_bytes_slack = 4096;
 };
 
 struct Change {
@@ -31,6 +35,7 @@ struct CompareResult {
   std::vector<Change> changes;  // every changed quantity, failing or not
   std::size_t cells_compared = 0;
   std::vector<std::string> missing_cells, new_cells;
+  std::size_t small_changes = 0;  // instruction changes under 0.1% and the floor, counted but not listed
   [[nodiscard]] bool fails() const;
   // A readable table of the changes and a one-line verdict.
   [[nodiscard]] std::string table() const;
