@@ -1,6 +1,8 @@
 #include "core/json_util.hpp"
 
 #include <algorithm>
+#include <fstream>
+#include <sstream>
 
 #include <fmt/format.h>
 
@@ -8,6 +10,15 @@
 #include "core/params.hpp"
 
 namespace growbench {
+
+std::string read_text_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(fmt::format("{}: cannot open", path));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
 
 std::pair<std::size_t, std::size_t> line_column(const std::string& text, std::size_t byte) {
   std::size_t line = 1, col = 1;

@@ -9,6 +9,9 @@
 
 namespace growbench {
 
+// The whole file as text; InputError "PATH: cannot open" when it cannot be read.
+std::string read_text_file(const std::string& path);
+
 // 1-based line and column of a byte offset (as nlohmann's parse_error::byte reports it).
 std::pair<std::size_t, std::size_t> line_column(const std::string& text, std::size_t byte);
 

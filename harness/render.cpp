@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 
 #include "core/errors.hpp"
+#include "core/json_util.hpp"
 #include "harness/exporters.hpp"
 #include "harness/process.hpp"
 
@@ -124,12 +125,6 @@ glm::vec3 any_perpendicular(const glm::vec3& d) {
   return glm::normalize(glm::cross(d, a));
 }
 
-std::string read_text_file(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 }  // namespace
 
@@ -384,7 +379,7 @@ RenderResult run_povray(const std::string& pov_path, const std::string& png_path
   }
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.cpu_s = cr.user_s + cr.system_s;
-  const std::string log = read_text_file(r.log);
+  const std::string log = fs::exists(r.log) ? read_text_file(r.log) : std::string();
   std::vector<std::string> errors;
   {
     std::stringstream ss(log);

@@ -18,17 +18,13 @@
 #include "core/errors.hpp"
 #include "harness/exporters.hpp"
 #include "harness/process.hpp"
+#include "harness/suite.hpp"
 #include "scenes/scene_library.hpp"
 
 namespace growbench {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 
-std::string safe_name(const std::string& s) {
-  std::string out;
-  for (const char ch : s) out += (std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '_' || ch == '.') ? ch : '-';
-  return out.empty() ? "unnamed" : out;
-}
 
 namespace {
 

@@ -26,7 +26,4 @@ struct RenderDirOptions {
 // written are kept. Throws InputError when DIR is neither. Returns the "renders" summary.
 nlohmann::json render_directory(const std::string& dir, const RenderDirOptions& options);
 
-// File-name-safe form of a label (letters, digits, '-', '_', '.'; anything else becomes '-').
-std::string safe_name(const std::string& s);
-
 }  // namespace growbench

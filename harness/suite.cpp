@@ -24,6 +24,7 @@
 #include "algorithms/algorithm.hpp"
 #include "core/errors.hpp"
 #include "core/json_util.hpp"
+#include "harness/exporters.hpp"
 #include "harness/process.hpp"
 #include "scenes/scene_library.hpp"
 
@@ -33,33 +34,12 @@ using nlohmann::json;
 
 namespace {
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(fmt::format("{}: cannot open", path));
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+std::string read_text(const std::string& path) { return read_text_file(path); }
 
-void write_atomic(const fs::path& path, const std::string& text) {
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out << text;
-    out.flush();
-    if (!out) throw std::runtime_error(fmt::format("{}: write failed", tmp.string()));
-  }
-  fs::rename(tmp, path);
-}
+void write_atomic(const fs::path& path, const std::string& text) { write_file_atomic(path.string(), text.data(), text.size()); }
 
 std::string value_text(const json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); }
 
-std::string safe_name(std::string s) {
-  for (auto& c : s)
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.' || c == '=' || c == ','))
-      c = '_';
-  return s;
-}
 
 class SuiteReader : public JsonPathReader {
  public:
@@ -410,6 +390,13 @@ void apply_sample(json& t, const json& sample, const json& cell) {
 }
 
 }  // namespace
+
+std::string safe_name(std::string s) {
+  for (auto& c : s)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.' || c == '=' || c == ','))
+      c = '_';
+  return s;
+}
 
 Suite load_suite(const std::string& path) {
   if (!fs::exists(path)) throw InputError(fmt::format("{}: no such suite file", path));

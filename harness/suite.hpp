@@ -32,6 +32,9 @@ struct Suite {
   std::vector<SuiteConfig> configs;  // in run order: interleaved across algorithm entries
 };
 
+// A label as a file name: letters, digits and - _ . = , kept, anything else '_' (trial folders, grid images).
+std::string safe_name(std::string s);
+
 // Reads and validates a suite file: every algorithm, scene and parameter (and every swept value) is
 // checked before anything runs; an error names the file and the JSON path.
 Suite load_suite(const std::string& path);
