@@ -1,6 +1,9 @@
 #include "algorithms/plant.hpp"
 
+#include <array>
 #include <cmath>
+#include <cstring>
+#include <memory>
 
 #include <fmt/format.h>
 #include <xxhash.h>
@@ -31,9 +34,33 @@ double Plant::total_length() const {
 }
 
 std::string Plant::geometry_hash() const {
-  XXH3_state_t* st = XXH3_createState();
-  XXH3_64bits_reset(st);
-  auto put = [&](const auto& v) { XXH3_64bits_update(st, &v, sizeof(v)); };
+  // Fields are gathered in a small buffer and hashed a chunk at a time: the same value as feeding XXH3
+  // field by field (it does not depend on how its input is split), at a fraction of the cost (a quarter
+  // of a million 4-byte updates for a 25k-node ivy took 1.6 ms). The buffer is fixed and reused: one
+  // the size of the plant would be fresh memory, whose page faults cost ~20 us per 4 KiB on a VM.
+  struct Hasher {
+    XXH3_state_t* st = XXH3_createState();
+    std::array<char, 1 << 14> buf{};
+    std::size_t used = 0;
+    Hasher() { XXH3_64bits_reset(st); }
+    ~Hasher() { XXH3_freeState(st); }
+    void flush() {
+      XXH3_64bits_update(st, buf.data(), used);
+      used = 0;
+    }
+    void bytes(const void* p, std::size_t n) {
+      if (used + n > buf.size()) flush();
+      if (n > buf.size()) {
+        XXH3_64bits_update(st, p, n);
+        return;
+      }
+      std::memcpy(buf.data() + used, p, n);
+      used += n;
+    }
+  };
+  auto hasher = std::make_unique<Hasher>();
+  auto bytes = [&](const void* p, std::size_t n) { hasher->bytes(p, n); };
+  auto put = [&](const auto& v) { bytes(&v, sizeof(v)); };
   put(nodes.size());
   for (const auto& n : nodes) {  // field by field: no padding bytes enter the hash
     put(n.position);
@@ -59,16 +86,15 @@ std::string Plant::geometry_hash() const {
   }
   if (!node_groups.empty()) {
     put(node_groups.size());
-    XXH3_64bits_update(st, node_groups.data(), node_groups.size() * sizeof(std::int32_t));
+    bytes(node_groups.data(), node_groups.size() * sizeof(std::int32_t));
   }
   for (const auto& a : node_attributes) {
-    XXH3_64bits_update(st, a.name.data(), a.name.size());
+    bytes(a.name.data(), a.name.size());
     put(a.components);
-    XXH3_64bits_update(st, a.values.data(), a.values.size() * sizeof(float));
+    bytes(a.values.data(), a.values.size() * sizeof(float));
   }
-  const auto h = XXH3_64bits_digest(st);
-  XXH3_freeState(st);
-  return fmt::format("{:016x}", h);
+  hasher->flush();
+  return fmt::format("{:016x}", XXH3_64bits_digest(hasher->st));
 }
 
 std::string Plant::validate() const {

@@ -1,15 +1,16 @@
 #include "harness/exporters.hpp"
 
+#include <array>
 #include <bit>
+#include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <type_traits>
-#include <cstdio>
-#include <filesystem>
 #include <map>
 #include <memory>
 #include <sstream>
+#include <type_traits>
 
 #include <fmt/format.h>
 #include <tiny_gltf.h>
@@ -200,10 +201,49 @@ namespace {
 
 constexpr char kSnapshotMagic[8] = {'G', 'B', 'P', 'L', 'A', 'N', 'T', '1'};
 
+// Writes a file atomically (PATH.tmp, renamed at the end) through a fixed 64 KiB buffer. A buffer the
+// size of the file would be fresh memory: on a paravirtualised VM its page faults (~20 us per 4 KiB)
+// cost more than the writing (18 ms for a 3.3 MB snapshot).
+class ChunkedFile {
+ public:
+  explicit ChunkedFile(std::string path) : path_(std::move(path)), tmp_(path_ + ".tmp"), f_(std::fopen(tmp_.c_str(), "wb"), &std::fclose) {
+    if (!f_) throw std::runtime_error(fmt::format("{}: cannot open for writing", tmp_));
+  }
+  void bytes(const void* p, std::size_t n) {
+    if (used_ + n > buf_.size()) flush();
+    if (n > buf_.size()) return write(p, n);
+    std::memcpy(buf_.data() + used_, p, n);
+    used_ += n;
+  }
+  std::uint64_t finish() {
+    flush();
+    if (std::fclose(f_.release()) != 0) throw std::runtime_error(fmt::format("{}: write failed", tmp_));
+    std::error_code ec;
+    std::filesystem::rename(tmp_, path_, ec);
+    if (ec) throw std::runtime_error(fmt::format("{}: cannot rename into place: {}", path_, ec.message()));
+    return total_;
+  }
+
+ private:
+  void flush() {
+    write(buf_.data(), used_);
+    used_ = 0;
+  }
+  void write(const void* p, std::size_t n) {
+    if (n > 0 && std::fwrite(p, 1, n, f_.get()) != n) throw std::runtime_error(fmt::format("{}: write failed", tmp_));
+    total_ += n;
+  }
+  std::string path_, tmp_;
+  std::unique_ptr<FILE, int (*)(FILE*)> f_;
+  std::array<char, 1 << 16> buf_{};
+  std::size_t used_ = 0;
+  std::uint64_t total_ = 0;
+};
+
 template <class T>
-void put(std::string& b, const T& v) {
+void put(ChunkedFile& b, const T& v) {
   static_assert(std::is_trivially_copyable_v<T>);
-  b.append(reinterpret_cast<const char*>(&v), sizeof(T));
+  b.bytes(&v, sizeof(T));
 }
 
 class SnapshotReader {
@@ -240,8 +280,9 @@ class SnapshotReader {
 }  // namespace
 
 std::uint64_t write_plant_snapshot(const std::string& path, const Plant& plant) {
-  std::string b(kSnapshotMagic, sizeof(kSnapshotMagic));
-  b.reserve(64 + plant.nodes.size() * 32 + plant.organs.size() * 64);
+  auto file = std::make_unique<ChunkedFile>(path);  // its buffer on the heap, not on a worker's stack
+  ChunkedFile& b = *file;
+  b.bytes(kSnapshotMagic, sizeof(kSnapshotMagic));
   put<std::uint64_t>(b, plant.nodes.size());
   for (const auto& n : plant.nodes) {
     put(b, n.position);
@@ -268,7 +309,7 @@ std::uint64_t write_plant_snapshot(const std::string& path, const Plant& plant) 
     put<std::uint64_t>(b, p.vertices.size());
     for (const auto& v : p.vertices) put(b, v);
   }
-  return write_file_atomic(path, b.data(), b.size());
+  return b.finish();
 }
 
 Plant read_plant_snapshot(const std::string& path) {

@@ -207,8 +207,12 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (*suite_cmd) {
+      // First, while this process is small: the launcher that forks the trials (harness/process.hpp).
+      std::unique_ptr<gb::Launcher> launcher;
+      if (!suite_instructions) launcher = gb::start_trial_launcher();
       const gb::Suite suite = gb::load_suite(suite_file);
       gb::SuiteRunOptions o;
+      o.launcher = launcher.get();
       o.out_dir = suite_out;
       o.resume = resume;
       o.quiet = suite_quiet;

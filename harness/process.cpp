@@ -3,19 +3,23 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <limits.h>
+#include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <string>
 #include <stdexcept>
+#include <string>
+#include <type_traits>
 
 #include <sstream>
 
@@ -32,14 +36,32 @@ int process_thread_count() {
 }
 
 ChildResult run_forked(const std::function<int()>& body, const ChildLimits& limits, const std::string& log_path) {
+  return run_forked([&](int) { return body(); }, limits, log_path, nullptr);
+}
+
+ChildResult run_forked(const std::function<int(int report_fd)>& body, const ChildLimits& limits,
+                       const std::string& log_path, const std::function<void(const std::string&)>& on_report) {
+  int report[2] = {-1, -1};
+  if (on_report && pipe2(report, O_CLOEXEC) != 0)
+    throw std::runtime_error(fmt::format("cannot create a pipe: {}", std::strerror(errno)));
   std::fflush(stdout);  // or the child would write the parent's buffered output again
   std::fflush(stderr);
+  const pid_t parent = getpid();
   const auto t0 = std::chrono::steady_clock::now();
   const pid_t pid = fork();
-  if (pid < 0) throw std::runtime_error(fmt::format("cannot fork: {}", std::strerror(errno)));
+  if (pid < 0) {
+    const int err = errno;
+    if (report[0] >= 0) close(report[0]), close(report[1]);
+    throw std::runtime_error(fmt::format("cannot fork: {}", std::strerror(err)));
+  }
   if (pid == 0) {
-    // Child: only async-signal-safe calls until exec.
+    // Child: only async-signal-safe calls until body.
+    if (limits.die_with_parent) {
+      prctl(PR_SET_PDEATHSIG, SIGKILL);
+      if (getppid() != parent) _exit(71);  // the parent died before the line above
+    }
     setpgid(0, 0);  // its own process group, so a timeout kills any helpers it starts too
+    if (report[0] >= 0) close(report[0]);
     if (!log_path.empty()) {
       const int fd = open(log_path.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
       if (fd >= 0) {
@@ -54,32 +76,60 @@ ChildResult run_forked(const std::function<int()>& body, const ChildLimits& limi
     }
     int code = 70;
     try {
-      code = body();
+      code = body(report[1]);
     } catch (...) {
     }
     std::fflush(stdout);
     std::fflush(stderr);
     _exit(code);  // no atexit handlers or static destructors of the parent's state
   }
+  if (report[1] >= 0) close(report[1]);
+  std::string message;
+  bool reported = false;
+  // The report: one write of at most PIPE_BUF bytes arrives whole; EOF means there was none.
+  auto read_report = [&] {
+    char buf[PIPE_BUF];
+    ssize_t n;
+    do {
+      n = read(report[0], buf, sizeof buf);
+    } while (n < 0 && errno == EINTR);
+    if (n > 0 && !reported) {
+      reported = true;
+      on_report(std::string(buf, static_cast<std::size_t>(n)));
+    }
+    if (n <= 0) {
+      close(report[0]);
+      report[0] = -1;
+    }
+  };
   ChildResult r;
+  r.spawn_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(t0.time_since_epoch()).count();
   const int pidfd = static_cast<int>(syscall(SYS_pidfd_open, pid, 0));
   int status = 0;
   rusage ru{};
   bool reaped = false;
+  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+  auto kill_child = [&] {
+    r.timed_out = true;
+    kill(-pid, SIGKILL);
+    kill(pid, SIGKILL);
+  };
   if (pidfd >= 0) {
-    // Sleep until the child exits or the timeout passes: no polling delay added to every trial.
-    pollfd pfd{pidfd, POLLIN, 0};
-    const int timeout_ms = limits.timeout_s > 0 ? static_cast<int>(limits.timeout_s * 1000.0) : -1;
-    int rc;
-    do {
-      rc = poll(&pfd, 1, timeout_ms);
-    } while (rc < 0 && errno == EINTR);
-    close(pidfd);
-    if (rc == 0) {
-      r.timed_out = true;
-      kill(-pid, SIGKILL);
-      kill(pid, SIGKILL);
+    // Sleep until the child reports or exits, or the timeout passes: no polling delay added to a trial.
+    while (true) {
+      pollfd pfd[2] = {{pidfd, POLLIN, 0}, {report[0], POLLIN, 0}};
+      int timeout_ms = -1;
+      if (limits.timeout_s > 0) timeout_ms = std::max(0, static_cast<int>((limits.timeout_s - elapsed()) * 1000.0) + 1);
+      const int rc = poll(pfd, report[0] >= 0 ? 2 : 1, timeout_ms);
+      if (rc < 0 && errno == EINTR) continue;
+      if (rc == 0) {
+        kill_child();
+        break;
+      }
+      if (report[0] >= 0 && (pfd[1].revents & (POLLIN | POLLHUP)) != 0) read_report();
+      if ((pfd[0].revents & POLLIN) != 0) break;
     }
+    close(pidfd);
   } else {
     // No pidfd (old kernel): poll wait4 every millisecond.
     while (true) {
@@ -88,11 +138,8 @@ ChildResult run_forked(const std::function<int()>& body, const ChildLimits& limi
         reaped = true;
         break;
       }
-      const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      if (limits.timeout_s > 0 && el > limits.timeout_s) {
-        r.timed_out = true;
-        kill(-pid, SIGKILL);
-        kill(pid, SIGKILL);
+      if (limits.timeout_s > 0 && elapsed() > limits.timeout_s) {
+        kill_child();
         break;
       }
       usleep(1000);
@@ -102,13 +149,154 @@ ChildResult run_forked(const std::function<int()>& body, const ChildLimits& limi
     while (wait4(pid, &status, 0, &ru) < 0 && errno == EINTR) {
     }
   }
-  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.wall_s = elapsed();
+  // A report written just before the exit may still be in the pipe.
+  if (report[0] >= 0 && !reported) {
+    fcntl(report[0], F_SETFL, O_NONBLOCK);
+    read_report();
+  }
+  if (report[0] >= 0) close(report[0]);
   r.user_s = static_cast<double>(ru.ru_utime.tv_sec) + 1e-6 * static_cast<double>(ru.ru_utime.tv_usec);
   r.system_s = static_cast<double>(ru.ru_stime.tv_sec) + 1e-6 * static_cast<double>(ru.ru_stime.tv_usec);
   r.max_rss_bytes = static_cast<std::uint64_t>(ru.ru_maxrss) * 1024u;
   if (WIFEXITED(status)) r.exit_code = WEXITSTATUS(status);
   if (WIFSIGNALED(status)) r.signal = WTERMSIG(status);
   return r;
+}
+
+static_assert(std::is_trivially_copyable_v<ChildResult> && std::is_trivially_copyable_v<ChildLimits>,
+              "sent through a pipe as bytes");
+
+namespace {
+
+// The launcher's replies: a header, then `size` bytes.
+enum class Reply : std::uint32_t { report = 1, result = 2, error = 3 };
+struct ReplyHeader {
+  Reply kind;
+  std::uint32_t size;
+};
+
+bool write_all(int fd, const void* data, std::size_t n) {
+  const char* p = static_cast<const char*>(data);
+  while (n > 0) {
+    const ssize_t w = write(fd, p, n);
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) return false;
+    p += w;
+    n -= static_cast<std::size_t>(w);
+  }
+  return true;
+}
+
+bool read_all(int fd, void* data, std::size_t n) {
+  char* p = static_cast<char*>(data);
+  while (n > 0) {
+    const ssize_t r = read(fd, p, n);
+    if (r < 0 && errno == EINTR) continue;
+    if (r <= 0) return false;
+    p += r;
+    n -= static_cast<std::size_t>(r);
+  }
+  return true;
+}
+
+bool send_reply(int fd, Reply kind, const void* data, std::size_t n) {
+  const ReplyHeader h{kind, static_cast<std::uint32_t>(n)};
+  return write_all(fd, &h, sizeof h) && write_all(fd, data, n);
+}
+
+}  // namespace
+
+Launcher::Launcher(Prepare prepare) {
+  int req[2], rep[2];
+  if (pipe2(req, O_CLOEXEC) != 0) throw std::runtime_error(fmt::format("cannot create a pipe: {}", std::strerror(errno)));
+  if (pipe2(rep, O_CLOEXEC) != 0) {
+    close(req[0]), close(req[1]);
+    throw std::runtime_error(fmt::format("cannot create a pipe: {}", std::strerror(errno)));
+  }
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const pid_t owner = getpid();
+  pid_ = fork();
+  if (pid_ < 0) {
+    const int err = errno;
+    for (int fd : {req[0], req[1], rep[0], rep[1]}) close(fd);
+    throw std::runtime_error(fmt::format("cannot fork the trial launcher: {}", std::strerror(err)));
+  }
+  if (pid_ == 0) {
+    prctl(PR_SET_PDEATHSIG, SIGKILL);  // the launcher never outlives its owner
+    if (getppid() != owner) _exit(0);
+    close(req[1]);
+    close(rep[0]);
+    const int in = req[0], out = rep[1];
+    // A request: the description's length, the description, the limits.
+    std::uint32_t size = 0;
+    std::string description;
+    ChildLimits limits;
+    while (read_all(in, &size, sizeof size)) {
+      description.resize(size);
+      if (!read_all(in, description.data(), size) || !read_all(in, &limits, sizeof limits)) break;
+      try {
+        Job job = prepare(description);
+        limits.die_with_parent = true;  // the launcher is single-threaded
+        const ChildResult cr = run_forked(
+            [&](int report_fd) {
+              close(in);  // the job's child has no business with the launcher's pipes
+              close(out);
+              return job.body(report_fd);
+            },
+            limits, job.log_path,
+            [&](const std::string& report) { send_reply(out, Reply::report, report.data(), report.size()); });
+        if (!send_reply(out, Reply::result, &cr, sizeof cr)) break;
+      } catch (const std::exception& e) {
+        const std::string what = e.what();
+        if (!send_reply(out, Reply::error, what.data(), what.size())) break;
+      }
+    }
+    _exit(0);
+  }
+  close(req[0]);
+  close(rep[1]);
+  request_fd_ = req[1];
+  reply_fd_ = rep[0];
+}
+
+Launcher::~Launcher() {
+  if (request_fd_ >= 0) close(request_fd_);
+  if (reply_fd_ >= 0) close(reply_fd_);
+  if (pid_ > 0) {
+    int status = 0;
+    while (waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
+    }
+  }
+}
+
+ChildResult Launcher::run(const std::string& description, const ChildLimits& limits,
+                          const std::function<void(const std::string&)>& on_report) {
+  const std::uint32_t size = static_cast<std::uint32_t>(description.size());
+  if (!write_all(request_fd_, &size, sizeof size) || !write_all(request_fd_, description.data(), size) ||
+      !write_all(request_fd_, &limits, sizeof limits))
+    throw std::runtime_error(fmt::format("the trial launcher (pid {}) has died", pid_));
+  while (true) {
+    ReplyHeader h{};
+    std::string data;
+    if (read_all(reply_fd_, &h, sizeof h)) {
+      data.resize(h.size);
+      if (read_all(reply_fd_, data.data(), data.size())) {
+        if (h.kind == Reply::report) {
+          if (on_report) on_report(data);
+          continue;
+        }
+        if (h.kind == Reply::error) throw std::runtime_error(data);
+        if (h.kind == Reply::result && data.size() == sizeof(ChildResult)) {
+          ChildResult r;
+          std::memcpy(&r, data.data(), sizeof r);
+          return r;
+        }
+      }
+    }
+    throw std::runtime_error(fmt::format("the trial launcher (pid {}) has died", pid_));
+  }
 }
 
 std::string find_program(const std::string& name) {

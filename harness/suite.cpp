@@ -448,16 +448,19 @@ json merge_results(const std::vector<json>& shards, const std::vector<std::strin
   return merged;
 }
 
-int run_trial_child(const TrialSpec& spec, const std::string& dir_name) {
+int run_trial_child(const TrialSpec& spec, const std::string& dir_name, int report_fd) {
   const fs::path dir(dir_name);
   auto write_error = [&](const std::string& msg) { std::ofstream(dir / "error.txt") << msg; };
   const auto started = std::chrono::steady_clock::now();
   try {
     run_trial(spec);
-    // steady_clock is CLOCK_MONOTONIC, comparable with the parent's clock; integer nanoseconds
-    // (a default-formatted double would keep only 6 significant digits).
-    std::ofstream(dir / "timing.txt") << started.time_since_epoch().count() << " "
-                                      << std::chrono::steady_clock::now().time_since_epoch().count();
+    if (report_fd >= 0) {
+      // steady_clock is CLOCK_MONOTONIC, comparable with the parent's clock; integer nanoseconds.
+      static_assert(std::is_same_v<std::chrono::steady_clock::duration, std::chrono::nanoseconds>);
+      const std::string report = fmt::format("{} {}", started.time_since_epoch().count(),
+                                             std::chrono::steady_clock::now().time_since_epoch().count());
+      [[maybe_unused]] const auto n = write(report_fd, report.data(), report.size());
+    }
     return kExitOk;
   } catch (const InputError& e) {
     write_error(e.what());
@@ -469,6 +472,41 @@ int run_trial_child(const TrialSpec& spec, const std::string& dir_name) {
     write_error(e.what());
     return kExitError;
   }
+}
+
+json trial_job(const SuiteConfig& c, const std::string& dir) {
+  json spec = to_json(c.spec);
+  spec["out_dir"] = dir;
+  spec["context"] = false;
+  spec["skip_teardown"] = true;
+  return spec;
+}
+
+namespace {
+
+int g_threads_at_fork = -1;  // in the process that started the launcher, when it did
+
+}  // namespace
+
+std::unique_ptr<Launcher> start_trial_launcher() {
+  // Forking is only safe from a single-threaded parent. OpenVDB's logger, log4cplus, starts a pool of
+  // worker threads when the library loads, before main: stop it (logging still works without it).
+  log4cplus::deinitialize();
+  // TBB's one-time initialisation (hardware topology; no worker threads: those start with the first
+  // parallel algorithm) is done here once, so each forked trial inherits it instead of paying ~3 ms.
+  (void)tbb::info::default_concurrency();
+  { tbb::global_control warm(tbb::global_control::max_allowed_parallelism, tbb::info::default_concurrency()); }
+  g_threads_at_fork = process_thread_count();
+  if (g_threads_at_fork != 1)
+    fmt::print(stderr, "growbench: warning: {} threads in the suite process before forking trials (expected 1)\n",
+               g_threads_at_fork);
+  return std::make_unique<Launcher>([](const std::string& description) {
+    const json j = json::parse(description);
+    const TrialSpec spec = trial_spec_from_json(j);
+    const std::string dir = spec.out_dir;
+    return Launcher::Job{[spec, dir](int report_fd) { return run_trial_child(spec, dir, report_fd); },
+                         (fs::path(dir) / "log.txt").string()};
+  });
 }
 
 std::string run_suite(const Suite& suite_in, const SuiteRunOptions& o) {
@@ -486,6 +524,14 @@ std::string run_suite(const Suite& suite_in, const SuiteRunOptions& o) {
   const fs::path out = o.out_dir.empty() ? fs::path("out/suites") / suite.name : fs::path(o.out_dir);
   const fs::path results_path = out / "results.json";
   fs::create_directories(out / "trials");
+
+  std::unique_ptr<Launcher> own_launcher;
+  Launcher* launcher = o.launcher;
+  if (!o.instructions && !launcher) {
+    own_launcher = start_trial_launcher();
+    launcher = own_launcher.get();
+  }
+  const ChildLimits limits{suite.timeout_s, suite.memory_limit_bytes};
 
   const fs::path journal_path = out / "journal.jsonl";
   json results;
@@ -513,20 +559,10 @@ std::string run_suite(const Suite& suite_in, const SuiteRunOptions& o) {
                {"shard", {{"index", o.shard_index}, {"count", o.shard_count}}},
                {"trials", json::array()}};
   }
-  // Forking is only safe from a single-threaded parent. OpenVDB's logger, log4cplus, starts a pool of
-  // worker threads when the library loads, before main: stop it (logging still works without it).
-  log4cplus::deinitialize();
-  // TBB's one-time initialisation (hardware topology; no worker threads: those start with the first
-  // parallel algorithm) is done here once, so each forked trial inherits it instead of paying ~3 ms.
-  (void)tbb::info::default_concurrency();
-  { tbb::global_control warm(tbb::global_control::max_allowed_parallelism, tbb::info::default_concurrency()); }
-  // The context is taken in the parent before any trial (no threads started here).
+  // The context is taken in the parent before any trial.
   json ctx = run_context();
   ctx["suite_file_hash"] = suite.hash;
-  ctx["parent_threads_at_fork"] = process_thread_count();
-  if (ctx["parent_threads_at_fork"] != 1)
-    fmt::print(stderr, "growbench: warning: {} threads in the suite process before forking trials (expected 1)\n",
-               ctx["parent_threads_at_fork"].get<int>());
+  if (g_threads_at_fork >= 0) ctx["parent_threads_at_fork"] = g_threads_at_fork;
   results["context"] = ctx;
 
   // Index the trials already recorded, and create entries for every cell of this shard.
@@ -609,20 +645,28 @@ std::string run_suite(const Suite& suite_in, const SuiteRunOptions& o) {
     const fs::path rec_path = dir / "record.json", err_path = dir / "error.txt";
     fs::remove(rec_path);
     fs::remove(err_path);
-    TrialSpec spec = c.spec;
-    spec.out_dir = dir.string();
-    spec.context = false;       // recorded once for the whole suite
-    spec.skip_teardown = true;  // the child exits right after
     const auto t0 = std::chrono::steady_clock::now();
     ChildResult cr;
+    // What the child reports once record.json is in place (steady-clock ns), and the record itself,
+    // read while the kernel is still tearing the child down.
+    std::int64_t started_ns = 0, finished_ns = 0;
+    json rec;
+    std::string rec_error;
+    double read_record_s = 0.0;
+    auto read_record = [&] {
+      const auto r0 = std::chrono::steady_clock::now();
+      try {
+        rec = json::parse(read_text(rec_path.string()));
+      } catch (const std::exception& e) {
+        rec = nullptr;
+        rec_error = e.what();
+      }
+      read_record_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
+    };
     if (o.instructions) {
       // Under callgrind: the trial runs in a fresh growbench process (`growbench trial`), single-threaded,
       // and dumps its instruction count at the end of every phase (harness/trial.cpp).
-      json child = to_json(spec);
-      child["out_dir"] = spec.out_dir;
-      child["context"] = spec.context;
-      child["skip_teardown"] = spec.skip_teardown;
-      write_atomic(dir / "spec.json", child.dump() + "\n");
+      write_atomic(dir / "spec.json", trial_job(c, dir.string()).dump() + "\n");
       for (const auto& e : fs::directory_iterator(dir))
         if (e.path().filename().string().rfind("callgrind.out", 0) == 0) fs::remove(e.path());
       std::vector<std::string> args = {valgrind, "--tool=callgrind", "--callgrind-out-file=" + (dir / "callgrind.out").string(),
@@ -633,9 +677,13 @@ std::string run_suite(const Suite& suite_in, const SuiteRunOptions& o) {
                                        self_exe, "trial", (dir / "spec.json").string()};
       cr = run_program(args, "", {suite.timeout_s * kCallgrindSlowdown, 0}, (dir / "log.txt").string());
     } else {
-      cr = run_forked([&]() -> int { return run_trial_child(spec, dir.string()); },
-                      {suite.timeout_s, suite.memory_limit_bytes}, (dir / "log.txt").string());
+      cr = launcher->run(trial_job(c, dir.string()).dump(), limits, [&](const std::string& report) {
+        std::istringstream in(report);
+        in >> started_ns >> finished_ns;
+        read_record();
+      });
     }
+    const auto t_reaped = std::chrono::steady_clock::now();
 
     json sample = {{"repetition", job.repetition},
                    {"child_wall_s", cr.wall_s},
@@ -643,7 +691,6 @@ std::string run_suite(const Suite& suite_in, const SuiteRunOptions& o) {
                    {"child_system_s", cr.system_s},
                    {"child_max_rss_bytes", cr.max_rss_bytes}};
     std::string status, message;
-    json rec;
     if (cr.timed_out) {
       status = "timeout";
       message = fmt::format("killed after {} s", suite.timeout_s);
@@ -652,11 +699,16 @@ std::string run_suite(const Suite& suite_in, const SuiteRunOptions& o) {
       status = cr.signal == SIGKILL ? "out_of_memory" : "crashed";
       message = signal_name(cr.signal);
     } else if (cr.exit_code == kExitOk && fs::exists(rec_path)) {
-      rec = json::parse(read_text(rec_path.string()));
-      status = "ok";
-      if (o.instructions) {
-        rec["instructions"] = read_callgrind_phases(dir);
-        sample["instructions"] = rec["instructions"];
+      if (rec.is_null() && rec_error.empty()) read_record();  // no report (callgrind trials)
+      if (rec.is_null()) {
+        status = "crashed";
+        message = fmt::format("{} is unreadable: {}", rec_path.string(), rec_error);
+      } else {
+        status = "ok";
+        if (o.instructions) {
+          rec["instructions"] = read_callgrind_phases(dir);
+          sample["instructions"] = rec["instructions"];
+        }
       }
     } else {
       message = fs::exists(err_path) ? read_text(err_path.string()) : fmt::format("exit code {}", cr.exit_code);
@@ -681,20 +733,24 @@ std::string run_suite(const Suite& suite_in, const SuiteRunOptions& o) {
         for (const auto& [k, v] : rec["phases"].items()) alloc[k] = {{"count", v["alloc_count"]}, {"bytes", v["alloc_bytes"]}};
         cell["alloc"] = alloc;
       }
-      // Where the time outside the phases goes: fork to child start, child bookkeeping (record JSON,
-      // files), and child exit to reaping (the kernel freeing the trial's memory). The total runs to
-      // just before the journal append below (one short write).
-      std::ifstream tin(dir / "timing.txt");
-      std::int64_t started_ns = 0, finished_ns = 0;
-      if (tin >> started_ns >> finished_ns) {
-        static_assert(std::is_same_v<std::chrono::steady_clock::duration, std::chrono::nanoseconds>);
+      // Where the time outside the phases goes (README, "Harness overhead"): fork to the child's start;
+      // the child's own bookkeeping (measuring, record.json, snapshot); the kernel tearing the child down
+      // (freeing its memory), during which this process reads the record; and this process's work.
+      // Everything runs to just before the journal append below (one short write).
+      const auto now = std::chrono::steady_clock::now();
+      sample["outside_phases_s"] = std::chrono::duration<double>(now - t0).count() - inside;
+      if (started_ns > 0) {
+        const auto secs = [](std::chrono::steady_clock::time_point tp) { return std::chrono::duration<double>(tp.time_since_epoch()).count(); };
         const double started = 1e-9 * static_cast<double>(started_ns), finished = 1e-9 * static_cast<double>(finished_ns);
-        const double t0s = std::chrono::duration<double>(t0.time_since_epoch()).count();
-        sample["launch_s"] = started - t0s;
-        sample["child_bookkeeping_s"] = finished - started - inside;
-        sample["exit_s"] = t0s + cr.wall_s - finished;
+        const double launch = started - secs(t0), bookkeeping = finished - started - inside;
+        const double parent = read_record_s + std::chrono::duration<double>(now - t_reaped).count();
+        sample["launch_s"] = launch;
+        sample["launch_fork_s"] = started - 1e-9 * static_cast<double>(cr.spawn_ns);
+        sample["child_bookkeeping_s"] = bookkeeping;
+        sample["teardown_s"] = secs(t_reaped) - finished;
+        sample["parent_s"] = parent;
+        sample["harness_overhead_s"] = launch + bookkeeping + parent;
       }
-      sample["harness_overhead_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() - inside;
     }
     // The journal line is the durable record: appended and flushed before the next trial starts, so an
     // interrupted suite (even by kill -9) loses at most the trial in flight.

@@ -6,11 +6,13 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "harness/process.hpp"
 #include "harness/trial.hpp"
 
 namespace growbench {
@@ -47,12 +49,26 @@ struct SuiteRunOptions {
   // Run each trial once, single-threaded, under valgrind's callgrind, recording instructions per phase
   // ("instructions" in each cell): the deterministic measure the regression gate compares.
   bool instructions = false;
+  // Forks the trials (timing mode). Null: run_suite starts one. `growbench suite` starts it first thing,
+  // before the suite file is read, so trials inherit as little of this process as possible.
+  Launcher* launcher = nullptr;
 };
 
-// The body of a trial's own process: runs the trial into DIR (record.json, timing.txt) and returns the
-// exit status the suite reads (0 ok, 2 invalid input, 3 out of memory, 4 other error; error.txt says why).
-// `growbench trial SPEC.json` calls it too (the callgrind mode runs trials that way).
-int run_trial_child(const TrialSpec& spec, const std::string& dir);
+// A cell's trial as a suite runs it, as the JSON a trial's process reads (the launcher's job, or the
+// spec.json of `growbench trial`): into DIR, without the context (recorded once per suite), and without
+// teardown (the process exits right after).
+nlohmann::json trial_job(const SuiteConfig& cell, const std::string& dir);
+
+// Readies this process for forking trials (stops library threads, warms TBB) and starts a launcher whose
+// jobs are trials (a job is the JSON {"spec", "dir"} run_suite sends).
+std::unique_ptr<Launcher> start_trial_launcher();
+
+// The body of a trial's own process: runs the trial into DIR (record.json) and returns the exit status
+// the suite reads (0 ok, 2 invalid input, 3 out of memory, 4 other error; error.txt says why). When
+// report_fd >= 0 it writes "STARTED FINISHED" there (steady-clock nanoseconds: when the body began, and
+// when record.json was in place) with one write, for the suite's overhead accounting.
+// `growbench trial SPEC.json` calls it too (the callgrind mode runs trials that way), without a report.
+int run_trial_child(const TrialSpec& spec, const std::string& dir, int report_fd = -1);
 
 // Runs the suite and returns the path of results.json. Throws InputError if results already exist
 // and resume is off.

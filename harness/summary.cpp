@@ -123,6 +123,21 @@ std::string summarize_results(const json& results) {
     }
   }
   out += "\nIntervals: distribution-free 95% CI of the median from order statistics ('~': fewer than 6 repetitions, full range shown).\n";
+  // Where each trial's time outside its phases went (harness/suite.cpp), medians over every ok sample.
+  std::map<std::string, std::vector<double>> over;
+  for (const auto& t : results["trials"])
+    for (const auto& s : t["samples"])
+      for (const char* k : {"launch_s", "child_bookkeeping_s", "parent_s", "harness_overhead_s", "teardown_s", "outside_phases_s"})
+        if (s.contains(k)) over[k].push_back(s[k].get<double>());
+  if (!over["harness_overhead_s"].empty()) {
+    auto ms = [&](const char* k) { return fmt::format("{:.2f} ms", 1e3 * median(over[k])); };
+    out += fmt::format(
+        "Harness overhead per trial, median of {} samples: {} (medians of its parts: launch {}, child bookkeeping {}, "
+        "parent {}); then the kernel's teardown of the trial process {} (it grows with the trial's memory); outside "
+        "the phases in all {}.\n",
+        over["harness_overhead_s"].size(), ms("harness_overhead_s"), ms("launch_s"), ms("child_bookkeeping_s"),
+        ms("parent_s"), ms("teardown_s"), ms("outside_phases_s"));
+  }
   if (!warnings.empty()) {
     out += "\nWarnings:\n";
     for (const auto& w : warnings) out += "  ! " + w + "\n";

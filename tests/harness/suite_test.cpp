@@ -200,7 +200,7 @@ TEST(Suite, QuickSuiteEndToEndAndSummary) {
   ASSERT_GE(res["trials"].size(), 3u);
   for (const auto& t : res["trials"]) {
     for (const auto& s : t["samples"])
-      for (const char* k : {"launch_s", "child_bookkeeping_s", "exit_s", "harness_overhead_s"}) {
+      for (const char* k : {"launch_s", "child_bookkeeping_s", "teardown_s", "parent_s", "harness_overhead_s", "outside_phases_s"}) {
         EXPECT_TRUE(s.contains(k)) << k;
         if (s.contains(k)) {
           EXPECT_GE(s[k].get<double>(), 0.0) << k;

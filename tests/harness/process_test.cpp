@@ -1,0 +1,112 @@
+// Child processes: the report channel that lets the parent read a trial's results while the kernel is
+// still tearing it down, and the launcher whose children inherit its small heap instead of their owner's.
+#include "harness/process.hpp"
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace growbench {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Touches `bytes` of fresh memory, so it is resident.
+std::vector<char> resident(std::size_t bytes) {
+  std::vector<char> v(bytes);
+  for (std::size_t i = 0; i < v.size(); i += 4096) v[i] = static_cast<char>(i);
+  return v;
+}
+
+constexpr std::uint64_t kMiB = 1024ull * 1024ull;
+
+TEST(Process, ReportArrivesBeforeTheChildHasExited) {
+  Clock::time_point reported{};
+  std::string got;
+  const auto t0 = Clock::now();
+  const ChildResult r = run_forked(
+      [](int fd) {
+        const char msg[] = "123 456";
+        if (write(fd, msg, sizeof msg - 1) != sizeof msg - 1) return 9;
+        usleep(300 * 1000);  // still running: the report must not wait for this
+        return 5;
+      },
+      {}, "",
+      [&](const std::string& report) {
+        got = report;
+        reported = Clock::now();
+      });
+  const auto done = Clock::now();
+  EXPECT_EQ(r.exit_code, 5);
+  EXPECT_EQ(got, "123 456");
+  EXPECT_LT(std::chrono::duration<double>(reported - t0).count(), 0.25) << "the report waited for the exit";
+  EXPECT_GE(std::chrono::duration<double>(done - t0).count(), 0.3);
+  EXPECT_GT(r.spawn_ns, 0);
+}
+
+TEST(Process, NoReportIsFine) {
+  bool called = false;
+  const ChildResult r = run_forked([](int) { return 0; }, {}, "", [&](const std::string&) { called = true; });
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_FALSE(called);
+}
+
+TEST(Process, LauncherChildrenInheritTheLauncherNotTheOwner) {
+  // The launcher is forked while this process is small; then this process grows by 192 MiB (as a suite
+  // process grows with its results). A child forked straight from here carries those pages in its
+  // peak RSS; a child of the launcher does not.
+  Launcher launcher([](const std::string& what) {
+    return Launcher::Job{[what](int) { return what == "ok" ? 0 : 3; }, ""};
+  });
+  const std::vector<char> big = resident(192 * kMiB);
+  const ChildResult direct = run_forked([] { return 0; }, {}, "");
+  const ChildResult via = launcher.run("ok", {}, nullptr);
+  EXPECT_EQ(direct.exit_code, 0);
+  EXPECT_EQ(via.exit_code, 0);
+  EXPECT_GE(direct.max_rss_bytes, 192 * kMiB) << "control: a direct child should carry its parent's heap";
+  EXPECT_LT(via.max_rss_bytes, 96 * kMiB) << "the launcher's child carried its owner's heap";
+  EXPECT_EQ(launcher.run("other", {}, nullptr).exit_code, 3);
+  EXPECT_NE(big[4096], 1);  // keep `big` alive (and touched) until here
+}
+
+TEST(Process, LauncherRelaysReportsCrashesTimeoutsAndErrors) {
+  Launcher launcher([](const std::string& what) -> Launcher::Job {
+    if (what == "bad") throw std::runtime_error("no such job: bad");
+    return Launcher::Job{[what](int fd) {
+                           if (what == "report") {
+                             [[maybe_unused]] const auto n = write(fd, "done", 4);
+                             return 0;
+                           }
+                           if (what == "crash") raise(SIGSEGV);
+                           if (what == "hang") sleep(30);
+                           return 1;
+                         },
+                         ""};
+  });
+  std::string got;
+  EXPECT_EQ(launcher.run("report", {}, [&](const std::string& r) { got = r; }).exit_code, 0);
+  EXPECT_EQ(got, "done");
+  EXPECT_EQ(launcher.run("crash", {}, nullptr).signal, SIGSEGV);
+  ChildLimits quick;
+  quick.timeout_s = 0.3;
+  const auto t0 = Clock::now();
+  EXPECT_TRUE(launcher.run("hang", quick, nullptr).timed_out);
+  EXPECT_LT(std::chrono::duration<double>(Clock::now() - t0).count(), 5.0);
+  try {
+    launcher.run("bad", {}, nullptr);
+    ADD_FAILURE() << "expected the launcher's error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("no such job: bad"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(launcher.run("other", {}, nullptr).exit_code, 1) << "the launcher goes on after an error";
+}
+
+}  // namespace
+}  // namespace growbench
