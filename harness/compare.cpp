@@ -66,6 +66,25 @@ std::string CompareResult::table() const {
   if (small_changes > 0)
     out += fmt::format("{} instruction counts moved by less than 0.1% and fewer instructions than the floor (not listed)\n",
                        small_changes);
+  if (!timings.empty()) {
+    std::size_t wc2 = 4;
+    for (const auto& t : timings) wc2 = std::max(wc2, t.cell.size());
+    out += fmt::format("\nTimings (reported, not gated: a flag here is unconfirmed; `growbench ab` reruns and confirms)\n");
+    out += fmt::format("{:<{}}  {:<14}  {:>7}  {:>10}  {:>10}  {:>24}  {:>8}  {}\n", "cell", wc2, "metric", "n", "old median",
+                       "new median", "new/old [95% CI]", "p", "verdict");
+    std::map<std::string, int> tally;
+    for (const auto& t : timings) {
+      const TimingVerdict& v = t.verdict;
+      ++tally[v.verdict];
+      out += fmt::format("{:<{}}  {:<14}  {:>7}  {:>10}  {:>10}  {:>24}  {:>8.2g}  {}\n", t.cell, wc2, t.metric,
+                         fmt::format("{}/{}", v.n_a, v.n_b), format_seconds(v.median_a), format_seconds(v.median_b),
+                         fmt::format("{:.3f} [{:.3f}, {:.3f}]", v.interval.ratio, v.interval.lo, v.interval.hi), v.test.p,
+                         v.verdict == "inconclusive" ? fmt::format("inconclusive (~{} repetitions needed)", v.needed) : v.verdict);
+    }
+    std::string counts;
+    for (const auto& [k, n] : tally) counts += fmt::format("{}{} {}", counts.empty() ? "" : ", ", n, k);
+    out += "timings: " + counts + "\n\n";
+  }
   std::size_t failing = 0;
   for (const auto& c : changes) failing += c.fails ? 1 : 0;
   out += fmt::format("{} cells compared, {} changed quantities, {} failing, {} missing cells: {}\n", cells_compared,
@@ -137,6 +156,21 @@ CompareResult compare_results(const json& base, const json& now, const CompareOp
                                          : ratio > 1.0 + o.instructions_threshold ? " (below the floor)" : "")});
       }
     }
+    // Timings: the repetitions of both runs, per phase, wall and CPU.
+    auto samples = [](const json& t, const std::string& phase, const char* what) {
+      std::vector<double> v;
+      if (t.contains("samples"))
+        for (const auto& s : t["samples"])
+          if (s.value("status", "") == "ok" && s.contains("phases") && s["phases"].contains(phase))
+            v.push_back(s["phases"][phase][what].get<double>());
+      return v;
+    };
+    for (const char* phase : {"growth"})
+      for (const char* what : {"wall_s", "cpu_s"}) {
+        const auto a = samples(b, phase, what), c = samples(n, phase, what);
+        if (a.size() >= 3 && c.size() >= 3)
+          r.timings.push_back({id, fmt::format("{}.{}", phase, what), judge_timings(a, c, o.timing_effect, o.timing_alpha)});
+      }
   }
   for (const auto& [id, t] : now_cells)
     if (!seen.count(id)) r.new_cells.push_back(id);

@@ -1,14 +1,17 @@
 // The deterministic regression gate: two results files (or a committed baseline and a new run) compared
 // on what must not change by accident: behaviour (geometry hash, counts, quality metrics), allocations
 // (count and bytes per phase), output bytes per format, and instruction counts per phase (from
-// `growbench suite --instructions`, callgrind). Wall-clock times are not compared here: on a shared
-// 2-core VM they move by tens of percent between runs.
+// `growbench suite --instructions`, callgrind). When both sides are timing runs with repetitions, their
+// wall and CPU times are compared too, statistically (harness/stats.hpp), and reported: a timing flag
+// never fails here, because it has not been confirmed; `growbench ab` reruns and confirms.
 #pragma once
 
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
+
+#include "harness/stats.hpp"
 
 namespace growbench {
 
@@ -21,6 +24,8 @@ struct CompareOptions {
   // builds absolute paths (the L-system's example grammars), the checkout's path length enters them,
   // 90 bytes between /work/main and /work/cleancheck.
   double alloc_bytes_slack = 4096;
+  double timing_effect = 1.03;  // the statistical comparison's effect size and significance level
+  double timing_alpha = 0.01;
 };
 
 struct Change {
@@ -31,7 +36,13 @@ struct Change {
   std::string why;             // "behaviour", "allocations", "output bytes", "instructions +3.1%", ...
 };
 
+struct TimingComparison {
+  std::string cell, metric;  // e.g. "growth.wall_s"
+  TimingVerdict verdict;
+};
+
 struct CompareResult {
+  std::vector<TimingComparison> timings;  // both sides with >= 3 ok repetitions
   std::vector<Change> changes;  // every changed quantity, failing or not
   std::size_t cells_compared = 0;
   std::vector<std::string> missing_cells, new_cells;

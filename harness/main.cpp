@@ -13,6 +13,7 @@
 #include "algorithms/algorithm.hpp"
 #include "algorithms/lsystem/lsystem.hpp"
 #include "core/errors.hpp"
+#include "harness/ab.hpp"
 #include "harness/compare.hpp"
 #include "harness/render_results.hpp"
 #include "harness/report.hpp"
@@ -116,6 +117,30 @@ int main(int argc, char** argv) {
   trial_cmd->group("");  // not listed in --help: suites call it under callgrind
   std::string trial_spec_file;
   trial_cmd->add_option("spec", trial_spec_file, "spec.json")->required();
+  std::string trial_fault;
+  // Test hook: a wrapper script that appends `--fault slow:N` turns this binary into a planted slowdown
+  // for `growbench ab` (tests/harness/ab_test.sh).
+  trial_cmd->add_option("--fault", trial_fault, "inject a fault into the trial (tests)");
+
+  auto* ab_cmd = app.add_subcommand(
+      "ab", "The statistical gate: run a suite's trials with two growbench binaries alternately (A B, B A, ...) and "
+            "report, per cell, whether B is slower, faster, unchanged, or the noise is too high to tell; exit 1 only "
+            "on a slowdown that a rerun confirms");
+  gb::AbOptions ab_opts;
+  std::string ab_suite;
+  ab_cmd->add_option("a", ab_opts.a_binary, "the base growbench binary")->required();
+  ab_cmd->add_option("b", ab_opts.b_binary, "the candidate growbench binary")->required();
+  ab_cmd->add_option("suite", ab_suite, "suite file (its cells, seeds and limits; its repetitions are not used)")->required();
+  ab_cmd->add_option("-o,--out", ab_opts.out_dir, "output directory: ab.json and the trials (default: out/ab/SUITE)");
+  ab_cmd->add_option("--effect", ab_opts.effect, "the smallest median ratio B/A to detect")->default_val(1.03);
+  ab_cmd->add_option("--alpha", ab_opts.alpha, "significance level of the Mann-Whitney U test")->default_val(0.01);
+  ab_cmd->add_option("--min-reps", ab_opts.min_repetitions, "pilot repetitions per side")->default_val(6);
+  ab_cmd->add_option("--max-reps", ab_opts.max_repetitions,
+                     "at most this many per side and batch; noisier cells are 'inconclusive'")->default_val(30);
+  ab_cmd->add_option("--phases", ab_opts.phases, "phases whose wall and CPU time are compared")
+      ->default_val(std::vector<std::string>{"growth"})->delimiter(',');
+  ab_cmd->add_flag("!--no-confirm", ab_opts.confirm, "do not rerun flagged cells (a flag is then 'unconfirmed')");
+  ab_cmd->add_flag("-q,--quiet", ab_opts.quiet, "no progress lines");
 
   auto* compare_cmd = app.add_subcommand(
       "compare", "Compare two results files (or a baseline): behaviour, allocations, output bytes, instructions; exit 1 "
@@ -285,8 +310,15 @@ int main(int argc, char** argv) {
     if (*trial_cmd) {
       std::ifstream in(trial_spec_file);
       if (!in) throw gb::InputError(fmt::format("{}: cannot open", trial_spec_file));
-      const gb::TrialSpec ts = gb::trial_spec_from_json(nlohmann::json::parse(in));
+      gb::TrialSpec ts = gb::trial_spec_from_json(nlohmann::json::parse(in));
+      if (!trial_fault.empty()) ts.fault = trial_fault;
       return gb::run_trial_child(ts, ts.out_dir);
+    }
+    if (*ab_cmd) {
+      const gb::Suite suite = gb::load_suite(ab_suite);
+      const gb::AbResult r = gb::run_ab(suite, ab_opts);
+      fmt::print("{}", r.table);
+      return r.regression ? 1 : 0;
     }
     if (*compare_cmd) {
       const auto r = gb::compare_results(gb::read_results_file(cmp_base), gb::read_results_file(cmp_new), cmp_opts);

@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "harness/stats.hpp"
 #include "harness/suite.hpp"
 
 namespace growbench {
@@ -52,11 +53,6 @@ std::string si_bytes(double b) {
   return fmt::format("{:.1f} {}", b, u[i]);
 }
 
-std::string seconds(double s) {
-  if (!std::isfinite(s)) return "-";
-  return s < 1.0 ? fmt::format("{:.1f} ms", s * 1e3) : fmt::format("{:.2f} s", s);
-}
-
 }  // namespace
 
 std::string summarize_results(const json& results) {
@@ -76,7 +72,7 @@ std::string summarize_results(const json& results) {
   std::vector<std::string> warnings;
   for (const auto& sc : scene_order) {
     out += fmt::format("\n== scene {}\n", sc);
-    out += fmt::format("{:<40} {:>6} {:>24} {:>10} {:>11} {:>8} {:>9} {:>10} {:>8} {:>8} {:>8}\n", "cell", "status",
+    out += fmt::format("{:<40} {:>6} {:>30} {:>10} {:>11} {:>8} {:>9} {:>10} {:>8} {:>8} {:>8}\n", "cell", "status",
                        "growth median [95% CI]", "total", "peak RSS", "nodes", "length m", "PLY", "cover", "attach",
                        "inside");
     for (const json* tp : by_scene[sc]) {
@@ -97,11 +93,11 @@ std::string summarize_results(const json& results) {
       bool exact = false;
       const auto [lo, hi] = median_ci(growth, exact);
       const double med = median(growth);
-      const std::string ci = growth.empty() ? "-" : fmt::format("{} [{}{}, {}]", seconds(med), exact ? "" : "~", seconds(lo), seconds(hi));
+      const std::string ci = growth.empty() ? "-" : fmt::format("{} [{}{}, {}]", format_seconds(med), exact ? "" : "~", format_seconds(lo), format_seconds(hi));
       const json m = t.value("metrics", json::object());
       auto metric = [&](const char* k) { return m.contains(k) ? fmt::format("{:.3f}", m[k].get<double>()) : std::string("-"); };
-      out += fmt::format("{:<40} {:>6} {:>24} {:>10} {:>11} {:>8} {:>9} {:>10} {:>8} {:>8} {:>8}\n", cell.substr(0, 40),
-                         t.value("status", "?"), ci, seconds(median(total)), si_bytes(median(rss)),
+      out += fmt::format("{:<40} {:>6} {:>30} {:>10} {:>11} {:>8} {:>9} {:>10} {:>8} {:>8} {:>8}\n", cell.substr(0, 40),
+                         t.value("status", "?"), ci, format_seconds(median(total)), si_bytes(median(rss)),
                          t.contains("counts") ? std::to_string(t["counts"]["nodes"].get<long>()) : "-",
                          t.contains("total_length_m") ? fmt::format("{:.2f}", t["total_length_m"].get<double>()) : "-",
                          t.contains("output_bytes") && t["output_bytes"].contains("ply") ? si_bytes(t["output_bytes"]["ply"].get<double>()) : "-",

@@ -53,6 +53,33 @@ TEST(Compare, AnyBehaviourChangeFails) {
   }
 }
 
+TEST(Compare, TimingsAreJudgedAndReportedButNeverFail) {
+  // Ten repetitions each: growth 10 ms +-1% against 11 ms +-1% (slower), and an unchanged cell.
+  auto timed = [](const std::string& id, double centre) {
+    json c = cell(id);
+    c["samples"] = json::array();
+    for (int r = 0; r < 10; ++r) {
+      const double t = centre * (1.0 + 0.01 * ((r * 7) % 10 - 4.5) / 4.5);
+      c["samples"].push_back({{"repetition", r}, {"status", "ok"}, {"phases", {{"growth", {{"wall_s", t}, {"cpu_s", t}}}}}});
+    }
+    return c;
+  };
+  const json a = results({timed("a/wall/s1", 0.010), timed("b/wall/s1", 0.020)});
+  const json b = results({timed("a/wall/s1", 0.011), timed("b/wall/s1", 0.020)});
+  const auto r = compare_results(a, b);
+  EXPECT_FALSE(r.fails()) << "an unconfirmed timing flag must not fail the gate";
+  ASSERT_EQ(r.timings.size(), 4u);
+  EXPECT_EQ(r.timings[0].cell, "a/wall/s1");
+  EXPECT_EQ(r.timings[0].metric, "growth.wall_s");
+  EXPECT_EQ(r.timings[0].verdict.verdict, "slower");
+  EXPECT_NEAR(r.timings[0].verdict.interval.ratio, 1.1, 1e-9);
+  EXPECT_LT(r.timings[0].verdict.test.p, 1e-4);
+  EXPECT_EQ(r.timings[2].verdict.verdict, "no change");
+  EXPECT_NE(r.table().find("timings: 2 no change, 2 slower"), std::string::npos) << r.table();
+  // Baselines have no repetitions: nothing to judge.
+  EXPECT_TRUE(compare_results(results({cell("a/wall/s1")}), results({cell("a/wall/s1")})).timings.empty());
+}
+
 TEST(Compare, InstructionsFailOnlyPastTheThreshold) {
   const json a = results({cell("a/wall/s1")});
   auto with_growth = [&](std::int64_t ir) {

@@ -1,0 +1,249 @@
+#include "harness/ab.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <map>
+
+#include <fmt/format.h>
+
+#include "core/errors.hpp"
+#include "core/json_util.hpp"
+#include "harness/exporters.hpp"
+#include "harness/process.hpp"
+#include "harness/stats.hpp"
+#include "harness/trial.hpp"
+
+namespace growbench {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+constexpr const char* kSides[2] = {"A", "B"};
+
+// Samples of one cell: per side, per metric ("growth.wall_s", ...).
+using Samples = std::array<std::map<std::string, std::vector<double>>, 2>;
+
+struct Cell {
+  const SuiteConfig* config = nullptr;
+  fs::path dir;
+  Samples pilot, confirmation;  // the first batch (pilot and its extension), the confirmation rerun
+  std::string error;            // a trial that failed: the cell is dropped
+  std::array<std::string, 2> hash;
+};
+
+std::string version_of(const std::string& binary, const fs::path& dir) {
+  const std::string log = (dir / "version.txt").string();
+  fs::remove(log);
+  const ChildResult r = run_program({binary, "--version"}, "", {30.0, 0}, log);
+  if (r.exit_code != 0) return "";
+  std::string v = read_text_file(log);
+  while (!v.empty() && (v.back() == '\n' || v.back() == '\r')) v.pop_back();
+  return v;
+}
+
+json verdict_json(const TimingVerdict& v) {
+  return {{"verdict", v.verdict},
+          {"n_a", v.n_a},
+          {"n_b", v.n_b},
+          {"median_a", v.median_a},
+          {"median_b", v.median_b},
+          {"robust_cv", v.cv},
+          {"needed", v.needed},
+          {"ratio", v.interval.ratio},
+          {"ratio_lo", v.interval.lo},
+          {"ratio_hi", v.interval.hi},
+          {"u", v.test.u},
+          {"p", v.test.p},
+          {"exact", v.test.exact}};
+}
+
+}  // namespace
+
+AbResult run_ab(const Suite& suite, const AbOptions& o) {
+  for (const auto& b : {o.a_binary, o.b_binary})
+    if (access(b.c_str(), X_OK) != 0) throw InputError(fmt::format("ab: '{}' is not an executable growbench binary", b));
+  if (o.effect <= 1.0) throw InputError(fmt::format("ab: --effect must be above 1, got {}", o.effect));
+  if (o.alpha <= 0.0 || o.alpha >= 1.0) throw InputError(fmt::format("ab: --alpha must be in (0, 1), got {}", o.alpha));
+  if (o.min_repetitions < 3 || o.max_repetitions < o.min_repetitions)
+    throw InputError(fmt::format("ab: expected 3 <= --min-reps <= --max-reps, got {} and {}", o.min_repetitions, o.max_repetitions));
+  const fs::path out = o.out_dir.empty() ? fs::path("out/ab") / suite.name : fs::path(o.out_dir);
+  fs::create_directories(out);
+  const std::string bins[2] = {fs::absolute(o.a_binary).string(), fs::absolute(o.b_binary).string()};
+
+  std::vector<Cell> cells;
+  for (const auto& c : suite.configs) {
+    Cell cell;
+    cell.config = &c;
+    cell.dir = out / "cells" / c.id;
+    for (int s = 0; s < 2; ++s) {
+      fs::create_directories(cell.dir / kSides[s]);
+      const std::string text = trial_job(c, (cell.dir / kSides[s]).string()).dump() + "\n";
+      write_file_atomic((cell.dir / kSides[s] / "spec.json").string(), text.data(), text.size());
+    }
+    cells.push_back(std::move(cell));
+  }
+  std::vector<std::string> metrics;
+  for (const auto& p : o.phases) {
+    metrics.push_back(p + ".wall_s");
+    metrics.push_back(p + ".cpu_s");
+  }
+
+  const bool tty = isatty(STDERR_FILENO) != 0 && !o.quiet;
+  int trials_run = 0;
+  // One trial of one side: its phases' times into `into`, or the cell's error.
+  auto run_one = [&](Cell& cell, int side, Samples* into) {
+    const fs::path dir = cell.dir / kSides[side];
+    fs::remove(dir / "record.json");
+    const ChildResult r = run_program({bins[side], "trial", (dir / "spec.json").string()}, "",
+                                      {suite.timeout_s, suite.memory_limit_bytes}, (dir / "log.txt").string());
+    ++trials_run;
+    std::string why;
+    if (r.timed_out) why = fmt::format("timed out after {} s", suite.timeout_s);
+    else if (r.signal != 0) why = fmt::format("killed by signal {}", r.signal);
+    else if (r.exit_code != 0 || !fs::exists(dir / "record.json"))
+      why = fmt::format("exit code {} (see {})", r.exit_code, (dir / "log.txt").string());
+    if (!why.empty()) {
+      cell.error = fmt::format("side {} ({}): {}", kSides[side], bins[side], why);
+      return;
+    }
+    const json rec = json::parse(read_text_file((dir / "record.json").string()));
+    cell.hash[static_cast<std::size_t>(side)] = rec.value("geometry_hash", "");
+    if (!into) return;  // a warm-up
+    for (const auto& p : o.phases) {
+      if (!rec["phases"].contains(p)) {
+        cell.error = fmt::format("side {}: its record has no phase '{}'", kSides[side], p);
+        return;
+      }
+      (*into)[static_cast<std::size_t>(side)][p + ".wall_s"].push_back(rec["phases"][p]["wall_s"].get<double>());
+      (*into)[static_cast<std::size_t>(side)][p + ".cpu_s"].push_back(rec["phases"][p]["cpu_s"].get<double>());
+    }
+  };
+  auto count = [&](const Samples& s) { return s[0].empty() ? 0 : static_cast<int>(s[0].begin()->second.size()); };
+  // Runs rounds until each listed cell has its target: in each round a cell runs A then B or B then A,
+  // alternating by round and by cell.
+  auto batch = [&](const std::string& stage, const std::map<std::size_t, int>& target, Samples Cell::*which) {
+    for (int round = 0;; ++round) {
+      bool any = false;
+      for (const auto& [k, n] : target) {
+        Cell& cell = cells[k];
+        if (!cell.error.empty() || count(cell.*which) >= n) continue;
+        any = true;
+        if (!o.quiet) {
+          const std::string line = fmt::format("[ab {}] {} pair {}/{}", stage, cell.config->id, count(cell.*which) + 1, n);
+          if (tty) fmt::print(stderr, "\r{:<100}", line.substr(0, 100));
+          else fmt::print(stderr, "{}\n", line);
+        }
+        const int first = (round + static_cast<int>(k)) % 2;
+        run_one(cell, first, &(cell.*which));
+        if (cell.error.empty()) run_one(cell, 1 - first, &(cell.*which));
+      }
+      if (!any) break;
+    }
+  };
+  auto judge = [&](const Samples& s, const std::string& m) { return judge_timings(s[0].at(m), s[1].at(m), o.effect, o.alpha); };
+
+  // A warm-up pair (file caches, the binaries' pages), not kept.
+  if (!cells.empty()) {
+    run_one(cells.front(), 0, nullptr);
+    run_one(cells.front(), 1, nullptr);
+  }
+  std::map<std::size_t, int> target;
+  for (std::size_t k = 0; k < cells.size(); ++k) target[k] = o.min_repetitions;
+  batch("pilot", target, &Cell::pilot);
+  // The pilot's noise sets each cell's repetitions for the effect asked for.
+  for (auto& [k, n] : target) {
+    if (!cells[k].error.empty()) continue;
+    int need = o.min_repetitions;
+    for (const auto& m : metrics) need = std::max(need, judge(cells[k].pilot, m).needed);
+    n = std::min(need, o.max_repetitions);
+  }
+  batch("main", target, &Cell::pilot);
+  // Flagged cells run again, a fresh batch of the same size: only a repeated flag counts.
+  std::map<std::size_t, int> flagged;
+  for (const auto& [k, n] : target) {
+    if (!cells[k].error.empty()) continue;
+    for (const auto& m : metrics) {
+      const std::string v = judge(cells[k].pilot, m).verdict;
+      if (v == "slower" || v == "faster") flagged[k] = count(cells[k].pilot);
+    }
+  }
+  if (o.confirm) batch("confirm", flagged, &Cell::confirmation);
+  if (tty) fmt::print(stderr, "\r{:<100}\r", "");
+
+  AbResult res;
+  json doc = {{"kind", "growbench-ab"},
+              {"schema_version", 1},
+              {"suite", {{"name", suite.name}, {"file", suite.file}, {"hash", suite.hash}}},
+              {"binaries", {{"A", {{"path", bins[0]}, {"version", version_of(bins[0], out)}}},
+                            {"B", {{"path", bins[1]}, {"version", version_of(bins[1], out)}}}}},
+              {"options", {{"effect", o.effect}, {"alpha", o.alpha}, {"power", o.power}, {"min_repetitions", o.min_repetitions},
+                           {"max_repetitions", o.max_repetitions}, {"phases", o.phases}, {"confirm", o.confirm}}},
+              {"context", run_context()},
+              {"trials_run", trials_run},
+              {"cells", json::array()}};
+  std::string table = fmt::format("{:<34} {:<16} {:>4} {:>10} {:>10} {:>24} {:>9}  {}\n", "cell", "metric", "n", "A median",
+                                  "B median", "B/A [95% CI]", "p", "verdict");
+  std::map<std::string, int> tally;
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    const Cell& cell = cells[k];
+    json jc = {{"id", cell.config->id}, {"verdicts", json::object()}};
+    for (int s = 0; s < 2; ++s) {
+      jc["samples"][kSides[s]] = cell.pilot[static_cast<std::size_t>(s)];
+      if (count(cell.confirmation) > 0) jc["confirmation_samples"][kSides[s]] = cell.confirmation[static_cast<std::size_t>(s)];
+    }
+    if (!cell.error.empty()) {
+      jc["error"] = cell.error;
+      table += fmt::format("{:<34} error: {}\n", cell.config->id.substr(0, 34), cell.error);
+      ++tally["error"];
+      doc["cells"].push_back(jc);
+      continue;
+    }
+    jc["same_plant"] = cell.hash[0] == cell.hash[1];
+    for (const auto& m : metrics) {
+      const TimingVerdict v = judge(cell.pilot, m);
+      json jm = verdict_json(v);
+      std::string final_verdict = v.verdict;
+      if (v.verdict == "slower" || v.verdict == "faster") {
+        if (count(cell.confirmation) > 0) {
+          const TimingVerdict c = judge(cell.confirmation, m);
+          jm["confirmation"] = verdict_json(c);
+          final_verdict = c.verdict == v.verdict ? (v.verdict == "slower" ? "regression" : "improvement") : "not confirmed";
+        } else {
+          final_verdict = v.verdict + " (unconfirmed)";
+        }
+      }
+      if (final_verdict == "inconclusive" && v.needed > o.max_repetitions)
+        jm["note"] = fmt::format("noise (robust CV {:.1f}%) needs ~{} repetitions per side for a {:.0f}% effect; the cap is {}",
+                                 100 * v.cv, v.needed, 100 * (o.effect - 1), o.max_repetitions);
+      jm["final"] = final_verdict;
+      ++tally[final_verdict];
+      if (final_verdict == "regression") res.regression = true;
+      table += fmt::format("{:<34} {:<16} {:>4} {:>10} {:>10} {:>24} {:>9.2g}  {}{}\n", cell.config->id.substr(0, 34), m,
+                           v.n_a, format_seconds(v.median_a), format_seconds(v.median_b),
+                           fmt::format("{:.3f} [{:.3f}, {:.3f}]", v.interval.ratio, v.interval.lo, v.interval.hi), v.test.p,
+                           final_verdict, jm.contains("note") ? " (" + jm["note"].get<std::string>() + ")" : "");
+      jc["verdicts"][m] = jm;
+    }
+    doc["cells"].push_back(jc);
+  }
+  std::string counts;
+  for (const auto& [k, n] : tally) counts += fmt::format("{}{} {}", counts.empty() ? "" : ", ", n, k);
+  table += fmt::format(
+      "\nA = {}\nB = {}\n{} trials, alternating A/B. A cell is flagged when Mann-Whitney p < {} and the median ratio is "
+      "beyond {:.2f} with its bootstrap 95% interval excluding 1; a flagged cell is rerun and counts only if the rerun "
+      "flags it again. 'no change': the interval lies within [1/{:.2f}, {:.2f}].\n{}\nverdict: {}\n",
+      bins[0], bins[1], trials_run, o.alpha, o.effect, o.effect, o.effect, counts,
+      res.regression ? "REGRESSION (B is slower, confirmed)" : "no confirmed regression");
+  doc["verdict"] = res.regression ? "regression" : "ok";
+  doc["tally"] = tally;
+  const std::string text = doc.dump(1) + "\n";
+  write_file_atomic((out / "ab.json").string(), text.data(), text.size());
+  res.doc = std::move(doc);
+  res.table = std::move(table);
+  return res;
+}
+
+}  // namespace growbench

@@ -1,0 +1,60 @@
+// Statistics for comparing timings: the Mann-Whitney U test, a bootstrap interval for the ratio of
+// medians, and how many repetitions a given noise level needs. Used by `growbench ab` (which runs both
+// sides) and `growbench compare` (which reads two results files). Everything here is deterministic: the
+// bootstrap draws from a fixed counter-based stream, so a reviewer gets the same verdict from the same
+// samples.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace growbench {
+
+double median_of(std::vector<double> v);
+
+// A duration for a table: "645.8 us", "12.34 ms", "1.234 s" ("-" when not finite).
+std::string format_seconds(double s);
+
+// A coefficient of variation robust to the odd outlier (a trial that shared its core with a cron job):
+// 1.4826 x the median absolute deviation over the median (the SD over the mean for normal data).
+double robust_cv(const std::vector<double>& v);
+
+struct MannWhitney {
+  double u = 0.0;     // U of the first sample: pairs (a, b) with a > b, ties counted 1/2
+  double p = 1.0;     // two-sided
+  bool exact = true;  // exact null distribution (no ties, both sizes <= 40); else normal, tie-corrected
+};
+MannWhitney mann_whitney(const std::vector<double>& a, const std::vector<double>& b);
+
+struct RatioInterval {
+  double ratio = 1.0;        // median(b) / median(a)
+  double lo = 1.0, hi = 1.0;  // percentile bootstrap interval
+};
+// Resamples a and b independently `resamples` times; level 0.95 gives the 2.5% and 97.5% percentiles.
+RatioInterval median_ratio_interval(const std::vector<double>& a, const std::vector<double>& b, double level = 0.95,
+                                    int resamples = 4000, std::uint64_t seed = 20170601);
+
+// Repetitions per side for a two-sided Mann-Whitney test at `alpha` to detect a ratio of `effect`
+// between medians with probability `power`, when each side's (robust) coefficient of variation is `cv`
+// (normal approximation on the log scale, divided by the test's 0.955 relative efficiency).
+int repetitions_needed(double cv, double effect, double alpha = 0.01, double power = 0.8);
+
+// The upper quantile z with P(Z > z) = q of the standard normal.
+double normal_upper_quantile(double q);
+
+struct TimingVerdict {
+  // "slower" | "faster": p < alpha, the median ratio at least `effect` (or at most 1/effect), and its
+  // interval excluding 1. "no change": the interval inside (1/effect, effect). "inconclusive": neither;
+  // `needed` says how many repetitions per side the observed noise calls for.
+  std::string verdict;
+  int n_a = 0, n_b = 0;
+  double median_a = 0.0, median_b = 0.0, cv = 0.0;
+  MannWhitney test;
+  RatioInterval interval;
+  int needed = 0;
+};
+TimingVerdict judge_timings(const std::vector<double>& a, const std::vector<double>& b, double effect = 1.03,
+                            double alpha = 0.01);
+
+}  // namespace growbench
