@@ -15,6 +15,7 @@
 #include "core/errors.hpp"
 #include "harness/ab.hpp"
 #include "harness/compare.hpp"
+#include "harness/history.hpp"
 #include "harness/render_results.hpp"
 #include "harness/report.hpp"
 #include "harness/suite.hpp"
@@ -98,6 +99,22 @@ int main(int argc, char** argv) {
   std::string suite_render;
   suite_cmd->add_option("--render", suite_render,
                         "render every trial with POV-Ray afterwards (preview or paper) and compose grid.png");
+  std::string suite_history;
+  suite_cmd->add_option("--history", suite_history,
+                        "append the run to this history directory (MACHINE/SUITE/COMMIT.json; see growbench history)");
+
+  auto* history_cmd = app.add_subcommand(
+      "history", "Suite runs across commits: append runs to a history directory, plot each metric over commits");
+  history_cmd->require_subcommand(1);
+  auto* history_add = history_cmd->add_subcommand("add", "Append a results file's run (keyed by its commit and machine)");
+  std::string hist_results, hist_dir = "out/history", hist_machine, hist_out = "out/history-report";
+  history_add->add_option("results", hist_results, "results.json of growbench suite")->required();
+  history_add->add_option("--dir", hist_dir, "the history directory")->default_val("out/history");
+  history_add->add_option("--machine", hist_machine, "machine name (default: from the CPU model and thread count)");
+  auto* history_plot = history_cmd->add_subcommand(
+      "plot", "Plot every metric over commits per machine and suite, change points marked (PNG, PDF, index.html)");
+  history_plot->add_option("--dir", hist_dir, "the history directory")->default_val("out/history");
+  history_plot->add_option("-o,--out", hist_out, "output directory")->default_val("out/history-report");
 
   auto* render_cmd = app.add_subcommand(
       "render", "Render a suite's results directory (every trial, then grid.png) or a `run` directory with POV-Ray");
@@ -269,6 +286,7 @@ int main(int argc, char** argv) {
         fmt::print("{}", gb::summarize_results(results));
         fmt::print("\nwrote {} and results.csv beside it\n", path);
       }
+      if (!suite_history.empty()) fmt::print("history: appended to {}\n", gb::history_add(path, suite_history));
       if (quality) {
         gb::RenderDirOptions ro;
         ro.render.quality = *quality;
@@ -335,6 +353,11 @@ int main(int argc, char** argv) {
       fmt::print("merged {} shards, {} cells, into {}\n", shards.size(), merged["trials"].size(), merge_out);
       return 0;
     }
+    if (*history_add) {
+      fmt::print("appended to {}\n", gb::history_add(hist_results, hist_dir, hist_machine));
+      return 0;
+    }
+    if (*history_plot) return gb::history_plot(hist_dir, hist_out);
     if (*baseline_update) {
       const auto results = gb::read_results_file(bl_results);
       if (results.value("mode", "") != "instructions")

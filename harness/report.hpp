@@ -16,4 +16,7 @@ std::string report_python();
 // when the script or Python cannot be found.
 int run_report(const std::string& results, const std::string& out_dir, const std::vector<std::string>& extra_args);
 
+// Runs another script of reports/ (beside the report script) with `args`; the same Python, the same errors.
+int run_reports_script(const std::string& name, const std::vector<std::string>& args);
+
 }  // namespace growbench

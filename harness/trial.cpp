@@ -215,15 +215,19 @@ nlohmann::json run_context() {
   // The commit the binary was configured at; the source tree's current state when it is reachable.
   std::string commit = GROWBENCH_GIT_COMMIT;
   std::string dirty = "unknown";
+  nlohmann::json commit_time = nullptr;  // committer time (Unix seconds): orders a history by commit
   if (std::filesystem::exists(std::string(GROWBENCH_SOURCE_DIR) + "/.git")) {
     const std::string c = run_command(fmt::format("git -C '{}' rev-parse --short=12 HEAD 2>/dev/null", GROWBENCH_SOURCE_DIR));
     if (!c.empty()) commit = c;
+    const std::string ct = run_command(fmt::format("git -C '{}' show -s --format=%ct HEAD 2>/dev/null", GROWBENCH_SOURCE_DIR));
+    if (!ct.empty() && ct.find_first_not_of("0123456789") == std::string::npos) commit_time = std::stoll(ct);
     dirty = run_command(fmt::format("git -C '{}' status --porcelain --untracked-files=no 2>/dev/null", GROWBENCH_SOURCE_DIR)).empty()
                 ? "false"
                 : "true";
   }
   return {{"growbench_commit", commit},
           {"dirty", dirty},
+          {"commit_time", commit_time},
           {"configured_commit", GROWBENCH_GIT_COMMIT},
           {"build_type", GROWBENCH_BUILD_TYPE},
           {"compiler", fmt::format("g++ {}", __VERSION__)},
