@@ -57,7 +57,15 @@ json verdict_json(const TimingVerdict& v) {
           {"ratio_hi", v.interval.hi},
           {"u", v.test.u},
           {"p", v.test.p},
-          {"exact", v.test.exact}};
+          {"exact", v.test.exact},
+          {"paired", v.paired},
+          {"pair_ratio", v.paired_interval.ratio},
+          {"pair_ratio_lo", v.paired_interval.lo},
+          {"pair_ratio_hi", v.paired_interval.hi},
+          {"pair_w_plus", v.paired_test.w_plus},
+          {"pair_p", v.paired_test.p},
+          {"pair_exact", v.paired_test.exact},
+          {"pair_robust_cv", v.paired_cv}};
 }
 
 }  // namespace
@@ -143,7 +151,10 @@ AbResult run_ab(const Suite& suite, const AbOptions& o) {
       if (!any) break;
     }
   };
-  auto judge = [&](const Samples& s, const std::string& m) { return judge_timings(s[0].at(m), s[1].at(m), o.effect, o.alpha); };
+  // Samples come in pairs (one A and one B per round, side by side): judged paired as well as unpaired.
+  auto judge = [&](const Samples& s, const std::string& m) {
+    return judge_timings(s[0].at(m), s[1].at(m), o.effect, o.alpha, true);
+  };
 
   // A warm-up pair (file caches, the binaries' pages), not kept.
   if (!cells.empty()) {
@@ -184,8 +195,8 @@ AbResult run_ab(const Suite& suite, const AbOptions& o) {
               {"context", run_context()},
               {"trials_run", trials_run},
               {"cells", json::array()}};
-  std::string table = fmt::format("{:<34} {:<16} {:>4} {:>10} {:>10} {:>24} {:>9}  {}\n", "cell", "metric", "n", "A median",
-                                  "B median", "B/A [95% CI]", "p", "verdict");
+  std::string table = fmt::format("{:<30} {:<14} {:>3} {:>10} {:>10} {:>22} {:>7} {:>22} {:>7}  {}\n", "cell", "metric", "n",
+                                  "A median", "B median", "B/A [95% CI]", "p MW", "pairs B/A [95% CI]", "p pairs", "verdict");
   std::map<std::string, int> tally;
   for (std::size_t k = 0; k < cells.size(); ++k) {
     const Cell& cell = cells[k];
@@ -196,7 +207,7 @@ AbResult run_ab(const Suite& suite, const AbOptions& o) {
     }
     if (!cell.error.empty()) {
       jc["error"] = cell.error;
-      table += fmt::format("{:<34} error: {}\n", cell.config->id.substr(0, 34), cell.error);
+      table += fmt::format("{:<30} error: {}\n", cell.config->id.substr(0, 30), cell.error);
       ++tally["error"];
       doc["cells"].push_back(jc);
       continue;
@@ -221,10 +232,12 @@ AbResult run_ab(const Suite& suite, const AbOptions& o) {
       jm["final"] = final_verdict;
       ++tally[final_verdict];
       if (final_verdict == "regression") res.regression = true;
-      table += fmt::format("{:<34} {:<16} {:>4} {:>10} {:>10} {:>24} {:>9.2g}  {}{}\n", cell.config->id.substr(0, 34), m,
-                           v.n_a, format_seconds(v.median_a), format_seconds(v.median_b),
+      table += fmt::format("{:<30} {:<14} {:>3} {:>10} {:>10} {:>22} {:>7.2g} {:>22} {:>7.2g}  {}{}\n",
+                           cell.config->id.substr(0, 30), m, v.n_a, format_seconds(v.median_a), format_seconds(v.median_b),
                            fmt::format("{:.3f} [{:.3f}, {:.3f}]", v.interval.ratio, v.interval.lo, v.interval.hi), v.test.p,
-                           final_verdict, jm.contains("note") ? " (" + jm["note"].get<std::string>() + ")" : "");
+                           fmt::format("{:.3f} [{:.3f}, {:.3f}]", v.paired_interval.ratio, v.paired_interval.lo,
+                                       v.paired_interval.hi),
+                           v.paired_test.p, final_verdict, jm.contains("note") ? " (" + jm["note"].get<std::string>() + ")" : "");
       jc["verdicts"][m] = jm;
     }
     doc["cells"].push_back(jc);
@@ -232,9 +245,11 @@ AbResult run_ab(const Suite& suite, const AbOptions& o) {
   std::string counts;
   for (const auto& [k, n] : tally) counts += fmt::format("{}{} {}", counts.empty() ? "" : ", ", n, k);
   table += fmt::format(
-      "\nA = {}\nB = {}\n{} trials, alternating A/B. A cell is flagged when Mann-Whitney p < {} and the median ratio is "
-      "beyond {:.2f} with its bootstrap 95% interval excluding 1; a flagged cell is rerun and counts only if the rerun "
-      "flags it again. 'no change': the interval lies within [1/{:.2f}, {:.2f}].\n{}\nverdict: {}\n",
+      "\nA = {}\nB = {}\n{} trials in pairs, A B and B A alternately. A metric is flagged when p < {} and the median "
+      "ratio is beyond {:.2f} with its bootstrap 95% interval excluding 1, either for the two samples (Mann-Whitney) or for "
+      "the pairs' ratios (Wilcoxon signed-rank; drift that moves both sides of a pair cancels there); a flagged cell is "
+      "rerun and counts only if the rerun flags it again. 'no change': an interval within [1/{:.2f}, {:.2f}].\n{}\n"
+      "verdict: {}\n",
       bins[0], bins[1], trials_run, o.alpha, o.effect, o.effect, o.effect, counts,
       res.regression ? "REGRESSION (B is slower, confirmed)" : "no confirmed regression");
   doc["verdict"] = res.regression ? "regression" : "ok";

@@ -119,6 +119,60 @@ MannWhitney mann_whitney(const std::vector<double>& a, const std::vector<double>
   return r;
 }
 
+SignedRank wilcoxon_signed_rank(const std::vector<double>& d_in) {
+  SignedRank r;
+  std::vector<double> d;
+  for (const double x : d_in)
+    if (x != 0.0) d.push_back(x);
+  const std::size_t n = d.size();
+  if (n == 0) return r;
+  std::vector<std::pair<double, bool>> mag;  // |d|, positive
+  for (const double x : d) mag.push_back({std::abs(x), x > 0.0});
+  std::sort(mag.begin(), mag.end());
+  double tie_term = 0.0;
+  bool ties = false;
+  for (std::size_t i = 0; i < n;) {
+    std::size_t j = i;
+    while (j < n && mag[j].first == mag[i].first) ++j;
+    const double t = static_cast<double>(j - i), rank = 0.5 * static_cast<double>(i + 1 + j);
+    if (t > 1) {
+      ties = true;
+      tie_term += t * t * t - t;
+    }
+    for (std::size_t k = i; k < j; ++k)
+      if (mag[k].second) r.w_plus += rank;
+    i = j;
+  }
+  const double dn = static_cast<double>(n);
+  if (!ties && n <= 40) {
+    // Under the null each rank's sign is a fair coin: W+ is the sum of a random subset of 1..n.
+    const std::size_t max_w = n * (n + 1) / 2;
+    std::vector<double> exact(max_w + 1, 0.0);
+    exact[0] = 1.0;
+    for (std::size_t k = 1; k <= n; ++k) {
+      std::vector<double> next(max_w + 1, 0.0);
+      for (std::size_t w = 0; w + k <= max_w; ++w) {
+        next[w] += 0.5 * exact[w];
+        next[w + k] += 0.5 * exact[w];
+      }
+      exact.swap(next);
+    }
+    const auto w = static_cast<std::size_t>(std::llround(r.w_plus));
+    double below = 0.0, above = 0.0;
+    for (std::size_t k = 0; k <= w; ++k) below += exact[k];
+    for (std::size_t k = w; k <= max_w; ++k) above += exact[k];
+    r.p = std::min(1.0, 2.0 * std::min(below, above));
+    return r;
+  }
+  r.exact = false;
+  const double mean = dn * (dn + 1.0) / 4.0;
+  const double var = dn * (dn + 1.0) * (2.0 * dn + 1.0) / 24.0 - tie_term / 48.0;
+  if (var <= 0.0) return r;
+  const double z = std::max(0.0, std::abs(r.w_plus - mean) - 0.5) / std::sqrt(var);
+  r.p = std::min(1.0, 2.0 * normal_upper_tail(z));
+  return r;
+}
+
 RatioInterval median_ratio_interval(const std::vector<double>& a, const std::vector<double>& b, double level,
                                     int resamples, std::uint64_t seed) {
   RatioInterval r;
@@ -148,6 +202,34 @@ RatioInterval median_ratio_interval(const std::vector<double>& a, const std::vec
   return r;
 }
 
+RatioInterval paired_ratio_interval(const std::vector<double>& a, const std::vector<double>& b, double level,
+                                    int resamples, std::uint64_t seed) {
+  RatioInterval r;
+  std::vector<double> q;
+  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i)
+    if (a[i] != 0.0) q.push_back(b[i] / a[i]);
+  if (q.empty()) return r;
+  r.ratio = median_of(q);
+  Rng rng(seed, 0xBA);
+  std::vector<double> rq(q.size()), meds;
+  meds.reserve(static_cast<std::size_t>(resamples));
+  for (int k = 0; k < resamples; ++k) {
+    for (auto& x : rq) x = q[rng.next_u64() % q.size()];
+    meds.push_back(median_of(rq));
+  }
+  std::sort(meds.begin(), meds.end());
+  const double tail = (1.0 - level) / 2.0;
+  auto at = [&](double p) {
+    const double pos = p * static_cast<double>(meds.size() - 1);
+    const auto i = static_cast<std::size_t>(pos);
+    const double f = pos - static_cast<double>(i);
+    return i + 1 < meds.size() ? meds[i] * (1.0 - f) + meds[i + 1] * f : meds[i];
+  };
+  r.lo = at(tail);
+  r.hi = at(1.0 - tail);
+  return r;
+}
+
 int repetitions_needed(double cv, double effect, double alpha, double power) {
   const double delta = std::log(effect);
   if (delta <= 0.0) return 1 << 30;
@@ -156,7 +238,8 @@ int repetitions_needed(double cv, double effect, double alpha, double power) {
   return std::max(3, static_cast<int>(std::ceil(n)));
 }
 
-TimingVerdict judge_timings(const std::vector<double>& a, const std::vector<double>& b, double effect, double alpha) {
+TimingVerdict judge_timings(const std::vector<double>& a, const std::vector<double>& b, double effect, double alpha,
+                            bool paired) {
   TimingVerdict v;
   v.n_a = static_cast<int>(a.size());
   v.n_b = static_cast<int>(b.size());
@@ -166,12 +249,32 @@ TimingVerdict judge_timings(const std::vector<double>& a, const std::vector<doub
   v.needed = repetitions_needed(v.cv, effect, alpha);
   v.test = mann_whitney(b, a);  // U of the new side: large when it is slower
   v.interval = median_ratio_interval(a, b);
-  const bool significant = v.test.p < alpha;
-  if (significant && v.interval.ratio >= effect && v.interval.lo > 1.0)
+  auto slower = [&](double p, const RatioInterval& i) { return p < alpha && i.ratio >= effect && i.lo > 1.0; };
+  auto faster = [&](double p, const RatioInterval& i) { return p < alpha && i.ratio <= 1.0 / effect && i.hi < 1.0; };
+  auto within = [&](const RatioInterval& i) { return i.lo > 1.0 / effect && i.hi < effect; };
+  bool is_slower = slower(v.test.p, v.interval), is_faster = faster(v.test.p, v.interval);
+  bool is_same = within(v.interval);
+  v.paired = paired && a.size() == b.size() && a.size() >= 3;
+  if (v.paired) {
+    std::vector<double> logs;
+    for (std::size_t i = 0; i < a.size(); ++i)
+      if (a[i] > 0.0 && b[i] > 0.0) logs.push_back(std::log(b[i] / a[i]));
+    v.paired_test = wilcoxon_signed_rank(logs);
+    v.paired_interval = paired_ratio_interval(a, b);
+    // The spread of one pair's log ratio is sqrt(2) times one side's: as a per-side CV for the count.
+    std::vector<double> q;
+    for (const double l : logs) q.push_back(std::exp(l));
+    v.paired_cv = robust_cv(q) / std::sqrt(2.0);
+    v.needed = std::min(v.needed, repetitions_needed(v.paired_cv, effect, alpha));
+    is_slower = is_slower || slower(v.paired_test.p, v.paired_interval);
+    is_faster = is_faster || faster(v.paired_test.p, v.paired_interval);
+    is_same = is_same || within(v.paired_interval);
+  }
+  if (is_slower && !is_faster)
     v.verdict = "slower";
-  else if (significant && v.interval.ratio <= 1.0 / effect && v.interval.hi < 1.0)
+  else if (is_faster && !is_slower)
     v.verdict = "faster";
-  else if (v.interval.lo > 1.0 / effect && v.interval.hi < effect)
+  else if (is_same && !is_slower && !is_faster)
     v.verdict = "no change";
   else
     v.verdict = "inconclusive";

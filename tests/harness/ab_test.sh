@@ -52,7 +52,9 @@ chmod +x "$W/slow-growbench"
 
 # 3. The planted slowdown: a confirmed regression, exit 1.
 set +e
-"$G" ab "$G" "$W/slow-growbench" "$W/suite.json" --out "$W/slow" --min-reps 8 --max-reps 20 -q > "$W/slow.txt"
+# --effect 1.02: a 5% slowdown measured with ~1% error sits safely above it (at the default 1.03 it
+# would be missed now and then by chance: the test would be flaky, not the gate wrong).
+"$G" ab "$G" "$W/slow-growbench" "$W/suite.json" --out "$W/slow" --effect 1.02 --min-reps 10 --max-reps 30 -q > "$W/slow.txt"
 code=$?
 set -e
 cat "$W/slow.txt"
@@ -65,7 +67,7 @@ import json, sys
 ab = json.load(open(f"{sys.argv[1]}/slow/ab.json"))
 v = ab["cells"][0]["verdicts"]["growth.cpu_s"]
 assert v["final"] == "regression", v
-assert 1.03 <= v["ratio"] <= 1.08, v  # about the 5% planted
+assert 1.02 <= max(v["ratio"], v["pair_ratio"]) <= 1.09, v  # about the 5% planted
 assert v["confirmation"]["verdict"] == "slower", v
 assert ab["cells"][0]["same_plant"], "the fault must leave the plant alone"
 print(f"planted 5%: measured {100 * (v['ratio'] - 1):.1f}% [{100 * (v['ratio_lo'] - 1):.1f}, {100 * (v['ratio_hi'] - 1):.1f}], p = {v['p']:.2g}, confirmed")

@@ -40,6 +40,38 @@ TEST(Stats, MannWhitneyWithTiesUsesTheCorrectedNormal) {
   EXPECT_NEAR(mann_whitney({2, 2, 2}, {2, 2, 2}).p, 1.0, 1e-12);
 }
 
+TEST(Stats, SignedRankExactTails) {
+  // All five positive: W+ = 15, reached by 1 of the 2^5 sign patterns.
+  EXPECT_NEAR(wilcoxon_signed_rank({1, 2, 3, 4, 5}).p, 2.0 / 32.0, 1e-12);
+  EXPECT_EQ(wilcoxon_signed_rank({1, 2, 3, 4, 5}).w_plus, 15.0);
+  EXPECT_NEAR(wilcoxon_signed_rank({0.0, 1, 2, 3, 4, 5}).p, 2.0 / 32.0, 1e-12) << "zeros are dropped";
+  EXPECT_NEAR(wilcoxon_signed_rank({1, 2, 3, 4, 5, 6, 7, 8}).p, 2.0 / 256.0, 1e-12);
+  // The smallest negative: W+ = 14; W+ >= 14 for 2 of 32 patterns.
+  EXPECT_NEAR(wilcoxon_signed_rank({-1, 2, 3, 4, 5}).p, 4.0 / 32.0, 1e-12);
+  EXPECT_NEAR(wilcoxon_signed_rank({-5, -4, -3, -2, -1}).p, 2.0 / 32.0, 1e-12);
+  EXPECT_TRUE(wilcoxon_signed_rank({-5, -4, -3, -2, -1}).exact);
+  EXPECT_FALSE(wilcoxon_signed_rank({1, 1, 2, 3}).exact);
+}
+
+TEST(Stats, PairsSeeThroughDrift) {
+  // The machine slows by half over twelve rounds; B is 5% slower than A in every round.
+  Rng rng(5, 3);
+  std::vector<double> a, b, a2;
+  for (int i = 0; i < 12; ++i) {
+    const double drift = 1.0 + 0.5 * i / 11.0;
+    a.push_back(drift * (1.0 + 0.005 * rng.uniform(-1.0, 1.0)));
+    b.push_back(1.05 * drift * (1.0 + 0.005 * rng.uniform(-1.0, 1.0)));
+    a2.push_back(drift * (1.0 + 0.005 * rng.uniform(-1.0, 1.0)));
+  }
+  const TimingVerdict unpaired = judge_timings(a, b, 1.03, 0.01, false);
+  EXPECT_EQ(unpaired.verdict, "inconclusive") << "the drift swamps the unpaired comparison";
+  const TimingVerdict paired = judge_timings(a, b, 1.03, 0.01, true);
+  EXPECT_EQ(paired.verdict, "slower");
+  EXPECT_NEAR(paired.paired_interval.ratio, 1.05, 0.01);
+  EXPECT_NEAR(paired.paired_test.p, 2.0 / 4096.0, 1e-12);  // all twelve pairs slower
+  EXPECT_EQ(judge_timings(a, a2, 1.03, 0.01, true).verdict, "no change");
+}
+
 TEST(Stats, NormalQuantileAndRepetitions) {
   EXPECT_NEAR(normal_upper_quantile(0.005), 2.5758293, 1e-6);
   EXPECT_NEAR(normal_upper_quantile(0.2), 0.8416212, 1e-6);
