@@ -69,7 +69,6 @@ class Launcher {
   // fork, or has died.
   ChildResult run(const std::string& description, const ChildLimits& limits,
                   const std::function<void(const std::string&)>& on_report);
-  int pid() const { return pid_; }
 
  private:
   int pid_ = -1;

@@ -61,6 +61,20 @@ std::vector<double> exact_u_distribution(int n, int m) {
   return p[static_cast<std::size_t>(n)][static_cast<std::size_t>(m)];
 }
 
+// The central `level` interval of bootstrap replicates (linear interpolation between order statistics).
+void percentile_interval(std::vector<double>& replicates, double level, RatioInterval& r) {
+  std::sort(replicates.begin(), replicates.end());
+  auto at = [&](double q) {
+    const double pos = q * static_cast<double>(replicates.size() - 1);
+    const auto i = static_cast<std::size_t>(pos);
+    const double f = pos - static_cast<double>(i);
+    return i + 1 < replicates.size() ? replicates[i] * (1.0 - f) + replicates[i + 1] * f : replicates[i];
+  };
+  const double tail = (1.0 - level) / 2.0;
+  r.lo = at(tail);
+  r.hi = at(1.0 - tail);
+}
+
 }  // namespace
 
 double normal_upper_quantile(double q) {
@@ -189,16 +203,7 @@ RatioInterval median_ratio_interval(const std::vector<double>& a, const std::vec
     if (m != 0.0) ratios.push_back(median_of(rb) / m);
   }
   if (ratios.empty()) return r;
-  std::sort(ratios.begin(), ratios.end());
-  const double tail = (1.0 - level) / 2.0;
-  auto at = [&](double q) {
-    const double pos = q * static_cast<double>(ratios.size() - 1);
-    const auto i = static_cast<std::size_t>(pos);
-    const double f = pos - static_cast<double>(i);
-    return i + 1 < ratios.size() ? ratios[i] * (1.0 - f) + ratios[i + 1] * f : ratios[i];
-  };
-  r.lo = at(tail);
-  r.hi = at(1.0 - tail);
+  percentile_interval(ratios, level, r);
   return r;
 }
 
@@ -217,16 +222,7 @@ RatioInterval paired_ratio_interval(const std::vector<double>& a, const std::vec
     for (auto& x : rq) x = q[rng.next_u64() % q.size()];
     meds.push_back(median_of(rq));
   }
-  std::sort(meds.begin(), meds.end());
-  const double tail = (1.0 - level) / 2.0;
-  auto at = [&](double p) {
-    const double pos = p * static_cast<double>(meds.size() - 1);
-    const auto i = static_cast<std::size_t>(pos);
-    const double f = pos - static_cast<double>(i);
-    return i + 1 < meds.size() ? meds[i] * (1.0 - f) + meds[i + 1] * f : meds[i];
-  };
-  r.lo = at(tail);
-  r.hi = at(1.0 - tail);
+  percentile_interval(meds, level, r);
   return r;
 }
 
