@@ -72,6 +72,9 @@ int main(int argc, char** argv) {
   run->add_option("-j,--threads", spec.threads, "worker threads (0: all cores)")->default_val(0);
   run->add_option("--voxel-size", spec.voxel_size, "distance-field voxel size in metres (0: scene diagonal / 256)")->default_val(0);
   run->add_option("--sides", spec.mesher.sides, sides_help)->default_val(6)->check(CLI::Range(3, 64));
+  run->add_option("--leaf-obj", spec.mesher.leaf_obj,
+                  "a custom leaf for every leaf and flower: an OBJ with the blade along +Z from the stem at z = 0 and "
+                  "its upper side toward +Y (scaled to unit length; the organ's size sizes it)");
   std::string out_dir;
   run->add_option("-o,--out", out_dir, "output directory (default: out/ALGORITHM-SCENE)");
   bool quiet = false;

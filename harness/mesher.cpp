@@ -2,9 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
+#include <fmt/format.h>
 #include <glm/gtc/quaternion.hpp>
+
+#include "core/errors.hpp"
+#include "scenes/scene_library.hpp"
 
 namespace growbench {
 
@@ -118,6 +123,22 @@ void add_organ(OutputMesh& m, const Organ& organ, const TriangleMesh& shape) {
 }
 
 }  // namespace
+
+TriangleMesh load_leaf_mesh(const std::string& path) {
+  TriangleMesh m = load_obj(path);  // InputError without faces
+  float lo = std::numeric_limits<float>::max(), hi = std::numeric_limits<float>::lowest();
+  for (const auto& v : m.vertices) lo = std::min(lo, v.z), hi = std::max(hi, v.z);
+  if (!(hi - lo > 1e-6f))
+    throw InputError(fmt::format("{}: the leaf has no length along z; expected its blade along +Z from the stem", path));
+  for (auto& v : m.vertices) v = glm::vec3(v.x, v.y, v.z - lo) / (hi - lo);
+  m.name = "leaf_obj";
+  return m;
+}
+
+MesherOptions with_leaf_mesh(MesherOptions o) {
+  if (!o.leaf_obj.empty() && o.leaf_mesh.triangles.empty()) o.leaf_mesh = load_leaf_mesh(o.leaf_obj);
+  return o;
+}
 
 TriangleMesh organ_shape(const MesherOptions& o) {
   if (!o.leaf_mesh.triangles.empty()) return o.leaf_mesh;

@@ -33,7 +33,17 @@ struct MesherOptions {
   float min_radius = 0.0f;    // radii below this are raised to it (0: as given; zero-radius nodes get 1e-4 m)
   std::string leaf_shape = "diamond";  // "diamond", "quad"; ignored when leaf_mesh has triangles
   TriangleMesh leaf_mesh;     // optional instanced leaf: local frame as Organ (+Z blade, +Y up), unit length
+  std::string leaf_obj;       // an OBJ to load into leaf_mesh (load_leaf_mesh) when a trial or render starts
 };
+
+// A custom leaf from an OBJ file, as every algorithm's leaves and flowers are instanced: authored in the
+// organ's frame, the blade along +Z from the stem and the upper side toward +Y. It is moved so its lowest
+// z is 0 and scaled so its length along z is 1 (the organ's size then sizes it). InputError naming the
+// file when it cannot be read, has no faces, or has no length along z.
+TriangleMesh load_leaf_mesh(const std::string& path);
+
+// options with leaf_mesh loaded from leaf_obj (when it names a file and leaf_mesh is empty).
+MesherOptions with_leaf_mesh(MesherOptions options);
 
 OutputMesh mesh_plant(const Plant& plant, const MesherOptions& options = {});
 

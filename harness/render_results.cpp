@@ -48,6 +48,7 @@ struct Job {
   fs::path snapshot, pov, png;
   std::string scene_spec;
   std::vector<std::string> scene_params;
+  std::string leaf_obj;  // the trial's custom leaf ("" : the default shape)
   bool frame = false;
   RenderResult result;
 };
@@ -100,15 +101,16 @@ json render_directory(const std::string& dir_arg, const RenderDirOptions& o) {
   std::vector<Job> jobs;
   std::map<std::string, std::size_t> trial_index;  // id -> index in doc["trials"]
   auto add_trial = [&](const std::string& key, const fs::path& tdir, const std::string& scene_spec,
-                       const std::vector<std::string>& scene_params) {
+                       const std::vector<std::string>& scene_params, const std::string& leaf_obj) {
     if (!fs::exists(tdir / "plant.gbplant")) return false;
-    jobs.push_back({key, tdir / "plant.gbplant", tdir / "render.pov", tdir / "render.png", scene_spec, scene_params, false, {}});
+    jobs.push_back({key, tdir / "plant.gbplant", tdir / "render.pov", tdir / "render.png", scene_spec, scene_params,
+                    leaf_obj, false, {}});
     for (const auto& f : frame_snapshots(tdir)) {
       fs::path png = f;
       png.replace_extension(".png");
       fs::path pov = f;
       pov.replace_extension(".pov");
-      jobs.push_back({key, f, pov, png, scene_spec, scene_params, true, {}});
+      jobs.push_back({key, f, pov, png, scene_spec, scene_params, leaf_obj, true, {}});
     }
     return true;
   };
@@ -121,12 +123,12 @@ json render_directory(const std::string& dir_arg, const RenderDirOptions& o) {
       trial_index[id] = i;
       const json& spec = t.contains("spec") ? t["spec"] : json::object();
       if (!add_trial(id, dir / "trials" / id, spec.value("scene", t.value("scene_spec", "")),
-                     spec.value("scene_params", std::vector<std::string>{})))
+                     spec.value("scene_params", std::vector<std::string>{}), spec.value("leaf_obj", std::string{})))
         ++skipped;
     }
   } else {
     const json& sc = doc.at("scene");
-    if (!add_trial("", dir, sc.value("spec", ""), sc.value("params", std::vector<std::string>{})))
+    if (!add_trial("", dir, sc.value("spec", ""), sc.value("params", std::vector<std::string>{}), doc.value("leaf_obj", std::string{})))
       throw InputError(fmt::format("{}: no plant.gbplant to render (written by growbench run and suite trials)", dir_arg));
   }
 
@@ -156,7 +158,10 @@ json render_directory(const std::string& dir_arg, const RenderDirOptions& o) {
       try {
         const auto scene = scene_for(j);
         const Plant plant = read_plant_snapshot(j.snapshot.string());
-        j.result = render_plant(*scene, plant, j.pov.string(), j.png.string(), ro);
+        RenderOptions jro = ro;
+        jro.mesher.leaf_obj = j.leaf_obj;
+        jro.mesher = with_leaf_mesh(jro.mesher);
+        j.result = render_plant(*scene, plant, j.pov.string(), j.png.string(), jro);
       } catch (const std::exception& e) {
         j.result.status = "failed";
         j.result.message = e.what();

@@ -127,7 +127,7 @@ class SuiteReader : public JsonPathReader {
     }
 
     struct AlgoEntry {
-      std::string label, name, fault;
+      std::string label, name, fault, leaf_obj;
       std::vector<std::string> params;
       std::vector<std::pair<std::string, std::vector<json>>> sweep;
       std::vector<json> points;  // explicit sweep points (instead of a product)
@@ -149,11 +149,21 @@ class SuiteReader : public JsonPathReader {
       if (e.is_string()) {
         a.name = e.get<std::string>();
       } else {
-        only_keys(e, path, {"name", "label", "params", "sweep", "fault"});
+        only_keys(e, path, {"name", "label", "params", "sweep", "fault", "leaf_obj"});
         if (!e.contains("name") || !e["name"].is_string()) fail(path + "/name", "expected the algorithm's name");
         a.name = e["name"].get<std::string>();
         a.label = e.value("label", "");
         a.fault = e.value("fault", "");
+        if (e.contains("leaf_obj")) {
+          if (!e["leaf_obj"].is_string()) fail(path + "/leaf_obj", "expected the path of an OBJ file");
+          const fs::path lp(e["leaf_obj"].get<std::string>());
+          a.leaf_obj = (lp.is_absolute() ? lp : dir_ / lp).lexically_normal().string();  // relative to the suite file
+          try {
+            (void)load_leaf_mesh(a.leaf_obj);
+          } catch (const InputError& err) {
+            fail(path + "/leaf_obj", err.what());
+          }
+        }
       }
       const AlgorithmEntry* entry = nullptr;
       try {
@@ -233,6 +243,7 @@ class SuiteReader : public JsonPathReader {
             c.spec.budget_nodes = budget_nodes;
             c.spec.budget_length_m = budget_length;
             c.spec.fault = a.fault;
+            c.spec.mesher.leaf_obj = a.leaf_obj;
             std::size_t rest = point;
             std::vector<std::string> parts;
             auto assign = [&](const std::string& k, const json& val) {

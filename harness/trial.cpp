@@ -246,7 +246,7 @@ nlohmann::json run_context() {
 nlohmann::json to_json(const TrialSpec& s) {
   nlohmann::json seeds = nlohmann::json::array();
   for (const auto& p : s.seed_at) seeds.push_back({p.x, p.y, p.z});
-  return {{"algorithm", s.algorithm},       {"scene", s.scene},
+  nlohmann::json j = {{"algorithm", s.algorithm},       {"scene", s.scene},
           {"scene_params", s.scene_params}, {"params", s.params},
           {"seed", s.seed},                 {"seed_at", seeds},
           {"max_steps", s.max_steps},       {"time_limit_s", s.time_limit_s},
@@ -255,6 +255,8 @@ nlohmann::json to_json(const TrialSpec& s) {
           {"budget_length_m", s.budget_length_m}, {"metrics", s.metrics},
           {"frame_every", s.frame_every},
           {"fault", s.fault}};
+  if (!s.mesher.leaf_obj.empty()) j["leaf_obj"] = s.mesher.leaf_obj;  // only when given: older specs stay as they were
+  return j;
 }
 
 TrialSpec trial_spec_from_json(const nlohmann::json& j) {
@@ -271,6 +273,7 @@ TrialSpec trial_spec_from_json(const nlohmann::json& j) {
   s.threads = j.value("threads", 0);
   s.voxel_size = j.value("voxel_size", 0.0f);
   s.mesher.sides = j.value("sides", 6);
+  s.mesher.leaf_obj = j.value("leaf_obj", std::string{});
   s.budget_nodes = j.value("budget_nodes", std::size_t{0});
   s.budget_length_m = j.value("budget_length_m", 0.0);
   s.metrics = j.value("metrics", true);
@@ -291,6 +294,8 @@ nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const P
   if (spec.frame_every < 0) throw InputError(fmt::format("--frames must be >= 0, got {}", spec.frame_every));
   if (spec.frame_every > 0 && spec.out_dir.empty()) throw InputError("--frames needs an output directory");
 
+  // A custom leaf is read first: a bad file is invalid input before anything is grown.
+  const MesherOptions mesher = with_leaf_mesh(spec.mesher);
   std::unique_ptr<tbb::global_control> threads;
   if (spec.threads > 0)
     threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
@@ -329,6 +334,7 @@ nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const P
                   {"seeds", scene.seeds.size()},
                   {"params", spec.scene_params}};
   rec["params"] = params.to_json();
+  if (!spec.mesher.leaf_obj.empty()) rec["leaf_obj"] = spec.mesher.leaf_obj;
 
   std::unique_ptr<GrowthAlgorithm> algo = entry.make();
   int steps = 0;
@@ -411,7 +417,7 @@ nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const P
     std::filesystem::create_directories(spec.out_dir);
     rec["snapshot_bytes"] = write_plant_snapshot((std::filesystem::path(spec.out_dir) / "plant.gbplant").string(), plant);
   }
-  OutputMesh mesh = timer.run("meshing", [&] { return mesh_plant(plant, spec.mesher); });
+  OutputMesh mesh = timer.run("meshing", [&] { return mesh_plant(plant, mesher); });
 
   nlohmann::json bytes = nlohmann::json::object();
   timer.run("export", [&] {

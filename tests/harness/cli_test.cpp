@@ -92,6 +92,32 @@ TEST(Cli, RunWritesMeshesSkeletonAndRecord) {
   EXPECT_EQ(rec["geometry_hash"].get<std::string>().size(), 16u);
 }
 
+TEST(Cli, CustomLeafObjForHadrich) {
+  // The same climbing plant with the default leaf and with a three-triangle leaf from an OBJ: the plant
+  // is the same; each leaf adds one triangle to the mesh. A bad leaf file is invalid input (exit 2).
+  const auto dir = test::temp_dir("cli_leaf");
+  const std::string leaf = test::write_text(dir / "leaf.obj", "v 0 0 0\nv 0.3 0 0.5\nv 0 0 1\nv -0.3 0 0.5\nv 0 0.1 0.5\n"
+                                                                 "f 1 2 3\nf 1 3 4\nf 1 5 3\n");
+  const std::string common = "run -q -a hadrich -s wall --set max_particles=400 --max-steps 300 -j 1 -o ";
+  auto r = growbench(common + (dir / "plain").string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  r = growbench(common + (dir / "custom").string() + " --leaf-obj " + leaf);
+  ASSERT_EQ(r.status, 0) << r.out;
+  auto record = [&](const char* sub) {
+    std::ifstream in(dir / sub / "record.json");
+    return nlohmann::json::parse(in);
+  };
+  const auto plain = record("plain"), custom = record("custom");
+  EXPECT_EQ(plain["geometry_hash"], custom["geometry_hash"]);
+  const int organs = custom["counts"]["organs"].get<int>();  // leaves and flowers share the shape
+  ASSERT_GT(custom["counts"]["leaves"].get<int>(), 0);
+  EXPECT_EQ(custom["counts"]["mesh_triangles"].get<int>() - plain["counts"]["mesh_triangles"].get<int>(), organs);
+  EXPECT_EQ(custom["leaf_obj"], leaf);
+  r = growbench(common + (dir / "bad").string() + " --leaf-obj " + (dir / "missing.obj").string());
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("missing.obj: no such file"), std::string::npos) << r.out;
+}
+
 TEST(Cli, SeedAtSnapsToTheSurface) {
   const auto dir = test::temp_dir("cli_seedat");
   const auto r = growbench("run -q -a spacecol -s mesh:" + test::shared_mesh("suzanne.obj") +

@@ -42,6 +42,45 @@ TEST(Mesher, ChainsAndTriangleCounts) {
   EXPECT_NEAR(glm::length(m.positions[branch_first_ring] - glm::vec3(0, 1, 0)), 0.02f, 1e-6f);
 }
 
+TEST(Mesher, CustomLeafFromObj) {
+  const auto dir = test::temp_dir("leaf_obj");
+  // A three-triangle leaf authored 2 units long from z = 0.5: normalised to z in [0, 1].
+  const std::string leaf = test::write_text(dir / "leaf.obj",
+                                            "v 0 0 0.5\nv 0.2 0 1.5\nv 0 0 2.5\nv -0.2 0 1.5\nv 0 0.1 1.5\n"
+                                            "f 1 2 3\nf 1 3 4\nf 1 5 3\n");
+  const TriangleMesh m = load_leaf_mesh(leaf);
+  ASSERT_EQ(m.triangles.size(), 3u);
+  EXPECT_FLOAT_EQ(m.vertices[0].z, 0.0f);
+  EXPECT_FLOAT_EQ(m.vertices[2].z, 1.0f);
+  EXPECT_FLOAT_EQ(m.vertices[1].x, 0.1f);  // scaled by 1/2 like z
+  // Every leaf of the plant is that shape: 3 triangles each instead of the default's 2.
+  MesherOptions o;
+  o.leaf_obj = leaf;
+  const OutputMesh mesh = mesh_plant(y_plant(), with_leaf_mesh(o));
+  ASSERT_EQ(mesh.groups.size(), 2u);
+  EXPECT_EQ(mesh.groups[1].triangle_count, 6u);
+  EXPECT_EQ(organ_shape(with_leaf_mesh(o)).triangles.size(), 3u);
+  // A leaf of size 0.1 at (0, 2, 0) with the identity frame spans z 0..0.1 there.
+  float zmax = -1.0f;
+  for (std::uint32_t t = mesh.groups[1].first_triangle; t < mesh.groups[1].first_triangle + 3; ++t)
+    for (int k = 0; k < 3; ++k) zmax = std::max(zmax, mesh.positions[mesh.triangles[t][k]].z);
+  EXPECT_NEAR(zmax, 0.1f, 1e-6f);
+  // Bad leaves are errors that name the file and what was expected.
+  auto message = [](const std::string& path) {
+    try {
+      (void)load_leaf_mesh(path);
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message((dir / "none.obj").string()).find("none.obj: no such file"), std::string::npos);
+  const std::string flat = test::write_text(dir / "flat.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  EXPECT_NE(message(flat).find("no length along z"), std::string::npos) << message(flat);
+  const std::string empty = test::write_text(dir / "empty.obj", "v 0 0 0\n");
+  EXPECT_NE(message(empty).find("empty.obj: the OBJ file has no faces"), std::string::npos) << message(empty);
+}
+
 TEST(Exporters, ObjReadsBackWithGroupsAndMaterials) {
   const auto dir = test::temp_dir("obj");
   const OutputMesh m = mesh_plant(y_plant());
