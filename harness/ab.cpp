@@ -161,27 +161,35 @@ AbResult run_ab(const Suite& suite, const AbOptions& o) {
     run_one(cells.front(), 0, nullptr);
     run_one(cells.front(), 1, nullptr);
   }
-  std::map<std::size_t, int> target;
-  for (std::size_t k = 0; k < cells.size(); ++k) target[k] = o.min_repetitions;
-  batch("pilot", target, &Cell::pilot);
-  // The pilot's noise sets each cell's repetitions for the effect asked for.
-  for (auto& [k, n] : target) {
+  // A batch: a pilot of min_repetitions pairs, whose noise then sets how many pairs the effect asked for
+  // needs (capped at max_repetitions).
+  auto pilot_then_extend = [&](const std::string& stage, const std::vector<std::size_t>& which, Samples Cell::*into) {
+    std::map<std::size_t, int> target;
+    for (const std::size_t k : which) target[k] = o.min_repetitions;
+    batch(stage, target, into);
+    for (auto& [k, n] : target) {
+      if (!cells[k].error.empty()) continue;
+      int need = o.min_repetitions;
+      for (const auto& m : metrics) need = std::max(need, judge(cells[k].*into, m).needed);
+      n = std::min(need, o.max_repetitions);
+    }
+    batch(stage, target, into);
+  };
+  std::vector<std::size_t> all;
+  for (std::size_t k = 0; k < cells.size(); ++k) all.push_back(k);
+  pilot_then_extend("main", all, &Cell::pilot);
+  // Flagged cells run again, a fresh batch by the same procedure: only a repeated flag counts.
+  std::vector<std::size_t> flagged;
+  for (const std::size_t k : all) {
     if (!cells[k].error.empty()) continue;
-    int need = o.min_repetitions;
-    for (const auto& m : metrics) need = std::max(need, judge(cells[k].pilot, m).needed);
-    n = std::min(need, o.max_repetitions);
-  }
-  batch("main", target, &Cell::pilot);
-  // Flagged cells run again, a fresh batch of the same size: only a repeated flag counts.
-  std::map<std::size_t, int> flagged;
-  for (const auto& [k, n] : target) {
-    if (!cells[k].error.empty()) continue;
+    bool any = false;
     for (const auto& m : metrics) {
       const std::string v = judge(cells[k].pilot, m).verdict;
-      if (v == "slower" || v == "faster") flagged[k] = count(cells[k].pilot);
+      any = any || v == "slower" || v == "faster";
     }
+    if (any) flagged.push_back(k);
   }
-  if (o.confirm) batch("confirm", flagged, &Cell::confirmation);
+  if (o.confirm) pilot_then_extend("confirm", flagged, &Cell::confirmation);
   if (tty) fmt::print(stderr, "\r{:<100}\r", "");
 
   AbResult res;

