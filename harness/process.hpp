@@ -27,15 +27,15 @@ struct ChildResult {
   std::uint64_t max_rss_bytes = 0;  // wait4's ru_maxrss
 };
 
-// Runs `body` in a forked child (stdout and stderr appended to `log_path` when given) and waits for it.
-// The child exits with body's return value (an escaping exception exits 70). Forking rather than
-// exec'ing keeps the launch cost near a millisecond: exec'ing growbench spends ~80 ms in the dynamic
-// linker relocating OpenVDB, TBB and Embree. The caller must not have started threads (TBB, Embree)
-// before forking: only the calling thread exists in the child.
-// Throws std::runtime_error when the process cannot be started.
 // Threads in this process (from /proc/self/status).
 int process_thread_count();
 
+// Runs `body` in a forked child (stdout and stderr appended to `log_path` when given) and waits for it.
+// The child exits with body's return value (an escaping exception exits 70). Forking rather than
+// exec'ing keeps the launch to 2-3 ms on a paravirtualised VM (the fork, then the child's first page
+// faults and syscalls): exec'ing growbench spends 70-80 ms in the dynamic linker relocating OpenVDB, TBB
+// and Embree. The caller must not have started threads (TBB, Embree) before forking: only the calling
+// thread exists in the child. Throws std::runtime_error when the process cannot be started.
 ChildResult run_forked(const std::function<int()>& body, const ChildLimits& limits, const std::string& log_path);
 
 // The same, with a report channel: body gets the write end of a pipe, and may write one report of at most
