@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <filesystem>
 #include <map>
 
@@ -45,27 +46,22 @@ std::string version_of(const std::string& binary, const fs::path& dir) {
 }
 
 json verdict_json(const TimingVerdict& v) {
-  return {{"verdict", v.verdict},
-          {"n_a", v.n_a},
-          {"n_b", v.n_b},
-          {"median_a", v.median_a},
-          {"median_b", v.median_b},
-          {"robust_cv", v.cv},
-          {"needed", v.needed},
-          {"ratio", v.interval.ratio},
-          {"ratio_lo", v.interval.lo},
-          {"ratio_hi", v.interval.hi},
-          {"u", v.test.u},
-          {"p", v.test.p},
-          {"exact", v.test.exact},
-          {"paired", v.paired},
-          {"pair_ratio", v.paired_interval.ratio},
-          {"pair_ratio_lo", v.paired_interval.lo},
-          {"pair_ratio_hi", v.paired_interval.hi},
-          {"pair_w_plus", v.paired_test.w_plus},
-          {"pair_p", v.paired_test.p},
-          {"pair_exact", v.paired_test.exact},
-          {"pair_robust_cv", v.paired_cv}};
+  json j = {{"verdict", v.verdict}, {"n_a", v.n_a},         {"n_b", v.n_b},        {"median_a", v.median_a},
+            {"median_b", v.median_b}, {"robust_cv", v.cv}, {"needed", v.needed}, {"paired", v.paired}};
+  // Each test: its ratio with the bootstrap interval, its statistic, p, and whether p is exact.
+  auto test = [&](const std::string& prefix, const RatioInterval& i, const char* statistic, double value, double p,
+                  bool exact) {
+    j[prefix + "ratio"] = i.ratio;
+    j[prefix + "ratio_lo"] = i.lo;
+    j[prefix + "ratio_hi"] = i.hi;
+    j[prefix + statistic] = value;
+    j[prefix + "p"] = p;
+    j[prefix + "exact"] = exact;
+  };
+  test("", v.interval, "u", v.test.u, v.test.p, v.test.exact);
+  test("pair_", v.paired_interval, "w_plus", v.paired_test.w_plus, v.paired_test.p, v.paired_test.exact);
+  j["pair_robust_cv"] = v.paired_cv;
+  return j;
 }
 
 }  // namespace
@@ -110,14 +106,20 @@ AbResult run_ab(const Suite& suite, const AbOptions& o) {
     ++trials_run;
     std::string why;
     if (r.timed_out) why = fmt::format("timed out after {} s", suite.timeout_s);
-    else if (r.signal != 0) why = fmt::format("killed by signal {}", r.signal);
+    else if (r.signal != 0) why = "killed by " + signal_name(r.signal);
     else if (r.exit_code != 0 || !fs::exists(dir / "record.json"))
       why = fmt::format("exit code {} (see {})", r.exit_code, (dir / "log.txt").string());
     if (!why.empty()) {
       cell.error = fmt::format("side {} ({}): {}", kSides[side], bins[side], why);
       return;
     }
-    const json rec = json::parse(read_text_file((dir / "record.json").string()));
+    json rec;
+    try {
+      rec = json::parse(read_text_file((dir / "record.json").string()));
+    } catch (const std::exception& e) {
+      cell.error = fmt::format("side {}: {}/record.json is unreadable: {}", kSides[side], dir.string(), e.what());
+      return;
+    }
     cell.hash[static_cast<std::size_t>(side)] = rec.value("geometry_hash", "");
     if (!into) return;  // a warm-up
     for (const auto& p : o.phases) {

@@ -84,7 +84,6 @@ ChildResult run_forked(const std::function<int(int report_fd)>& body, const Chil
     _exit(code);  // no atexit handlers or static destructors of the parent's state
   }
   if (report[1] >= 0) close(report[1]);
-  std::string message;
   bool reported = false;
   // The report: one write of at most PIPE_BUF bytes arrives whole; EOF means there was none.
   auto read_report = [&] {
@@ -122,6 +121,7 @@ ChildResult run_forked(const std::function<int(int report_fd)>& body, const Chil
       if (limits.timeout_s > 0) timeout_ms = std::max(0, static_cast<int>((limits.timeout_s - elapsed()) * 1000.0) + 1);
       const int rc = poll(pfd, report[0] >= 0 ? 2 : 1, timeout_ms);
       if (rc < 0 && errno == EINTR) continue;
+      if (rc < 0) break;  // cannot wait on it: the blocking wait4 below still reaps it
       if (rc == 0) {
         kill_child();
         break;
@@ -273,10 +273,21 @@ Launcher::~Launcher() {
 
 ChildResult Launcher::run(const std::string& description, const ChildLimits& limits,
                           const std::function<void(const std::string&)>& on_report) {
+  // Writing to a launcher that has died raises SIGPIPE, which would end this process (and the suite
+  // with it): it is blocked for the write, and one it raised is taken back before unblocking.
+  sigset_t pipe_signal, before;
+  sigemptyset(&pipe_signal);
+  sigaddset(&pipe_signal, SIGPIPE);
+  pthread_sigmask(SIG_BLOCK, &pipe_signal, &before);
   const std::uint32_t size = static_cast<std::uint32_t>(description.size());
-  if (!write_all(request_fd_, &size, sizeof size) || !write_all(request_fd_, description.data(), size) ||
-      !write_all(request_fd_, &limits, sizeof limits))
-    throw std::runtime_error(fmt::format("the trial launcher (pid {}) has died", pid_));
+  const bool sent = write_all(request_fd_, &size, sizeof size) && write_all(request_fd_, description.data(), size) &&
+                    write_all(request_fd_, &limits, sizeof limits);
+  if (!sent) {
+    const timespec now{0, 0};
+    sigtimedwait(&pipe_signal, nullptr, &now);
+  }
+  pthread_sigmask(SIG_SETMASK, &before, nullptr);
+  if (!sent) throw std::runtime_error(fmt::format("the trial launcher (pid {}) has died", pid_));
   while (true) {
     ReplyHeader h{};
     std::string data;
@@ -297,6 +308,11 @@ ChildResult Launcher::run(const std::string& description, const ChildLimits& lim
     }
     throw std::runtime_error(fmt::format("the trial launcher (pid {}) has died", pid_));
   }
+}
+
+std::string signal_name(int sig) {
+  const char* d = strsignal(sig);
+  return fmt::format("signal {} ({})", sig, d ? d : "?");
 }
 
 std::string find_program(const std::string& name) {

@@ -75,6 +75,9 @@ class Launcher {
   int request_fd_ = -1, reply_fd_ = -1;
 };
 
+// "signal 11 (Segmentation fault)": what ended a child.
+std::string signal_name(int sig);
+
 // The executable NAME on PATH ("" when there is none).
 std::string find_program(const std::string& name);
 

@@ -149,6 +149,17 @@ json render_directory(const std::string& dir_arg, const RenderDirOptions& o) {
     if (!s) s = std::make_shared<const Scene>(load_scene(j.scene_spec, j.scene_params));
     return s;
   };
+  // Render options per custom leaf: each OBJ is read once, not once per trial and frame.
+  std::map<std::string, RenderOptions> leaf_options;
+  auto options_for = [&](const Job& j) {
+    std::lock_guard lock(scene_mutex);
+    const auto it = leaf_options.find(j.leaf_obj);
+    if (it != leaf_options.end()) return it->second;
+    RenderOptions jro = ro;
+    jro.mesher.leaf_obj = j.leaf_obj;
+    jro.mesher = with_leaf_mesh(jro.mesher);
+    return leaf_options.emplace(j.leaf_obj, jro).first->second;
+  };
   std::atomic<std::size_t> next{0}, done{0};
   const bool tty = isatty(STDERR_FILENO) != 0 && !o.quiet;
   const auto t0 = std::chrono::steady_clock::now();
@@ -158,10 +169,7 @@ json render_directory(const std::string& dir_arg, const RenderDirOptions& o) {
       try {
         const auto scene = scene_for(j);
         const Plant plant = read_plant_snapshot(j.snapshot.string());
-        RenderOptions jro = ro;
-        jro.mesher.leaf_obj = j.leaf_obj;
-        jro.mesher = with_leaf_mesh(jro.mesher);
-        j.result = render_plant(*scene, plant, j.pov.string(), j.png.string(), jro);
+        j.result = render_plant(*scene, plant, j.pov.string(), j.png.string(), options_for(j));
       } catch (const std::exception& e) {
         j.result.status = "failed";
         j.result.message = e.what();

@@ -49,16 +49,15 @@ class SuiteReader : public JsonPathReader {
       fail(path, fmt::format("expected a number in [{}, {}], got {}", lo, hi, j.dump()));
     return j.get<double>();
   }
+  // A path in a suite file, relative to the suite file.
+  std::string relative_to_suite(const std::string& path) const {
+    const fs::path p(path);
+    return (p.is_absolute() ? p : dir_ / p).lexically_normal().string();
+  }
   // Scene specs in suites: mesh:PATH and *.json are relative to the suite file.
   std::string scene_spec(const std::string& spec) const {
-    if (spec.rfind("mesh:", 0) == 0) {
-      const fs::path p(spec.substr(5));
-      return "mesh:" + (p.is_absolute() ? p : dir_ / p).lexically_normal().string();
-    }
-    if (spec.size() > 5 && spec.substr(spec.size() - 5) == ".json") {
-      const fs::path p(spec);
-      return (p.is_absolute() ? p : dir_ / p).lexically_normal().string();
-    }
+    if (spec.rfind("mesh:", 0) == 0) return "mesh:" + relative_to_suite(spec.substr(5));
+    if (spec.size() > 5 && spec.substr(spec.size() - 5) == ".json") return relative_to_suite(spec);
     return spec;
   }
 
@@ -156,8 +155,7 @@ class SuiteReader : public JsonPathReader {
         a.fault = e.value("fault", "");
         if (e.contains("leaf_obj")) {
           if (!e["leaf_obj"].is_string()) fail(path + "/leaf_obj", "expected the path of an OBJ file");
-          const fs::path lp(e["leaf_obj"].get<std::string>());
-          a.leaf_obj = (lp.is_absolute() ? lp : dir_ / lp).lexically_normal().string();  // relative to the suite file
+          a.leaf_obj = relative_to_suite(e["leaf_obj"].get<std::string>());
           try {
             (void)load_leaf_mesh(a.leaf_obj);
           } catch (const InputError& err) {
@@ -274,11 +272,6 @@ class SuiteReader : public JsonPathReader {
 
 // Exit codes of a trial child.
 constexpr int kExitOk = 0, kExitInvalid = 2, kExitOom = 3, kExitError = 4;
-
-std::string signal_name(int sig) {
-  const char* d = strsignal(sig);
-  return fmt::format("signal {} ({})", sig, d ? d : "?");
-}
 
 std::string csv_row(const std::vector<std::string>& cells) {
   std::string row;
@@ -514,9 +507,8 @@ std::unique_ptr<Launcher> start_trial_launcher() {
   return std::make_unique<Launcher>([](const std::string& description) {
     const json j = json::parse(description);
     const TrialSpec spec = trial_spec_from_json(j);
-    const std::string dir = spec.out_dir;
-    return Launcher::Job{[spec, dir](int report_fd) { return run_trial_child(spec, dir, report_fd); },
-                         (fs::path(dir) / "log.txt").string()};
+    return Launcher::Job{[spec](int report_fd) { return run_trial_child(spec, spec.out_dir, report_fd); },
+                         (fs::path(spec.out_dir) / "log.txt").string()};
   });
 }
 

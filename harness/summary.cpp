@@ -14,11 +14,8 @@ namespace {
 
 using nlohmann::json;
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n == 0 ? NAN : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
-}
+// NAN for none: the tables print it as "-".
+double median(std::vector<double> v) { return v.empty() ? NAN : median_of(std::move(v)); }
 
 // Distribution-free confidence interval for the median from order statistics: the widest-coverage
 // pair (x_(l), x_(n+1-l)) with binomial coverage >= 95%. Below 6 samples no pair reaches 95%: the

@@ -108,5 +108,23 @@ TEST(Process, LauncherRelaysReportsCrashesTimeoutsAndErrors) {
   EXPECT_EQ(launcher.run("other", {}, nullptr).exit_code, 1) << "the launcher goes on after an error";
 }
 
+TEST(Process, ADeadLauncherIsAnErrorNotTheEndOfItsOwner) {
+  // The job reports its parent, the launcher; killed, the next run must throw, not die of SIGPIPE.
+  Launcher launcher([](const std::string&) {
+    return Launcher::Job{[](int fd) {
+                           const std::string pid = std::to_string(getppid());
+                           return write(fd, pid.data(), pid.size()) == static_cast<ssize_t>(pid.size()) ? 0 : 1;
+                         },
+                         ""};
+  });
+  std::string reported;
+  ASSERT_EQ(launcher.run("x", {}, [&](const std::string& r) { reported = r; }).exit_code, 0);
+  ASSERT_FALSE(reported.empty());
+  ASSERT_EQ(kill(static_cast<pid_t>(std::stol(reported)), SIGKILL), 0);
+  usleep(100 * 1000);
+  EXPECT_THROW(launcher.run("x", {}, nullptr), std::runtime_error);
+  EXPECT_THROW(launcher.run("x", {}, nullptr), std::runtime_error);
+}
+
 }  // namespace
 }  // namespace growbench
