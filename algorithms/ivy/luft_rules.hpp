@@ -159,8 +159,15 @@ struct AdhesionSearch {
              float box2 = -1.0f) {
     if (!t.adhesive) return false;
     // Cheap rejections first. They only drop triangles that are farther than the best so far by more
-    // than rounding, so the outcome never depends on the order triangles are offered in.
-    const float bound = best * (1.0f + 1e-5f);
+    // than rounding, so the outcome never depends on the order triangles are offered in. The slack is
+    // absolute as well as relative: d is measured between float points whose coordinates are rounded
+    // at the scale of |p|, so a plane distance (nq) or box distance can exceed the d computed for the
+    // same triangle by a few ulps of |p|, which near a surface is far more than 1e-5 of d (a bunny
+    // node 3 mm from two faces had nq - d = 4e-8 = 1.4e-5 d, and a relative slack alone let the
+    // triangle offered first win). Nothing at or beyond max_distance counts either.
+    const float scale = std::max(std::abs(p.x), std::max(std::abs(p.y), std::abs(p.z)));
+    const float base = std::min(best, max_distance);
+    const float bound = base * (1.0f + 1e-5f) + 1e-6f * (scale + base);
     if (box2 < 0.0f) box2 = box_distance2(t, p);
     if (box2 > bound * bound) return false;
     glm::vec3 f;

@@ -146,11 +146,14 @@ TEST(IvyBranching, ThinnedSamplerMatchesLuftsNodeLoop) {
 // Luft's own algorithm: every triangle for the adhesion, every triangle as a collision candidate.
 class BruteForceGeometry final : public ivy::Geometry {
  public:
-  BruteForceGeometry(const ivy::TriangleTable& t, const ivy::Config& c, const SceneQuery& q) : t_(t), c_(c), q_(q) {}
+  BruteForceGeometry(const ivy::TriangleTable& t, const ivy::Config& c, const SceneQuery& q, bool reverse = false)
+      : t_(t), c_(c), q_(q), reverse_(reverse) {}
   glm::vec3 adhesion(const glm::vec3& p, float gather, ivy::Candidates& candidates,
                      std::uint32_t& hint) const override {
     ivy::AdhesionSearch s{p, c_.max_adhesion, c_.adhesion_mode == ivy::AdhesionMode::Luft};
-    for (std::uint32_t id = 0; id < t_.size(); ++id) {
+    const auto n = static_cast<std::uint32_t>(t_.size());
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const std::uint32_t id = reverse_ ? n - 1 - i : i;  // the order must not matter
       s.offer(t_.tris[id], id, geom::closest_point_on_triangle);
       if (gather > 0.0f) candidates.push(id);
     }
@@ -163,6 +166,7 @@ class BruteForceGeometry final : public ivy::Geometry {
   const ivy::TriangleTable& t_;
   ivy::Config c_;
   const SceneQuery& q_;
+  bool reverse_;
 };
 
 Plant grow_with(const Scene& scene, const SceneQuery& query, bool brute, std::uint64_t seed, int steps,
@@ -194,6 +198,94 @@ TEST(IvyReference, EmbreePathGrowsExactlyLuftsBruteForcePlant) {
       ASSERT_GT(fast.nodes.size(), 200u) << name;
       EXPECT_EQ(fast.nodes.size(), slow.nodes.size()) << name << " seed " << seed;
       EXPECT_EQ(fast.geometry_hash(), slow.geometry_hash()) << name << " seed " << seed;
+    }
+  }
+}
+
+// Query by query on a scanned mesh of 70k triangles (too many to grow a brute-force plant on): the
+// Embree path's adhesion vector, target and collision candidates equal the brute-force ones, in both
+// adhesion modes, whichever triangle a clinging root offers first and in whichever order the brute
+// force loops. Points: random ones on, above, below and far from the surface, and near-ties on the
+// bisector of two faces sharing an edge, where the two distances differ only by rounding (the case
+// in which a rejection test without enough slack let the triangle offered first win).
+TEST(IvyReference, EmbreeAdhesionEqualsBruteForceOnTheBunny) {
+  const Scene bunny = load_scene("mesh:" + test::shared_mesh("stanford-bunny.obj"));
+  const SceneQuery query(bunny, {.build_sdf = false});
+  const ivy::TriangleTable table(bunny);
+  auto neighbour = [&](std::uint32_t t, glm::vec3& mid) -> std::uint32_t {  // across t's edge a-b
+    const ivy::Triangle& x = table.tris[t];
+    for (std::uint32_t id = 0; id < table.size(); ++id) {
+      const ivy::Triangle& y = table.tris[id];
+      auto has = [&](const glm::vec3& v) { return y.a == v || y.b == v || y.c == v; };
+      if (id != t && has(x.a) && has(x.b)) {
+        mid = 0.5f * (x.a + x.b);
+        return id;
+      }
+    }
+    return ivy::kNoTriangle;
+  };
+  for (const char* mode : {"luft", "closest"}) {
+    Params params = default_params(find_algorithm("ivy"));
+    params.set_assignment(std::string("adhesion=") + mode);
+    const ivy::Config cfg = ivy::make_config(params, bunny);
+    const auto fast = ivy::make_embree_geometry(query, table, cfg);
+    const BruteForceGeometry slow(table, cfg, query), reversed(table, cfg, query, true);
+    Rng rng(7, 0, 0);
+    int attracted = 0, none = 0, ties = 0;
+    auto check = [&](const glm::vec3& p, float gather, std::initializer_list<std::uint32_t> hints, int i) {
+      ivy::Candidates cf, cs, cr;
+      std::uint32_t hf = ivy::kNoTriangle, hs = ivy::kNoTriangle, hr = ivy::kNoTriangle;
+      const glm::vec3 af = fast->adhesion(p, gather, cf, hf);
+      const glm::vec3 as = slow.adhesion(p, gather, cs, hs);
+      const glm::vec3 ar = reversed.adhesion(p, gather, cr, hr);
+      ASSERT_EQ(hf, hs) << mode << " point " << i;
+      ASSERT_EQ(af, as) << mode << " point " << i;
+      ASSERT_EQ(hr, hs) << mode << " point " << i << ": offering the triangles in reverse order changed the target";
+      ASSERT_EQ(ar, as) << mode << " point " << i;
+      // A clinging root offers its previous target first: no hint changes the answer.
+      for (std::uint32_t h : hints) {
+        ivy::Candidates ch;
+        std::uint32_t hint = h;
+        ASSERT_EQ(fast->adhesion(p, gather, ch, hint), as) << mode << " point " << i << " hint " << h;
+        ASSERT_EQ(hint, hs) << mode << " point " << i << " hint " << h;
+      }
+      // The candidates are exactly the triangles whose bounds come within gather.
+      const auto fs = cf.sorted_unique();
+      const std::vector<std::uint32_t> got(fs.begin(), fs.end());
+      std::vector<std::uint32_t> want;
+      for (std::uint32_t id = 0; id < table.size() && gather > 0.0f; ++id)
+        if (ivy::box_distance2(table.tris[id], p) <= gather * gather) want.push_back(id);
+      ASSERT_EQ(got, want) << mode << " point " << i;
+      (hf == ivy::kNoTriangle ? none : attracted) += 1;
+    };
+    for (int i = 0; i < 300; ++i) {
+      const SurfaceSample s = query.sample_surface(11, static_cast<std::uint64_t>(i));
+      // From just inside to beyond the adhesion distance, with a sideways jitter of a few steps.
+      const float off = static_cast<float>(rng.uniform() * 1.4 - 0.1) * cfg.max_adhesion;
+      const glm::vec3 jitter(static_cast<float>(rng.uniform() - 0.5), static_cast<float>(rng.uniform() - 0.5),
+                             static_cast<float>(rng.uniform() - 0.5));
+      const glm::vec3 p = s.position + off * s.normal + 4.0f * cfg.step * jitter;
+      const float gather = i % 3 == 0 ? 0.0f : cfg.step * static_cast<float>(1.0 + rng.uniform());
+      check(p, gather, {s.triangle}, i);
+      if (HasFatalFailure()) return;
+    }
+    for (int i = 0; i < 300; ++i) {
+      const SurfaceSample s = query.sample_surface(12, static_cast<std::uint64_t>(i));
+      glm::vec3 mid;
+      const std::uint32_t u = neighbour(s.triangle, mid);
+      if (u == ivy::kNoTriangle) continue;  // a boundary edge of the scan
+      const glm::vec3 bisector = table.tris[s.triangle].n + table.tris[u].n;
+      if (glm::length(bisector) < 0.1f) continue;
+      const float h = static_cast<float>(0.002 + 0.05 * rng.uniform()) * cfg.max_adhesion;
+      check(mid + h * glm::normalize(bisector), cfg.step, {s.triangle, u}, 1000 + i);
+      if (HasFatalFailure()) return;
+      ++ties;
+    }
+    // Both outcomes and the near-ties were exercised.
+    EXPECT_GT(attracted, 100) << mode;
+    EXPECT_GT(ties, 200) << mode;
+    if (std::string(mode) == "luft") {
+      EXPECT_GT(none, 20) << mode;
     }
   }
 }
