@@ -288,6 +288,59 @@ bool visit_callback(RTCPointQueryFunctionArguments* args) {
 }
 }  // namespace
 
+struct BoxIndex::Impl {
+  RTCScene scene = nullptr;
+  ~Impl() {
+    if (scene) rtcReleaseScene(scene);
+  }
+};
+
+namespace {
+void box_bounds(const RTCBoundsFunctionArguments* args) {
+  const auto& boxes = *static_cast<const std::vector<Aabb>*>(args->geometryUserPtr);
+  const Aabb& b = boxes[args->primID];
+  *args->bounds_o = RTCBounds{b.min.x, b.min.y, b.min.z, 0.0f, b.max.x, b.max.y, b.max.z, 0.0f};
+}
+struct BoxVisitState {
+  BoxIndex::Visitor visit;
+  void* user;
+};
+bool box_visit_callback(RTCPointQueryFunctionArguments* args) {
+  const auto* st = static_cast<const BoxVisitState*>(args->userPtr);
+  st->visit(st->user, args->primID);
+  return false;
+}
+}  // namespace
+
+BoxIndex::BoxIndex(void* device, std::vector<Aabb> boxes) : boxes_(std::move(boxes)), impl_(std::make_unique<Impl>()) {
+  auto* dev = static_cast<RTCDevice>(device);
+  // Empty boxes stay out of the BVH (Embree skips primitives with invalid bounds), so ids keep their
+  // meaning without ever being visited.
+  impl_->scene = rtcNewScene(dev);
+  rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
+  RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_USER);
+  rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(boxes_.size()));
+  rtcSetGeometryUserData(g, &boxes_);
+  rtcSetGeometryBoundsFunction(g, box_bounds, &boxes_);
+  rtcCommitGeometry(g);
+  rtcAttachGeometryByID(impl_->scene, g, 0);
+  rtcReleaseGeometry(g);
+  rtcCommitScene(impl_->scene);
+  if (const RTCError e = rtcGetDeviceError(dev); e != RTC_ERROR_NONE)
+    throw std::runtime_error(fmt::format("Embree: building a box index failed (error {})", static_cast<int>(e)));
+}
+
+BoxIndex::~BoxIndex() = default;
+
+void BoxIndex::visit_containing(const glm::vec3& p, Visitor visit, void* user) const {
+  BoxVisitState st{visit, user};
+  point_query(impl_->scene, p, 0.0f, box_visit_callback, &st);
+}
+
+std::unique_ptr<BoxIndex> SceneQuery::box_index(std::vector<Aabb> boxes) const {
+  return std::unique_ptr<BoxIndex>(new BoxIndex(embree_->device, std::move(boxes)));
+}
+
 ClosestHit SceneQuery::closest_point(const glm::vec3& p, float max_distance, bool climbable_only) const {
   PointQueryState st{&embree_->main->meshes, {}, climbable_only && !not_climbable_.empty() ? &not_climbable_ : nullptr};
   // The vertex bound counts every mesh, so it only bounds an unfiltered query.

@@ -57,6 +57,29 @@ struct SurfaceSample {
 
 class SdfGrid;  // OpenVDB, in sdf.cpp only
 
+// An Embree BVH over caller-given boxes (user geometry), for "which of these regions hold p" queries:
+// the ivy's Luft adhesion asks which triangles' extruded prisms contain a point, which a ball query
+// over the triangles answers only by visiting every triangle within the adhesion distance. Built by
+// SceneQuery::box_index on its device; safe for concurrent queries.
+class BoxIndex {
+ public:
+  ~BoxIndex();
+  BoxIndex(const BoxIndex&) = delete;
+  BoxIndex& operator=(const BoxIndex&) = delete;
+  // Calls `visit(user, id)` for every box (index into the boxes given) that contains p, and possibly
+  // for a few that do not (Embree's leaves hold several boxes): the visitor tests its own rule.
+  using Visitor = void (*)(void* user, std::uint32_t id);
+  void visit_containing(const glm::vec3& p, Visitor visit, void* user) const;
+  [[nodiscard]] std::size_t size() const { return boxes_.size(); }
+
+ private:
+  friend class SceneQuery;
+  struct Impl;
+  BoxIndex(void* device, std::vector<Aabb> boxes);
+  std::vector<Aabb> boxes_;
+  std::unique_ptr<Impl> impl_;
+};
+
 class SceneQuery {
  public:
   explicit SceneQuery(const Scene& scene, SceneQueryOptions options = {});
@@ -75,6 +98,8 @@ class SceneQuery {
   // queries with their own per-triangle rule (the ivy's Luft adhesion and collision candidates).
   using TriangleVisitor = void (*)(void* user, std::uint32_t mesh, std::uint32_t triangle, float* radius);
   void visit_near(const glm::vec3& p, float radius, TriangleVisitor visit, void* user) const;
+  // An index over `boxes` (an empty box never contains anything).
+  [[nodiscard]] std::unique_ptr<BoxIndex> box_index(std::vector<Aabb> boxes) const;
   [[nodiscard]] RayHit ray(const glm::vec3& origin, const glm::vec3& dir,
                            float tmax = std::numeric_limits<float>::infinity(), float tmin = 0.0f) const;
   [[nodiscard]] bool occluded(const glm::vec3& origin, const glm::vec3& dir,

@@ -89,6 +89,45 @@ TEST(Geometry, FillSmallHolesClosesAScanButNotAWall) {
   EXPECT_EQ(quad.triangles.size(), 2u);
 }
 
+// The box index visits every box that holds the point (and never an empty one); whatever extra boxes
+// share a leaf are for the caller's own test to drop.
+TEST(SceneQuery, BoxIndexVisitsEveryBoxHoldingThePoint) {
+  const Scene scene = load_scene("boulder");
+  const SceneQuery q(scene, {.build_sdf = false});
+  Rng rng(3, 0, 0);
+  auto u = [&] { return static_cast<float>(rng.uniform()); };
+  std::vector<Aabb> boxes(2000);
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    if (i % 7 == 0) continue;  // empty
+    const glm::vec3 c(u() * 4 - 2, u() * 4 - 2, u() * 4 - 2), h(u() * 0.5f, u() * 0.5f, u() * 0.01f + u() * 0.3f);
+    boxes[i].extend(c - h);
+    boxes[i].extend(c + h);
+  }
+  const auto index = q.box_index(boxes);
+  ASSERT_EQ(index->size(), boxes.size());
+  std::size_t hits = 0;
+  for (int k = 0; k < 500; ++k) {
+    const glm::vec3 p(u() * 4 - 2, u() * 4 - 2, u() * 4 - 2);
+    std::vector<std::uint32_t> seen;
+    index->visit_containing(
+        p, [](void* user, std::uint32_t id) { static_cast<std::vector<std::uint32_t>*>(user)->push_back(id); }, &seen);
+    std::sort(seen.begin(), seen.end());
+    for (std::uint32_t id = 0; id < boxes.size(); ++id) {
+      const bool holds = !boxes[id].empty() && glm::all(glm::lessThanEqual(boxes[id].min, p)) &&
+                         glm::all(glm::lessThanEqual(p, boxes[id].max));
+      const bool visited = std::binary_search(seen.begin(), seen.end(), id);
+      if (holds) {
+        EXPECT_TRUE(visited) << "box " << id << " holds point " << k << " but was not visited";
+        ++hits;
+      }
+      if (boxes[id].empty()) {
+        EXPECT_FALSE(visited) << "empty box " << id << " visited";
+      }
+    }
+  }
+  EXPECT_GT(hits, 500u);  // the points do land in boxes
+}
+
 TEST(SceneQuery, BoxDistancesMatchAnalyticWithinAVoxel) {
   const Scene s = scene_with(geom::make_box("box", {-1, -1, -1}, {1, 1, 1}));
   SceneQuery q(s, {.voxel_size = 0.02f});
