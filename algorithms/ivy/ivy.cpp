@@ -3,13 +3,15 @@
 //  * Luft loops over every scene triangle for each node's adhesion and again for its collision test.
 //    Here Embree queries find the same answers from a few triangles: in `luft` adhesion mode a point
 //    query on an index of the triangles' adhesion prisms (see EmbreeGeometry), in `closest` mode
-//    growing ball queries; and a ball query gathers the triangles the collision test can possibly
-//    touch. Every position the collision loop can produce stays within |step| of the old position
-//    (mirroring across a plane the segment crosses never moves the end farther from the start), so
-//    the triangles within that radius are a complete candidate set, and Luft's loop over them in index
-//    order gives exactly his result. A ray could not promise that: its hit set comes from Embree's own
-//    float test, which differs from Luft's rule along edges. (The Blender collision mode is a ray,
-//    because Blender's is.)
+//    growing ball queries. For the collision, ball queries gather the triangles Luft's loop can touch.
+//    His first pass can only mirror at a triangle the segment itself crosses, and all of those lie
+//    within half its length of its midpoint: when none of that small set is crossed, neither is any
+//    other triangle and the loop ends (three nodes in four on the bunny). Otherwise every position
+//    the loop can produce stays within the segment's length of the start (mirroring across a plane
+//    the segment crosses never moves the end farther from the start), so the triangles within that
+//    radius are a complete candidate set, and his loop over them in index order gives exactly his
+//    result. A ray could not promise that: its hit set comes from Embree's own float test, which
+//    differs from Luft's rule along edges. (The Blender collision mode is a ray, because Blender's is.)
 //  * Luft's branching scans every node of every alive root each iteration (quadratic over a run).
 //    The same distribution is drawn without the scan: a node can only branch where its weight
 //    w = 1 - (cos(2 pi l / L) / 2 + 1/2) exceeds the threshold b, a contiguous window of the root
@@ -132,7 +134,7 @@ glm::vec3 cube(Rng& rng) {
 // triangles each. So the prisms' bounding boxes get their own Embree BVH, and a point query returns the
 // ~10 whose box holds p; the exact rule then decides. Each box is padded beyond anything rounding or
 // the inside test's tolerance can accept, so it is a superset and the answer is Luft's, bit for bit.
-// The collision candidates (triangles within one step) still come from a small ball query.
+// The collision candidates come from a small ball query.
 // Closest mode keeps growing balls around the previous target (the true closest point is found at
 // once when the root clings, and there is no rule under which nothing near counts).
 class EmbreeGeometry final : public ivy::Geometry {
@@ -152,12 +154,9 @@ class EmbreeGeometry final : public ivy::Geometry {
     prisms_ = query_.box_index(std::move(prisms));
   }
 
-  glm::vec3 adhesion(const glm::vec3& p, float gather, ivy::Candidates& candidates,
-                     std::uint32_t& hint) const override {
-    State st{this, {p, cfg_.max_adhesion, cfg_.adhesion_mode == ivy::AdhesionMode::Luft}, &candidates, gather,
-             gather > 0.0f ? gather * gather : -1.0f};
+  glm::vec3 adhesion(const glm::vec3& p, std::uint32_t& hint) const override {
+    State st{this, {p, cfg_.max_adhesion, cfg_.adhesion_mode == ivy::AdhesionMode::Luft}};
     if (prisms_) {
-      if (gather > 0.0f) query_.visit_near(p, gather, &EmbreeGeometry::gather_visit, &st);
       prisms_->visit_containing(p, &EmbreeGeometry::prism_visit, &st);
       hint = st.search.best_id;
       return st.search.vector();
@@ -169,17 +168,22 @@ class EmbreeGeometry final : public ivy::Geometry {
     // Growing balls (two steps, then eight): when the target is found inside one, every triangle that
     // could beat or tie it was inside it too, so the answer is final. Otherwise the full adhesion ball.
     for (const float steps : {2.0f, 8.0f}) {
-      const float near = std::max(gather, steps * cfg_.step);
+      const float near = steps * cfg_.step;
       if (near >= cfg_.max_adhesion) break;
-      query_.visit_near(p, reach(std::max(std::min(near, st.search.best), gather)), &EmbreeGeometry::visit, &st);
+      query_.visit_near(p, reach(std::min(near, st.search.best)), &EmbreeGeometry::visit, &st);
       if (reach(st.search.best) <= reach(near)) {
         hint = st.search.best_id;
         return st.search.vector();
       }
     }
-    query_.visit_near(p, reach(std::max(std::min(cfg_.max_adhesion, st.search.best), gather)), &EmbreeGeometry::visit, &st);
+    query_.visit_near(p, reach(std::min(cfg_.max_adhesion, st.search.best)), &EmbreeGeometry::visit, &st);
     hint = st.search.best_id;
     return st.search.vector();
+  }
+
+  void gather(const glm::vec3& centre, float radius, ivy::Candidates& candidates) const override {
+    Gather st{&table_, centre, radius * radius, &candidates};
+    query_.visit_near(centre, radius, &EmbreeGeometry::gather_visit, &st);
   }
 
   RayHit first_hit(const glm::vec3& o, const glm::vec3& d) const override { return query_.ray(o, d, 1.0f, 0.0f); }
@@ -188,26 +192,26 @@ class EmbreeGeometry final : public ivy::Geometry {
   struct State {
     const EmbreeGeometry* self;
     ivy::AdhesionSearch search;
-    ivy::Candidates* candidates;
-    float gather;
-    float gather2;  // squared, -1 when not gathering
   };
   static void visit(void* user, std::uint32_t mesh, std::uint32_t tri, float* radius) {
     auto& st = *static_cast<State*>(user);
     const auto& table = st.self->table_;
     const std::uint32_t id = table.id(mesh, tri);
-    const ivy::Triangle& t = table.tris[id];
-    const float box2 = ivy::box_distance2(t, st.search.p);
-    if (box2 <= st.gather2) st.candidates->push(id);  // gather2 < 0 when not gathering
-    if (st.search.offer(t, id, geom::closest_point_on_triangle, box2)) {
-      // Keep every triangle that could still tie or win (and every collision candidate) in reach.
-      *radius = std::min(*radius, std::max(st.gather, st.search.best) * (1.0f + 1e-4f) + st.self->cfg_.margin);
+    if (st.search.offer(table.tris[id], id, geom::closest_point_on_triangle)) {
+      // Keep every triangle that could still tie or win in reach.
+      *radius = std::min(*radius, st.search.best * (1.0f + 1e-4f) + st.self->cfg_.margin);
     }
   }
+  struct Gather {
+    const ivy::TriangleTable* table;
+    glm::vec3 centre;
+    float radius2;
+    ivy::Candidates* out;
+  };
   static void gather_visit(void* user, std::uint32_t mesh, std::uint32_t tri, float*) {
-    auto& st = *static_cast<State*>(user);
-    const std::uint32_t id = st.self->table_.id(mesh, tri);
-    if (ivy::box_distance2(st.self->table_.tris[id], st.search.p) <= st.gather2) st.candidates->push(id);
+    auto& st = *static_cast<Gather*>(user);
+    const std::uint32_t id = st.table->id(mesh, tri);
+    if (ivy::box_distance2(st.table->tris[id], st.centre) <= st.radius2) st.out->push(id);
   }
   static void prism_visit(void* user, std::uint32_t id) {
     auto& st = *static_cast<State*>(user);
@@ -369,20 +373,31 @@ Grower::Grown Grower::grow_one(const Root& r) const {
   random = rl > 0.0f ? random / rl : kUp;
 
   const float fall = cfg_.gravity * std::pow(floating / cfg_.max_float, 0.7f);
-  Candidates candidates;
-  const bool luft_collision = cfg_.collision_mode == CollisionMode::Luft;
-  // |grow| <= step (unit vectors, weights summing to 1) and |gravity| = step * fall: the farthest any
-  // mirrored candidate can be from pos.
-  const float gather = luft_collision ? cfg_.step * (1.0f + fall) * (1.0f + 1e-3f) + cfg_.margin : 0.0f;
-  const glm::vec3 adhesion = geometry_.adhesion(pos, gather, candidates, g.hint);
+  const glm::vec3 adhesion = geometry_.adhesion(pos, g.hint);
 
   glm::vec3 grow = cfg_.step * (r.dir * cfg_.primary + random * cfg_.random + adhesion * cfg_.adhesion);
   const glm::vec3 gravity = cfg_.step * fall * glm::vec3(0.0f, -1.0f, 0.0f);
   glm::vec3 next = pos + grow + gravity;
 
   bool ok = true;
-  if (luft_collision) {
-    const CollisionResult c = collide(table_, candidates.sorted_unique(), pos, next);
+  if (cfg_.collision_mode == CollisionMode::Luft) {
+    // Pass one of Luft's loop mirrors only at a triangle the segment crosses: those all lie within
+    // half its length of its midpoint. Only if one is crossed does the loop need every triangle the
+    // mirrored ends can reach, all within the segment's length of pos. (The slack covers rounding and
+    // the inside test's tolerance.)
+    const glm::vec3 d = next - pos;
+    const float len = glm::length(d);
+    Candidates near;
+    geometry_.gather(pos + 0.5f * d, 0.5f * len * (1.0f + 1e-3f) + cfg_.margin, near);
+    glm::vec3 end = next;
+    CollisionResult c = collide(table_, near.sorted_unique(), pos, end);
+    if (c.reflections > 0) {
+      Candidates reach;
+      geometry_.gather(pos, len * (1.0f + 1e-3f) + cfg_.margin, reach);
+      end = next;
+      c = collide(table_, reach.sorted_unique(), pos, end);
+    }
+    next = end;
     g.climbing = c.climbing;
     g.reflections = static_cast<std::uint32_t>(c.reflections);
     ok = c.alive;

@@ -80,11 +80,13 @@ class Candidates {
 class Geometry {
  public:
   virtual ~Geometry() = default;
-  // The adhesion vector at p. With gather > 0 it also pushes every triangle that may come within
-  // `gather` of p (a superset) into `candidates` for the Luft collision test. `hint` is the triangle
-  // that attracted the previous node of the root (or kNoTriangle): offered first, it bounds the search
-  // radius without changing the answer. It returns holding this node's target.
-  virtual glm::vec3 adhesion(const glm::vec3& p, float gather, Candidates& candidates, std::uint32_t& hint) const = 0;
+  // The adhesion vector at p. `hint` is the triangle that attracted the previous node of the root (or
+  // kNoTriangle): offered first, it may bound the search without changing the answer. It returns
+  // holding this node's target.
+  virtual glm::vec3 adhesion(const glm::vec3& p, std::uint32_t& hint) const = 0;
+  // Pushes every triangle whose bounds come within `radius` of `centre` (or a superset) into
+  // `candidates`, for the Luft collision test.
+  virtual void gather(const glm::vec3& centre, float radius, Candidates& candidates) const = 0;
   // Blender's collision: the first hit on the segment o -> o + d (t in [0, 1]), any side.
   virtual RayHit first_hit(const glm::vec3& o, const glm::vec3& d) const = 0;
 };
