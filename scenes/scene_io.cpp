@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -95,6 +96,37 @@ Camera frame_camera(const Aabb& b) {
   return {c + glm::vec3(0.35f * r, 0.45f * r, 2.6f * r), c, 45.0f};
 }
 
+// The default seed of a mesh scene: the foot of the mesh's lit side, where a climber rooted beside it
+// would meet it. That is the lowest vertex whose normal is within 60 degrees of horizontal and faces
+// the light (then any such vertex; then the lowest of all), lowest index among ties, growing up along
+// the surface (world up laid into its tangent plane). The lowest vertex of all usually lies on an
+// underside facing the ground, where a plant pointed up grows into the solid; and a seed in the shadow
+// behind the mesh is hidden from the default camera, which looks from the light's side.
+Seed side_foot_seed(const TriangleMesh& m, const glm::vec3& light) {
+  std::vector<glm::vec3> normal(m.vertices.size(), glm::vec3(0.0f));
+  for (const auto& t : m.triangles) {
+    const glm::vec3 n = glm::cross(m.vertices[t.y] - m.vertices[t.x], m.vertices[t.z] - m.vertices[t.x]);  // area-weighted
+    normal[t.x] += n;
+    normal[t.y] += n;
+    normal[t.z] += n;
+  }
+  constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
+  std::size_t lit = kNone, side = kNone, lowest = 0;
+  auto lower = [&](std::size_t i, std::size_t than) { return than == kNone || m.vertices[i].y < m.vertices[than].y; };
+  for (std::size_t i = 0; i < m.vertices.size(); ++i) {
+    if (lower(i, lowest)) lowest = i;
+    const float len = glm::length(normal[i]);
+    if (!(len > 0.0f) || std::abs(normal[i].y) > 0.5f * len) continue;
+    if (lower(i, side)) side = i;
+    if (glm::dot(normal[i], light) > 0.0f && lower(i, lit)) lit = i;
+  }
+  const std::size_t at = lit != kNone ? lit : side;
+  if (at == kNone) return {m.vertices[lowest], {0, 1, 0}, 0};
+  const glm::vec3 n = glm::normalize(normal[at]);
+  const glm::vec3 up = glm::vec3(0, 1, 0) - n.y * n;
+  return {m.vertices[at], glm::length(up) > 1e-6f ? glm::normalize(up) : glm::vec3(0, 1, 0), 0};
+}
+
 Scene mesh_scene(const std::string& path, const Params& p) {
   Scene s;
   s.name = fs::path(path).stem().string();
@@ -102,10 +134,7 @@ Scene mesh_scene(const std::string& path, const Params& p) {
   const auto size = static_cast<float>(p.real("size"));
   if (size > 0.0f) fit_scene(s, size);
   const Aabb b = s.meshes[0].bounds();
-  // Default seed: the lowest vertex (lowest index among ties), growing up.
-  const auto& v = s.meshes[0].vertices;
-  const auto low = std::min_element(v.begin(), v.end(), [](const glm::vec3& a, const glm::vec3& c) { return a.y < c.y; });
-  s.seeds.push_back({*low, {0, 1, 0}, 0});
+  s.seeds.push_back(side_foot_seed(s.meshes[0], s.light.towards(b.center())));
   if (p.boolean("ground")) {
     const float half = 0.75f * std::max(b.size().x, b.size().z) + 0.5f;
     auto g = geom::make_box("ground", {b.center().x - half, b.min.y - 0.1f, b.center().z - half},

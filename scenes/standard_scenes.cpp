@@ -270,7 +270,9 @@ const std::vector<ParamSpec>& mesh_scene_params() {
   static const std::vector<ParamSpec> specs = {
       real_param("size", 2.0, 0.0, 1000, "m",
                  "scale the mesh so its largest extent is this (0 keeps the file's units and placement)"),
-      ParamSpec{"ground", ParamType::Bool, false, -INFINITY, INFINITY, "", "add a ground slab under the mesh", {}},
+      ParamSpec{"ground", ParamType::Bool, true, -INFINITY, INFINITY, "",
+                "a ground slab under the mesh (not climbable), where shoots that fall or hang come to rest, as on the "
+                "floor every render shows; false: the mesh alone", {}},
   };
   return specs;
 }

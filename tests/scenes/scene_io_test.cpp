@@ -32,18 +32,44 @@ TEST(StandardScenes, ParametersAreValidated) {
   EXPECT_NE(e.find("envelope"), std::string::npos) << e;  // lists the valid ones
 }
 
-TEST(MeshScene, FittedToStandardSizeWithSeedAtLowestVertex) {
+TEST(MeshScene, FittedToStandardSizeOnAGroundWithSeedAtTheFootOfItsLitSide) {
   const Scene s = load_scene("mesh:" + test::shared_mesh("stanford-bunny.obj"));
   const Aabb b = s.meshes[0].bounds();
   const glm::vec3 e = b.size();
   EXPECT_NEAR(std::max({e.x, e.y, e.z}), 2.0f, 1e-4f);
   EXPECT_NEAR(b.min.y, 0.0f, 1e-5f);
-  ASSERT_EQ(s.seeds.size(), 1u);
-  EXPECT_NEAR(s.seeds[0].position.y, 0.0f, 1e-5f);
   EXPECT_EQ(s.meshes[0].triangles.size(), 69451u);
+  // A ground slab, not climbable, its top at the mesh's lowest point.
+  ASSERT_EQ(s.meshes.size(), 2u);
+  EXPECT_FALSE(s.meshes[1].climbable);
+  EXPECT_NEAR(s.meshes[1].bounds().max.y, 0.0f, 1e-6f);
+  EXPECT_EQ(load_scene("mesh:" + test::shared_mesh("stanford-bunny.obj"), {"ground=false"}).meshes.size(), 1u);
+  // The seed: the lowest vertex among those whose (area-weighted) normal is within 60 degrees of
+  // horizontal and faces the light, growing up along the surface.
+  ASSERT_EQ(s.seeds.size(), 1u);
+  const TriangleMesh& m = s.meshes[0];
+  std::vector<glm::vec3> normal(m.vertices.size(), glm::vec3(0.0f));
+  for (const auto& t : m.triangles)
+    for (const auto k : {t.x, t.y, t.z})
+      normal[k] += glm::cross(m.vertices[t.y] - m.vertices[t.x], m.vertices[t.z] - m.vertices[t.x]);
+  const glm::vec3 light = s.light.towards(b.center());
+  float lowest = INFINITY;
+  std::size_t at = 0;
+  for (std::size_t i = 0; i < m.vertices.size(); ++i) {
+    const float len = glm::length(normal[i]);
+    if (len > 0.0f && std::abs(normal[i].y) <= 0.5f * len && glm::dot(normal[i], light) > 0.0f && m.vertices[i].y < lowest) {
+      lowest = m.vertices[i].y;
+      at = i;
+    }
+  }
+  EXPECT_EQ(s.seeds[0].position, m.vertices[at]);
+  EXPECT_LT(s.seeds[0].position.y, 0.05f);  // at the foot, not up the side
+  const glm::vec3 n = glm::normalize(normal[at]);
+  EXPECT_NEAR(glm::dot(s.seeds[0].direction, n), 0.0f, 1e-5f);  // along the surface
+  EXPECT_GT(s.seeds[0].direction.y, 0.9f);                       // and up
+  EXPECT_NEAR(glm::length(s.seeds[0].direction), 1.0f, 1e-5f);
   const Scene raw = load_scene("mesh:" + test::shared_mesh("stanford-bunny.obj"), {"size=0"});
   EXPECT_NEAR(raw.meshes[0].bounds().max.y, 0.187321f, 1e-5f);  // the file's own units
-  EXPECT_EQ(load_scene("mesh:" + test::shared_mesh("suzanne.obj"), {"ground=true"}).meshes.size(), 2u);
 }
 
 TEST(MeshScene, BadFilesGiveClearErrors) {
