@@ -304,5 +304,26 @@ TEST(Hadrich, WallPlantClimbsAndLeavesFaceOut) {
   EXPECT_GT(top, 1.0f);  // it climbed
 }
 
+// Hugging, not sprawling: on the corner and on the bunny (whose ground is not climbable) most of the
+// plant is up on the climbable surfaces and close to them. With the former default gravity of 1 the
+// shoots peeled off and lay on the ground (bunny: median node height 0.011 m; corner: 0.038 m).
+TEST(Hadrich, PlantsClimbTheCornerAndTheBunnyRatherThanTheGround) {
+  for (const std::string& name : std::vector<std::string>{"corner", "mesh:" + test::shared_mesh("stanford-bunny.obj")}) {
+    const Scene s = load_scene(name);
+    SceneQuery q(s);
+    const Plant plant = test::grow("hadrich", s, q, {"max_particles=3000"});
+    ASSERT_GT(plant.nodes.size(), 2000u) << name;
+    std::vector<float> height;
+    std::size_t up_and_on = 0;
+    for (const auto& n : plant.nodes) {
+      height.push_back(n.position.y);
+      up_and_on += n.position.y > 0.3f && q.closest_point(n.position, 0.05f, true).found ? 1 : 0;
+    }
+    std::nth_element(height.begin(), height.begin() + height.size() / 2, height.end());
+    EXPECT_GT(height[height.size() / 2], 0.15f) << name << ": the median node is near the ground";
+    EXPECT_GT(static_cast<double>(up_and_on) / plant.nodes.size(), 0.3) << name;
+  }
+}
+
 }  // namespace
 }  // namespace growbench
