@@ -273,6 +273,7 @@ Spare fork_spare(const Launcher::Prepare& prepare) {
   if (pid == 0) {
     prctl(PR_SET_PDEATHSIG, SIGKILL);
     if (getppid() != launcher) _exit(71);
+    signal(SIGPIPE, SIG_DFL);  // the launcher ignores it; a job runs as any process would
     // Its two ends become fds 3 and 4, and every other descriptor above 2 is closed.
     const int in = fcntl(job[0], F_DUPFD_CLOEXEC, 10), out = fcntl(rep[1], F_DUPFD_CLOEXEC, 10);
     if (in < 0 || out < 0 || dup3(in, 3, O_CLOEXEC) < 0 || dup3(out, 4, O_CLOEXEC) < 0) _exit(71);
@@ -334,6 +335,9 @@ Launcher::Launcher(Prepare prepare) {
   if (pid_ == 0) {
     prctl(PR_SET_PDEATHSIG, SIGKILL);  // the launcher never outlives its owner
     if (getppid() != owner) _exit(0);
+    // A write to a child that died waiting for its job (or to an owner that died) fails with EPIPE
+    // instead of ending the launcher.
+    signal(SIGPIPE, SIG_IGN);
     close(req[1]);
     close(rep[0]);
     const int in = req[0], out = rep[1];
@@ -351,19 +355,36 @@ Launcher::Launcher(Prepare prepare) {
       if (!read_all(in, description.data(), size) || !read_all(in, &limits, sizeof limits)) break;
       try {
         (void)prepare(description);  // a bad description is an error reply; the child prepares its own
-        if (spare.pid < 0) spare = fork_spare(prepare);
-        if (spare.pid < 0) throw std::runtime_error(fmt::format("cannot fork: {}", std::strerror(errno)));
-        const Spare job = spare;
-        spare = {};
         limits.die_with_parent = true;  // the launcher is single-threaded
-        const auto t0 = std::chrono::steady_clock::now();
-        const bool handed = write_all(job.job_fd, &size, sizeof size) && write_all(job.job_fd, description.data(), size) &&
-                            write_all(job.job_fd, &limits, sizeof limits);
-        close(job.job_fd);
-        if (!handed) kill(job.pid, SIGKILL);  // it died waiting: reaped below, reported as its signal
+        auto t0 = std::chrono::steady_clock::now();
+        auto hand_over = [&](const Spare& c) {
+          const bool ok = c.pid > 0 && write_all(c.job_fd, &size, sizeof size) &&
+                          write_all(c.job_fd, description.data(), size) && write_all(c.job_fd, &limits, sizeof limits);
+          if (c.job_fd >= 0) close(c.job_fd);
+          return ok;
+        };
+        auto discard = [](const Spare& c) {
+          if (c.pid <= 0) return;
+          close(c.report_fd);
+          kill(c.pid, SIGKILL);
+          while (waitpid(c.pid, nullptr, 0) < 0 && errno == EINTR) {
+          }
+        };
+        Spare job = spare;
+        spare = {};
+        if (!hand_over(job)) {  // none waiting, or it died waiting (killed from outside): a fresh one
+          discard(job);
+          t0 = std::chrono::steady_clock::now();
+          job = fork_spare(prepare);
+          if (!hand_over(job)) {
+            const int err = errno;
+            discard(job);
+            throw std::runtime_error(fmt::format("cannot start a trial process: {}", std::strerror(err)));
+          }
+        }
         const ChildResult cr = monitor_child(job.pid, t0, job.report_fd, limits, [&](const std::string& report) {
           send_reply(out, Reply::report, report.data(), report.size());
-          spare = fork_spare(prepare);
+          if (spare.pid < 0) spare = fork_spare(prepare);
         });
         if (!send_reply(out, Reply::result, &cr, sizeof cr)) break;
       } catch (const std::exception& e) {

@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <cstring>
+#include <fstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -124,6 +125,32 @@ TEST(Process, ADeadLauncherIsAnErrorNotTheEndOfItsOwner) {
   usleep(100 * 1000);
   EXPECT_THROW(launcher.run("x", {}, nullptr), std::runtime_error);
   EXPECT_THROW(launcher.run("x", {}, nullptr), std::runtime_error);
+}
+
+// The launcher keeps a job's process forked ahead; one that dies while it waits (killed from outside)
+// is replaced, and the job runs.
+TEST(Process, AJobsProcessKilledWhileWaitingIsReplaced) {
+  Launcher launcher([](const std::string&) {
+    return Launcher::Job{[](int fd) {
+                           const std::string pid = std::to_string(getppid());
+                           return write(fd, pid.data(), pid.size()) == static_cast<ssize_t>(pid.size()) ? 0 : 1;
+                         },
+                         ""};
+  });
+  std::string reported;
+  ASSERT_EQ(launcher.run("x", {}, [&](const std::string& r) { reported = r; }).exit_code, 0);
+  // The launcher's only child now is the process waiting for the next job.
+  std::ifstream children("/proc/" + reported + "/task/" + reported + "/children");
+  std::vector<pid_t> waiting;
+  for (long pid = 0; children >> pid;) waiting.push_back(static_cast<pid_t>(pid));
+  ASSERT_EQ(waiting.size(), 1u);
+  ASSERT_EQ(kill(waiting[0], SIGKILL), 0);
+  usleep(100 * 1000);
+  for (int i = 0; i < 2; ++i) {
+    const ChildResult r = launcher.run("x", {}, nullptr);
+    EXPECT_EQ(r.exit_code, 0);
+    EXPECT_EQ(r.signal, 0);
+  }
 }
 
 }  // namespace
