@@ -40,6 +40,23 @@ int process_thread_count() {
 namespace {
 ChildResult monitor_child(pid_t pid, std::chrono::steady_clock::time_point t0, int report_fd, const ChildLimits& limits,
                           const std::function<void(const std::string&)>& on_report);
+
+// In a job's child, before its body: output appended to log_path (when given), the address-space
+// limit. Async-signal-safe calls only.
+void enter_job(const std::string& log_path, const ChildLimits& limits) {
+  if (!log_path.empty()) {
+    const int fd = open(log_path.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+    if (fd >= 0) {
+      dup2(fd, STDOUT_FILENO);
+      dup2(fd, STDERR_FILENO);
+      close(fd);
+    }
+  }
+  if (limits.address_space_bytes > 0) {
+    rlimit rl{limits.address_space_bytes, limits.address_space_bytes};
+    setrlimit(RLIMIT_AS, &rl);
+  }
+}
 }  // namespace
 
 ChildResult run_forked(const std::function<int()>& body, const ChildLimits& limits, const std::string& log_path) {
@@ -69,18 +86,7 @@ ChildResult run_forked(const std::function<int(int report_fd)>& body, const Chil
     }
     setpgid(0, 0);  // its own process group, so a timeout kills any helpers it starts too
     if (report[0] >= 0) close(report[0]);
-    if (!log_path.empty()) {
-      const int fd = open(log_path.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-      if (fd >= 0) {
-        dup2(fd, STDOUT_FILENO);
-        dup2(fd, STDERR_FILENO);
-        close(fd);
-      }
-    }
-    if (limits.address_space_bytes > 0) {
-      rlimit rl{limits.address_space_bytes, limits.address_space_bytes};
-      setrlimit(RLIMIT_AS, &rl);
-    }
+    enter_job(log_path, limits);
     int code = 70;
     try {
       code = body(report[1]);
@@ -290,18 +296,7 @@ Spare fork_spare(const Launcher::Prepare& prepare) {
     int code = 70;
     try {
       const Launcher::Job job_spec = prepare(description);
-      if (!job_spec.log_path.empty()) {
-        const int fd = open(job_spec.log_path.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-        if (fd >= 0) {
-          dup2(fd, STDOUT_FILENO);
-          dup2(fd, STDERR_FILENO);
-          close(fd);
-        }
-      }
-      if (limits.address_space_bytes > 0) {
-        rlimit rl{limits.address_space_bytes, limits.address_space_bytes};
-        setrlimit(RLIMIT_AS, &rl);
-      }
+      enter_job(job_spec.log_path, limits);
       code = job_spec.body(4);
     } catch (...) {
     }

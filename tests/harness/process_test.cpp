@@ -109,15 +109,18 @@ TEST(Process, LauncherRelaysReportsCrashesTimeoutsAndErrors) {
   EXPECT_EQ(launcher.run("other", {}, nullptr).exit_code, 1) << "the launcher goes on after an error";
 }
 
+// A job that reports its parent: the launcher.
+Launcher::Job report_the_launcher(const std::string&) {
+  return Launcher::Job{[](int fd) {
+                         const std::string pid = std::to_string(getppid());
+                         return write(fd, pid.data(), pid.size()) == static_cast<ssize_t>(pid.size()) ? 0 : 1;
+                       },
+                       ""};
+}
+
 TEST(Process, ADeadLauncherIsAnErrorNotTheEndOfItsOwner) {
   // The job reports its parent, the launcher; killed, the next run must throw, not die of SIGPIPE.
-  Launcher launcher([](const std::string&) {
-    return Launcher::Job{[](int fd) {
-                           const std::string pid = std::to_string(getppid());
-                           return write(fd, pid.data(), pid.size()) == static_cast<ssize_t>(pid.size()) ? 0 : 1;
-                         },
-                         ""};
-  });
+  Launcher launcher(report_the_launcher);
   std::string reported;
   ASSERT_EQ(launcher.run("x", {}, [&](const std::string& r) { reported = r; }).exit_code, 0);
   ASSERT_FALSE(reported.empty());
@@ -130,13 +133,7 @@ TEST(Process, ADeadLauncherIsAnErrorNotTheEndOfItsOwner) {
 // The launcher keeps a job's process forked ahead; one that dies while it waits (killed from outside)
 // is replaced, and the job runs.
 TEST(Process, AJobsProcessKilledWhileWaitingIsReplaced) {
-  Launcher launcher([](const std::string&) {
-    return Launcher::Job{[](int fd) {
-                           const std::string pid = std::to_string(getppid());
-                           return write(fd, pid.data(), pid.size()) == static_cast<ssize_t>(pid.size()) ? 0 : 1;
-                         },
-                         ""};
-  });
+  Launcher launcher(report_the_launcher);
   std::string reported;
   ASSERT_EQ(launcher.run("x", {}, [&](const std::string& r) { reported = r; }).exit_code, 0);
   // The launcher's only child now is the process waiting for the next job.
