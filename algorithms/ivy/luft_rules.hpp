@@ -153,10 +153,8 @@ struct AdhesionSearch {
   std::uint32_t best_id = std::numeric_limits<std::uint32_t>::max();
   glm::vec3 foot{0.0f};
 
-  // `box2`: the squared distance from p to t's bounds when the caller has it already (else < 0).
   bool offer(const Triangle& t, std::uint32_t id,
-             glm::vec3 (*closest)(const glm::vec3&, const glm::vec3&, const glm::vec3&, const glm::vec3&),
-             float box2 = -1.0f) {
+             glm::vec3 (*closest)(const glm::vec3&, const glm::vec3&, const glm::vec3&, const glm::vec3&)) {
     if (!t.adhesive) return false;
     // Cheap rejections first. They only drop triangles that are farther than the best so far by more
     // than rounding, so the outcome never depends on the order triangles are offered in. The slack is
@@ -168,8 +166,7 @@ struct AdhesionSearch {
     const float scale = std::max(std::abs(p.x), std::max(std::abs(p.y), std::abs(p.z)));
     const float base = std::min(best, max_distance);
     const float bound = base * (1.0f + 1e-5f) + 1e-6f * (scale + base);
-    if (box2 < 0.0f) box2 = box_distance2(t, p);
-    if (box2 > bound * bound) return false;
+    if (box_distance2(t, p) > bound * bound) return false;
     glm::vec3 f;
     float d;
     if (luft) {
