@@ -106,22 +106,21 @@ namespace {
 // or -1), enforcing the timeout, and reaps it.
 ChildResult monitor_child(pid_t pid, std::chrono::steady_clock::time_point t0, int report_fd, const ChildLimits& limits,
                           const std::function<void(const std::string&)>& on_report) {
-  int report[1] = {report_fd};
   bool reported = false;
   // The report: one write of at most PIPE_BUF bytes arrives whole; EOF means there was none.
   auto read_report = [&] {
     char buf[PIPE_BUF];
     ssize_t n;
     do {
-      n = read(report[0], buf, sizeof buf);
+      n = read(report_fd, buf, sizeof buf);
     } while (n < 0 && errno == EINTR);
     if (n > 0 && !reported) {
       reported = true;
       on_report(std::string(buf, static_cast<std::size_t>(n)));
     }
     if (n <= 0) {
-      close(report[0]);
-      report[0] = -1;
+      close(report_fd);
+      report_fd = -1;
     }
   };
   ChildResult r;
@@ -139,17 +138,17 @@ ChildResult monitor_child(pid_t pid, std::chrono::steady_clock::time_point t0, i
   if (pidfd >= 0) {
     // Sleep until the child reports or exits, or the timeout passes: no polling delay added to a trial.
     while (true) {
-      pollfd pfd[2] = {{pidfd, POLLIN, 0}, {report[0], POLLIN, 0}};
+      pollfd pfd[2] = {{pidfd, POLLIN, 0}, {report_fd, POLLIN, 0}};
       int timeout_ms = -1;
       if (limits.timeout_s > 0) timeout_ms = std::max(0, static_cast<int>((limits.timeout_s - elapsed()) * 1000.0) + 1);
-      const int rc = poll(pfd, report[0] >= 0 ? 2 : 1, timeout_ms);
+      const int rc = poll(pfd, report_fd >= 0 ? 2 : 1, timeout_ms);
       if (rc < 0 && errno == EINTR) continue;
       if (rc < 0) break;  // cannot wait on it: the blocking wait4 below still reaps it
       if (rc == 0) {
         kill_child();
         break;
       }
-      if (report[0] >= 0 && (pfd[1].revents & (POLLIN | POLLHUP)) != 0) read_report();
+      if (report_fd >= 0 && (pfd[1].revents & (POLLIN | POLLHUP)) != 0) read_report();
       if ((pfd[0].revents & POLLIN) != 0) break;
     }
     close(pidfd);
@@ -174,11 +173,11 @@ ChildResult monitor_child(pid_t pid, std::chrono::steady_clock::time_point t0, i
   }
   r.wall_s = elapsed();
   // A report written just before the exit may still be in the pipe.
-  if (report[0] >= 0 && !reported) {
-    fcntl(report[0], F_SETFL, O_NONBLOCK);
+  if (report_fd >= 0 && !reported) {
+    fcntl(report_fd, F_SETFL, O_NONBLOCK);
     read_report();
   }
-  if (report[0] >= 0) close(report[0]);
+  if (report_fd >= 0) close(report_fd);
   r.user_s = static_cast<double>(ru.ru_utime.tv_sec) + 1e-6 * static_cast<double>(ru.ru_utime.tv_usec);
   r.system_s = static_cast<double>(ru.ru_stime.tv_sec) + 1e-6 * static_cast<double>(ru.ru_stime.tv_usec);
   r.max_rss_bytes = static_cast<std::uint64_t>(ru.ru_maxrss) * 1024u;
@@ -223,6 +222,20 @@ bool read_all(int fd, void* data, std::size_t n) {
     n -= static_cast<std::size_t>(r);
   }
   return true;
+}
+
+// A job request, on the owner's pipe to the launcher and on the launcher's pipe to a job's child: the
+// description's length, the description, the limits.
+bool write_request(int fd, const std::string& description, const ChildLimits& limits) {
+  const auto size = static_cast<std::uint32_t>(description.size());
+  return write_all(fd, &size, sizeof size) && write_all(fd, description.data(), size) &&
+         write_all(fd, &limits, sizeof limits);
+}
+bool read_request(int fd, std::string& description, ChildLimits& limits) {
+  std::uint32_t size = 0;
+  if (!read_all(fd, &size, sizeof size)) return false;
+  description.resize(size);
+  return read_all(fd, description.data(), size) && read_all(fd, &limits, sizeof limits);
 }
 
 bool send_reply(int fd, Reply kind, const void* data, std::size_t n) {
@@ -285,12 +298,9 @@ Spare fork_spare(const Launcher::Prepare& prepare) {
     if (in < 0 || out < 0 || dup3(in, 3, O_CLOEXEC) < 0 || dup3(out, 4, O_CLOEXEC) < 0) _exit(71);
     close_range(5, ~0U, 0);
     warm_up();
-    std::uint32_t size = 0;
     std::string description;
     ChildLimits limits;
-    if (!read_all(3, &size, sizeof size)) _exit(0);  // the launcher is closing: no job
-    description.resize(size);
-    if (!read_all(3, description.data(), size) || !read_all(3, &limits, sizeof limits)) _exit(0);
+    if (!read_request(3, description, limits)) _exit(0);  // the launcher is closing: no job
     close(3);
     setpgid(0, 0);
     int code = 70;
@@ -341,20 +351,15 @@ Launcher::Launcher(Prepare prepare) {
     // its memory, and the suite reads its record). The fork is off the launch's critical path and
     // overlaps nothing that is measured. Without a spare (a job that never reported) it forks on demand.
     Spare spare = fork_spare(prepare);
-    // A request: the description's length, the description, the limits.
-    std::uint32_t size = 0;
     std::string description;
     ChildLimits limits;
-    while (read_all(in, &size, sizeof size)) {
-      description.resize(size);
-      if (!read_all(in, description.data(), size) || !read_all(in, &limits, sizeof limits)) break;
+    while (read_request(in, description, limits)) {
       try {
         (void)prepare(description);  // a bad description is an error reply; the child prepares its own
         limits.die_with_parent = true;  // the launcher is single-threaded
         auto t0 = std::chrono::steady_clock::now();
         auto hand_over = [&](const Spare& c) {
-          const bool ok = c.pid > 0 && write_all(c.job_fd, &size, sizeof size) &&
-                          write_all(c.job_fd, description.data(), size) && write_all(c.job_fd, &limits, sizeof limits);
+          const bool ok = c.pid > 0 && write_request(c.job_fd, description, limits);
           if (c.job_fd >= 0) close(c.job_fd);
           return ok;
         };
@@ -419,9 +424,7 @@ ChildResult Launcher::run(const std::string& description, const ChildLimits& lim
   sigemptyset(&pipe_signal);
   sigaddset(&pipe_signal, SIGPIPE);
   pthread_sigmask(SIG_BLOCK, &pipe_signal, &before);
-  const std::uint32_t size = static_cast<std::uint32_t>(description.size());
-  const bool sent = write_all(request_fd_, &size, sizeof size) && write_all(request_fd_, description.data(), size) &&
-                    write_all(request_fd_, &limits, sizeof limits);
+  const bool sent = write_request(request_fd_, description, limits);
   if (!sent) {
     const timespec now{0, 0};
     sigtimedwait(&pipe_signal, nullptr, &now);

@@ -18,6 +18,7 @@
 #include "core/json_util.hpp"
 #include "harness/exporters.hpp"
 #include "harness/process.hpp"
+#include "scenes/geometry.hpp"
 
 namespace growbench {
 namespace fs = std::filesystem;
@@ -53,24 +54,19 @@ constexpr float kMinRadius = 1e-4f;
 // their average, as on the bunny or the boulder); empty otherwise (boxes and capped cylinders are
 // drawn flat, so their edges stay sharp).
 std::vector<glm::vec3> smooth_normals(const TriangleMesh& m) {
-  std::vector<glm::vec3> n(m.vertices.size(), glm::vec3(0.0f));
-  std::vector<glm::vec3> face(m.triangles.size());
-  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
-    const auto& tri = m.triangles[t];
-    face[t] = glm::cross(m.vertices[tri.y] - m.vertices[tri.x], m.vertices[tri.z] - m.vertices[tri.x]);
-    for (int k = 0; k < 3; ++k) n[tri[k]] += face[t];
-  }
+  std::vector<glm::vec3> n = geom::vertex_normal_sums(m);
   for (auto& v : n) {
     const float l = glm::length(v);
     if (!(l > 0.0f)) return {};
     v /= l;
   }
   const float cos60 = 0.5f;
-  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
-    const float l = glm::length(face[t]);
+  for (const auto& tri : m.triangles) {
+    const glm::vec3 face = glm::cross(m.vertices[tri.y] - m.vertices[tri.x], m.vertices[tri.z] - m.vertices[tri.x]);
+    const float l = glm::length(face);
     if (!(l > 0.0f)) continue;
     for (int k = 0; k < 3; ++k)
-      if (glm::dot(face[t] / l, n[m.triangles[t][k]]) < cos60) return {};
+      if (glm::dot(face / l, n[tri[k]]) < cos60) return {};
   }
   return n;
 }

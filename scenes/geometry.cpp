@@ -118,6 +118,17 @@ TriangleMesh make_icosphere(const std::string& name, const glm::vec3& center, fl
   return m;
 }
 
+std::vector<glm::vec3> vertex_normal_sums(const TriangleMesh& m) {
+  std::vector<glm::vec3> n(m.vertices.size(), glm::vec3(0.0f));
+  for (const auto& t : m.triangles) {
+    const glm::vec3 f = glm::cross(m.vertices[t.y] - m.vertices[t.x], m.vertices[t.z] - m.vertices[t.x]);
+    n[t.x] += f;
+    n[t.y] += f;
+    n[t.z] += f;
+  }
+  return n;
+}
+
 bool fill_small_holes(TriangleMesh& m, double max_boundary_fraction) {
   if (m.is_closed()) return true;
   std::map<std::pair<unsigned, unsigned>, int> directed;

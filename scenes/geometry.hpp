@@ -1,6 +1,8 @@
 // Small geometric building blocks for scenes and tests.
 #pragma once
 
+#include <vector>
+
 #include <glm/glm.hpp>
 
 #include "scenes/scene.hpp"
@@ -10,6 +12,10 @@ namespace growbench::geom {
 // Closest point on triangle (a, b, c) to p (Ericson, Real-Time Collision Detection, 5.1.5).
 glm::vec3 closest_point_on_triangle(const glm::vec3& p, const glm::vec3& a, const glm::vec3& b,
                                     const glm::vec3& c);
+
+// Per vertex, the sum of its faces' (b - a) x (c - a): area-weighted, not normalised (zero for a vertex
+// no face uses).
+std::vector<glm::vec3> vertex_normal_sums(const TriangleMesh& mesh);
 
 // Closed, outward-facing primitive meshes.
 TriangleMesh make_box(const std::string& name, const glm::vec3& min, const glm::vec3& max);

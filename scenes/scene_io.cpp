@@ -103,13 +103,7 @@ Camera frame_camera(const Aabb& b) {
 // underside facing the ground, where a plant pointed up grows into the solid; and a seed in the shadow
 // behind the mesh is hidden from the default camera, which looks from the light's side.
 Seed side_foot_seed(const TriangleMesh& m, const glm::vec3& light) {
-  std::vector<glm::vec3> normal(m.vertices.size(), glm::vec3(0.0f));
-  for (const auto& t : m.triangles) {
-    const glm::vec3 n = glm::cross(m.vertices[t.y] - m.vertices[t.x], m.vertices[t.z] - m.vertices[t.x]);  // area-weighted
-    normal[t.x] += n;
-    normal[t.y] += n;
-    normal[t.z] += n;
-  }
+  const std::vector<glm::vec3> normal = geom::vertex_normal_sums(m);
   constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
   std::size_t lit = kNone, side = kNone, lowest = 0;
   auto lower = [&](std::size_t i, std::size_t than) { return than == kNone || m.vertices[i].y < m.vertices[than].y; };
