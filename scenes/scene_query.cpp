@@ -15,6 +15,20 @@
 namespace growbench {
 
 namespace {
+
+RTCRay make_ray(const glm::vec3& o, const glm::vec3& d, float tmin, float tmax) {
+  RTCRay ray{};
+  ray.org_x = o.x;
+  ray.org_y = o.y;
+  ray.org_z = o.z;
+  ray.dir_x = d.x;
+  ray.dir_y = d.y;
+  ray.dir_z = d.z;
+  ray.tnear = tmin;
+  ray.tfar = tmax;
+  ray.mask = 0xFFFFFFFFu;
+  return ray;
+}
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -66,15 +80,7 @@ struct BvhScene {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRayHit rh{};
-    rh.ray.org_x = o.x;
-    rh.ray.org_y = o.y;
-    rh.ray.org_z = o.z;
-    rh.ray.dir_x = d.x;
-    rh.ray.dir_y = d.y;
-    rh.ray.dir_z = d.z;
-    rh.ray.tnear = tmin;
-    rh.ray.tfar = tmax;
-    rh.ray.mask = 0xFFFFFFFFu;
+    rh.ray = make_ray(o, d, tmin, tmax);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(scene, &ctx, &rh);
@@ -92,16 +98,7 @@ struct BvhScene {
   bool occluded(const glm::vec3& o, const glm::vec3& d, float tmin, float tmax) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
-    RTCRay ray{};
-    ray.org_x = o.x;
-    ray.org_y = o.y;
-    ray.org_z = o.z;
-    ray.dir_x = d.x;
-    ray.dir_y = d.y;
-    ray.dir_z = d.z;
-    ray.tnear = tmin;
-    ray.tfar = tmax;
-    ray.mask = 0xFFFFFFFFu;
+    RTCRay ray = make_ray(o, d, tmin, tmax);
     rtcOccluded1(scene, &ctx, &ray);
     return ray.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
   }
@@ -301,15 +298,18 @@ void box_bounds(const RTCBoundsFunctionArguments* args) {
   const Aabb& b = boxes[args->primID];
   *args->bounds_o = RTCBounds{b.min.x, b.min.y, b.min.z, 0.0f, b.max.x, b.max.y, b.max.z, 0.0f};
 }
-struct BoxVisitState {
+// The visitor rides behind the intersect context, which Embree hands to every callback.
+struct BoxRayContext {
+  RTCIntersectContext context;
   BoxIndex::Visitor visit;
   void* user;
 };
-bool box_visit_callback(RTCPointQueryFunctionArguments* args) {
-  const auto* st = static_cast<const BoxVisitState*>(args->userPtr);
-  st->visit(st->user, args->primID);
-  return false;
+void box_occluded(const RTCOccludedFunctionNArguments* args) {
+  if (args->valid[0] == 0) return;
+  const auto* c = reinterpret_cast<const BoxRayContext*>(args->context);
+  if (c->visit(c->user, args->primID)) RTCRayN_tfar(args->ray, args->N, 0) = -std::numeric_limits<float>::infinity();
 }
+void box_intersect(const RTCIntersectFunctionNArguments*) {}  // only occlusion queries are made
 }  // namespace
 
 BoxIndex::BoxIndex(void* device, std::vector<Aabb> boxes) : boxes_(std::move(boxes)), impl_(std::make_unique<Impl>()) {
@@ -322,6 +322,8 @@ BoxIndex::BoxIndex(void* device, std::vector<Aabb> boxes) : boxes_(std::move(box
   rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(boxes_.size()));
   rtcSetGeometryUserData(g, &boxes_);
   rtcSetGeometryBoundsFunction(g, box_bounds, &boxes_);
+  rtcSetGeometryIntersectFunction(g, box_intersect);
+  rtcSetGeometryOccludedFunction(g, box_occluded);
   rtcCommitGeometry(g);
   rtcAttachGeometryByID(impl_->scene, g, 0);
   rtcReleaseGeometry(g);
@@ -332,9 +334,14 @@ BoxIndex::BoxIndex(void* device, std::vector<Aabb> boxes) : boxes_(std::move(box
 
 BoxIndex::~BoxIndex() = default;
 
-void BoxIndex::visit_containing(const glm::vec3& p, Visitor visit, void* user) const {
-  BoxVisitState st{visit, user};
-  point_query(impl_->scene, p, 0.0f, box_visit_callback, &st);
+void BoxIndex::visit_segment(const glm::vec3& o, const glm::vec3& d, Visitor visit, void* user) const {
+  BoxRayContext c{{}, visit, user};
+  rtcInitIntersectContext(&c.context);
+  // A point is a ray of length zero. Its direction (1, 1, 1) has reciprocal 1, so the slab tests
+  // subtract exactly and a box holding p is never missed.
+  const bool point = d == glm::vec3(0.0f);
+  RTCRay ray = make_ray(o, point ? glm::vec3(1.0f) : d, 0.0f, point ? 0.0f : 1.0f);
+  rtcOccluded1(impl_->scene, &c.context, &ray);
 }
 
 std::unique_ptr<BoxIndex> SceneQuery::box_index(std::vector<Aabb> boxes) const {

@@ -57,19 +57,26 @@ struct SurfaceSample {
 
 class SdfGrid;  // OpenVDB, in sdf.cpp only
 
-// An Embree BVH over caller-given boxes (user geometry), for "which of these regions hold p" queries:
-// the ivy's Luft adhesion asks which triangles' extruded prisms contain a point, which a ball query
-// over the triangles answers only by visiting every triangle within the adhesion distance. Built by
+// An Embree BVH over caller-given boxes (user geometry), for "which of these regions hold p" and
+// "which does this segment pass through" queries: the ivy's Luft adhesion asks which triangles'
+// extruded prisms contain a point, which a ball query over the triangles answers only by visiting
+// every triangle within the adhesion distance; its collision test asks whether a segment crosses any
+// triangle. Both are traversed as rays (a point is a ray of length zero), Embree's fastest traversal:
+// on the bunny a ray costs a fraction of a ball query (rtcPointQuery) of the same reach. Built by
 // SceneQuery::box_index on its device; safe for concurrent queries.
 class BoxIndex {
  public:
   ~BoxIndex();
   BoxIndex(const BoxIndex&) = delete;
   BoxIndex& operator=(const BoxIndex&) = delete;
-  // Calls `visit(user, id)` for every box (index into the boxes given) that contains p, and possibly
-  // for a few that do not (Embree's leaves hold several boxes): the visitor tests its own rule.
-  using Visitor = void (*)(void* user, std::uint32_t id);
-  void visit_containing(const glm::vec3& p, Visitor visit, void* user) const;
+  // Called with the index of a box (into the boxes given); returning true ends the query.
+  using Visitor = bool (*)(void* user, std::uint32_t id);
+  // Visits every box that contains p, and possibly a few that do not (Embree's leaves hold several
+  // boxes): the visitor tests its own rule.
+  void visit_containing(const glm::vec3& p, Visitor visit, void* user) const { visit_segment(p, glm::vec3(0.0f), visit, user); }
+  // Visits every box the segment from o to o + d passes through (and possibly a few more). Boxes
+  // touched only within rounding of their faces may be missed: pad the boxes if that matters.
+  void visit_segment(const glm::vec3& o, const glm::vec3& d, Visitor visit, void* user) const;
   [[nodiscard]] std::size_t size() const { return boxes_.size(); }
 
  private:

@@ -87,6 +87,8 @@ class Geometry {
   // Pushes every triangle whose bounds come within `radius` of `centre` (or a superset) into
   // `candidates`, for the Luft collision test.
   virtual void gather(const glm::vec3& centre, float radius, Candidates& candidates) const = 0;
+  // Whether Luft's collision rule finds any triangle that the segment o -> q crosses (entering it).
+  virtual bool crosses_any(const glm::vec3& o, const glm::vec3& q) const = 0;
   // Blender's collision: the first hit on the segment o -> o + d (t in [0, 1]), any side.
   virtual RayHit first_hit(const glm::vec3& o, const glm::vec3& d) const = 0;
 };

@@ -32,12 +32,17 @@
 
 namespace growbench::ivy {
 
-struct Triangle {
+// One cache line each: a query touches a handful of triangles scattered over a table of megabytes,
+// so every triangle costs a miss, and a record straddling two lines costs two (the bounds, which
+// were stored as well, are six min/max operations away).
+struct alignas(64) Triangle {
   glm::vec3 a{0.0f}, b{0.0f}, c{0.0f};
   glm::vec3 n{0.0f};              // unit normal of (b - a) x (c - a); zero when degenerate
-  glm::vec3 lo{0.0f}, hi{0.0f};   // bounds
   bool adhesive = true;           // on a climbable mesh (only those attract)
+  [[nodiscard]] glm::vec3 lo() const { return glm::min(a, glm::min(b, c)); }
+  [[nodiscard]] glm::vec3 hi() const { return glm::max(a, glm::max(b, c)); }
 };
+static_assert(sizeof(Triangle) == 64);
 
 // Every triangle of the scene in Luft's loop order: mesh by mesh, triangle by triangle.
 struct TriangleTable {
@@ -57,8 +62,6 @@ struct TriangleTable {
         const glm::vec3 n = glm::cross(r.b - r.a, r.c - r.a);
         const float len = glm::length(n);
         r.n = len > 0.0f ? n / len : glm::vec3(0.0f);
-        r.lo = glm::min(r.a, glm::min(r.b, r.c));
-        r.hi = glm::max(r.a, glm::max(r.b, r.c));
         r.adhesive = m.climbable || !any_climbable;
         tris.push_back(r);
       }
@@ -72,7 +75,7 @@ constexpr double kInsideTolerance = 1e-6;
 
 // Squared distance from p to t's bounding box (0 inside it).
 inline float box_distance2(const Triangle& t, const glm::vec3& p) {
-  const glm::vec3 out = glm::max(glm::vec3(0.0f), glm::max(t.lo - p, p - t.hi));
+  const glm::vec3 out = glm::max(glm::vec3(0.0f), glm::max(t.lo() - p, p - t.hi()));
   return glm::dot(out, out);
 }
 
@@ -163,9 +166,7 @@ struct AdhesionSearch {
     // same triangle by a few ulps of |p|, which near a surface is far more than 1e-5 of d (a bunny
     // node 3 mm from two faces had nq - d = 4e-8 = 1.4e-5 d, and a relative slack alone let the
     // triangle offered first win). Nothing at or beyond max_distance counts either.
-    const float scale = std::max(std::abs(p.x), std::max(std::abs(p.y), std::abs(p.z)));
-    const float base = std::min(best, max_distance);
-    const float bound = base * (1.0f + 1e-5f) + 1e-6f * (scale + base);
+    const float bound = reject_beyond();
     if (box_distance2(t, p) > bound * bound) return false;
     glm::vec3 f;
     float d;
@@ -186,6 +187,13 @@ struct AdhesionSearch {
       return true;
     }
     return false;
+  }
+  // The distance past which offered triangles are rejected unseen: the best so far (or the maximum)
+  // plus rounding slack. A search that offered every triangle this close to p has found Luft's target.
+  [[nodiscard]] float reject_beyond() const {
+    const float scale = std::max(std::abs(p.x), std::max(std::abs(p.y), std::abs(p.z)));
+    const float base = std::min(best, max_distance);
+    return base * (1.0f + 1e-5f) + 1e-6f * (scale + base);
   }
   // normalize(foot - p) * (1 - d / max_distance); zero when nothing counted or p is on the surface.
   [[nodiscard]] glm::vec3 vector() const {

@@ -161,6 +161,11 @@ class BruteForceGeometry final : public ivy::Geometry {
   void gather(const glm::vec3&, float, ivy::Candidates& candidates) const override {
     for (std::uint32_t id = 0; id < t_.size(); ++id) candidates.push(id);  // every triangle, as Luft
   }
+  bool crosses_any(const glm::vec3& o, const glm::vec3& q) const override {
+    for (const auto& t : t_.tris)
+      if (ivy::crosses(t, o, q)) return true;
+    return false;
+  }
   RayHit first_hit(const glm::vec3& o, const glm::vec3& d) const override { return q_.ray(o, d, 1.0f, 0.0f); }
 
  private:
@@ -259,6 +264,14 @@ TEST(IvyReference, EmbreeAdhesionEqualsBruteForceOnTheBunny) {
       ASSERT_EQ(got, want) << mode << " point " << i;
       (hf == ivy::kNoTriangle ? none : attracted) += 1;
     };
+    // Luft's collision question, whether the segment crosses any triangle, as the box index answers it
+    // and as the loop over every triangle does.
+    int crossed = 0, clear = 0;
+    auto cross = [&](const glm::vec3& o, const glm::vec3& q, int i) {
+      const bool want = slow.crosses_any(o, q);
+      ASSERT_EQ(fast->crosses_any(o, q), want) << mode << " segment " << i;
+      (want ? crossed : clear) += 1;
+    };
     for (int i = 0; i < 300; ++i) {
       const SurfaceSample s = query.sample_surface(11, static_cast<std::uint64_t>(i));
       // From just inside to beyond the adhesion distance, with a sideways jitter of a few steps.
@@ -269,22 +282,37 @@ TEST(IvyReference, EmbreeAdhesionEqualsBruteForceOnTheBunny) {
       const float gather = cfg.step * static_cast<float>(0.2 + 2.0 * rng.uniform());
       check(p, gather, {s.triangle}, i);
       if (HasFatalFailure()) return;
+      // Through the surface just below the sample, and one step in the jitter's direction.
+      cross(p, s.position - 0.3f * cfg.step * s.normal + cfg.step * jitter, i);
+      cross(p, p + cfg.step * jitter, 500 + i);
+      if (HasFatalFailure()) return;
     }
     for (int i = 0; i < 300; ++i) {
       const SurfaceSample s = query.sample_surface(12, static_cast<std::uint64_t>(i));
       glm::vec3 mid;
       const std::uint32_t u = neighbour(s.triangle, mid);
-      if (u == ivy::kNoTriangle) continue;  // a boundary edge of the scan
+      if (u == ivy::kNoTriangle) {  // a boundary edge of the scan: a crossing on the rim of a hole
+        const glm::vec3 n = table.tris[s.triangle].n;
+        cross(mid + cfg.step * n, mid - cfg.step * n, 2000 + i);
+        if (HasFatalFailure()) return;
+        continue;
+      }
       const glm::vec3 bisector = table.tris[s.triangle].n + table.tris[u].n;
       if (glm::length(bisector) < 0.1f) continue;
       const float h = static_cast<float>(0.002 + 0.05 * rng.uniform()) * cfg.max_adhesion;
       check(mid + h * glm::normalize(bisector), cfg.step, {s.triangle, u}, 1000 + i);
+      cross(mid + h * glm::normalize(bisector), mid - 0.5f * h * glm::normalize(bisector), 1000 + i);  // on the edge
+      // Through a vertex, where the crossing lies on a corner of the triangles' boxes to within rounding.
+      const glm::vec3 v = table.tris[s.triangle].a;
+      cross(v + h * glm::normalize(bisector), v - 0.5f * h * glm::normalize(bisector), 3000 + i);
       if (HasFatalFailure()) return;
       ++ties;
     }
     // Both outcomes and the near-ties were exercised.
     EXPECT_GT(attracted, 100) << mode;
     EXPECT_GT(ties, 200) << mode;
+    EXPECT_GT(crossed, 300) << mode;
+    EXPECT_GT(clear, 150) << mode;
     if (std::string(mode) == "luft") {
       EXPECT_GT(none, 20) << mode;
     }

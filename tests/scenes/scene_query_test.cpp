@@ -89,6 +89,20 @@ TEST(Geometry, FillSmallHolesClosesAScanButNotAWall) {
   EXPECT_EQ(quad.triangles.size(), 2u);
 }
 
+// 2000 boxes centred in [-2, 2]^3 with half-sizes up to `half` (some thin), every seventh one empty
+// when asked.
+std::vector<Aabb> random_boxes(Rng& rng, float half, bool with_empty) {
+  auto u = [&] { return static_cast<float>(rng.uniform()); };
+  std::vector<Aabb> boxes(2000);
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    if (with_empty && i % 7 == 0) continue;
+    const glm::vec3 c(u() * 4 - 2, u() * 4 - 2, u() * 4 - 2), h(u() * half, u() * half, (u() * 0.02f + u() * 0.6f) * half);
+    boxes[i].extend(c - h);
+    boxes[i].extend(c + h);
+  }
+  return boxes;
+}
+
 // The box index visits every box that holds the point (and never an empty one); whatever extra boxes
 // share a leaf are for the caller's own test to drop.
 TEST(SceneQuery, BoxIndexVisitsEveryBoxHoldingThePoint) {
@@ -96,13 +110,7 @@ TEST(SceneQuery, BoxIndexVisitsEveryBoxHoldingThePoint) {
   const SceneQuery q(scene, {.build_sdf = false});
   Rng rng(3, 0, 0);
   auto u = [&] { return static_cast<float>(rng.uniform()); };
-  std::vector<Aabb> boxes(2000);
-  for (std::size_t i = 0; i < boxes.size(); ++i) {
-    if (i % 7 == 0) continue;  // empty
-    const glm::vec3 c(u() * 4 - 2, u() * 4 - 2, u() * 4 - 2), h(u() * 0.5f, u() * 0.5f, u() * 0.01f + u() * 0.3f);
-    boxes[i].extend(c - h);
-    boxes[i].extend(c + h);
-  }
+  const std::vector<Aabb> boxes = random_boxes(rng, 0.5f, true);
   const auto index = q.box_index(boxes);
   ASSERT_EQ(index->size(), boxes.size());
   std::size_t hits = 0;
@@ -110,7 +118,12 @@ TEST(SceneQuery, BoxIndexVisitsEveryBoxHoldingThePoint) {
     const glm::vec3 p(u() * 4 - 2, u() * 4 - 2, u() * 4 - 2);
     std::vector<std::uint32_t> seen;
     index->visit_containing(
-        p, [](void* user, std::uint32_t id) { static_cast<std::vector<std::uint32_t>*>(user)->push_back(id); }, &seen);
+        p,
+        [](void* user, std::uint32_t id) {
+          static_cast<std::vector<std::uint32_t>*>(user)->push_back(id);
+          return false;
+        },
+        &seen);
     std::sort(seen.begin(), seen.end());
     for (std::uint32_t id = 0; id < boxes.size(); ++id) {
       const bool holds = !boxes[id].empty() && glm::all(glm::lessThanEqual(boxes[id].min, p)) &&
@@ -126,6 +139,51 @@ TEST(SceneQuery, BoxIndexVisitsEveryBoxHoldingThePoint) {
     }
   }
   EXPECT_GT(hits, 500u);  // the points do land in boxes
+}
+
+// Segment queries: every box the segment passes through well inside (not just grazing a face within
+// rounding) is visited, and a visitor that answers true ends the query.
+TEST(SceneQuery, BoxIndexVisitsEveryBoxTheSegmentPassesThrough) {
+  const Scene scene = load_scene("boulder");
+  const SceneQuery q(scene, {.build_sdf = false});
+  Rng rng(5, 0, 0);
+  auto u = [&] { return static_cast<float>(rng.uniform()); };
+  const std::vector<Aabb> boxes = random_boxes(rng, 0.2f, false);
+  const auto index = q.box_index(boxes);
+  auto collect = [](void* user, std::uint32_t id) {
+    static_cast<std::vector<std::uint32_t>*>(user)->push_back(id);
+    return false;
+  };
+  std::size_t through = 0;
+  for (int k = 0; k < 500; ++k) {
+    const glm::vec3 o(u() * 4 - 2, u() * 4 - 2, u() * 4 - 2), d(u() - 0.5f, u() - 0.5f, u() - 0.5f);
+    std::vector<std::uint32_t> seen;
+    index->visit_segment(o, d, collect, &seen);
+    std::sort(seen.begin(), seen.end());
+    for (std::uint32_t id = 0; id < boxes.size(); ++id) {
+      // The parameter interval of o + t d inside the box, in double (slab method), t in [0, 1].
+      double t0 = 0.0, t1 = 1.0;
+      for (int a = 0; a < 3; ++a) {
+        const double lo = boxes[id].min[a], hi = boxes[id].max[a], oa = o[a], da = d[a];
+        if (da == 0.0) {
+          if (oa < lo || oa > hi) t1 = -1.0;
+          continue;
+        }
+        const double ta = (lo - oa) / da, tb = (hi - oa) / da;
+        t0 = std::max(t0, std::min(ta, tb));
+        t1 = std::min(t1, std::max(ta, tb));
+      }
+      if (t1 - t0 > 1e-4) {
+        EXPECT_TRUE(std::binary_search(seen.begin(), seen.end(), id)) << "segment " << k << " passes through box " << id;
+        ++through;
+      }
+    }
+  }
+  EXPECT_GT(through, 200u);
+  // Stopping at the first box: one visit.
+  int visits = 0;
+  index->visit_segment(glm::vec3(-2.0f), glm::vec3(4.0f), [](void* user, std::uint32_t) { return ++*static_cast<int*>(user) > 0; }, &visits);
+  EXPECT_EQ(visits, 1);
 }
 
 TEST(SceneQuery, BoxDistancesMatchAnalyticWithinAVoxel) {
