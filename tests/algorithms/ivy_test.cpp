@@ -4,7 +4,9 @@
 // facing away from it, Blender's limits).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <map>
 
 #include <nlohmann/json.hpp>
 
@@ -218,18 +220,28 @@ TEST(IvyReference, EmbreeAdhesionEqualsBruteForceOnTheBunny) {
   const Scene bunny = load_scene("mesh:" + test::shared_mesh("stanford-bunny.obj"));
   const SceneQuery query(bunny, {.build_sdf = false});
   const ivy::TriangleTable table(bunny);
-  auto neighbour = [&](std::uint32_t t, glm::vec3& mid) -> std::uint32_t {  // across t's edge a-b
+  // The triangle across t's edge a-b (kNoTriangle on the rim of a hole), and the edge's midpoint.
+  auto neighbour = [&](std::uint32_t t, glm::vec3& mid) -> std::uint32_t {
     const ivy::Triangle& x = table.tris[t];
+    mid = 0.5f * (x.a + x.b);
     for (std::uint32_t id = 0; id < table.size(); ++id) {
       const ivy::Triangle& y = table.tris[id];
       auto has = [&](const glm::vec3& v) { return y.a == v || y.b == v || y.c == v; };
-      if (id != t && has(x.a) && has(x.b)) {
-        mid = 0.5f * (x.a + x.b);
-        return id;
-      }
+      if (id != t && has(x.a) && has(x.b)) return id;
     }
     return ivy::kNoTriangle;
   };
+  // How many triangles share each edge (endpoints ordered), to find the rims of holes.
+  auto edge_key = [](const glm::vec3& p, const glm::vec3& q) {
+    const std::array<float, 3> a{p.x, p.y, p.z}, b{q.x, q.y, q.z};
+    return a < b ? std::pair(a, b) : std::pair(b, a);
+  };
+  std::map<std::pair<std::array<float, 3>, std::array<float, 3>>, int> edges;
+  for (const auto& x : table.tris) {
+    ++edges[edge_key(x.a, x.b)];
+    ++edges[edge_key(x.b, x.c)];
+    ++edges[edge_key(x.c, x.a)];
+  }
   for (const char* mode : {"luft", "closest"}) {
     Params params = default_params(find_algorithm("ivy"));
     params.set_assignment(std::string("adhesion=") + mode);
@@ -291,12 +303,7 @@ TEST(IvyReference, EmbreeAdhesionEqualsBruteForceOnTheBunny) {
       const SurfaceSample s = query.sample_surface(12, static_cast<std::uint64_t>(i));
       glm::vec3 mid;
       const std::uint32_t u = neighbour(s.triangle, mid);
-      if (u == ivy::kNoTriangle) {  // a boundary edge of the scan: a crossing on the rim of a hole
-        const glm::vec3 n = table.tris[s.triangle].n;
-        cross(mid + cfg.step * n, mid - cfg.step * n, 2000 + i);
-        if (HasFatalFailure()) return;
-        continue;
-      }
+      if (u == ivy::kNoTriangle) continue;  // on the rim of a hole: see below
       const glm::vec3 bisector = table.tris[s.triangle].n + table.tris[u].n;
       if (glm::length(bisector) < 0.1f) continue;
       const float h = static_cast<float>(0.002 + 0.05 * rng.uniform()) * cfg.max_adhesion;
@@ -308,6 +315,23 @@ TEST(IvyReference, EmbreeAdhesionEqualsBruteForceOnTheBunny) {
       if (HasFatalFailure()) return;
       ++ties;
     }
+    // The rims of the scan's holes, where a crossing on the edge has no neighbour to fall into: through
+    // the middle of every rim edge and through its ends.
+    int rim = 0;
+    for (std::uint32_t t = 0; t < table.size(); ++t) {
+      const ivy::Triangle& x = table.tris[t];
+      const glm::vec3 v[3] = {x.a, x.b, x.c};
+      for (int e = 0; e < 3; ++e) {
+        const auto key = edge_key(v[e], v[(e + 1) % 3]);
+        if (edges.at(key) != 1) continue;
+        for (const glm::vec3& at : {0.5f * (v[e] + v[(e + 1) % 3]), v[e]}) {
+          cross(at + cfg.step * x.n, at - cfg.step * x.n, 5000 + rim);
+          if (HasFatalFailure()) return;
+        }
+        ++rim;
+      }
+    }
+    EXPECT_GT(rim, 200) << mode;
     // Both outcomes and the near-ties were exercised.
     EXPECT_GT(attracted, 100) << mode;
     EXPECT_GT(ties, 200) << mode;
