@@ -8,11 +8,10 @@
 //    (three nodes in four on the bunny). That is asked of an index of the triangles' boxes (swept a
 //    few steps along the normal for the adhesion lookup, and padded past the inside test's
 //    tolerance), traversed along the segment: every triangle the rule can call crossed has a box the
-//    segment passes through, and the rule itself decides. Otherwise every
-//    position the loop can produce stays within the segment's length of the start (mirroring across
-//    a plane the segment crosses never moves the end farther from the start), so a ball query of
-//    that radius gathers a complete candidate set, and his loop over it in index order gives exactly
-//    his result. Embree's own ray-triangle hits could not promise that: its float test differs from
+//    segment passes through, and the rule itself decides. Otherwise every position the loop can
+//    produce stays within the segment's length of the start (mirroring across a plane the segment
+//    crosses never moves the end farther from the start), so a ball query of that radius gathers a
+//    complete candidate set, and his loop over it in index order gives exactly his result. Embree's own ray-triangle hits could not promise that: its float test differs from
 //    Luft's rule along edges. (The Blender collision mode is a ray, because Blender's is.)
 //  * Luft's branching scans every node of every alive root each iteration (quadratic over a run).
 //    The same distribution is drawn without the scan: a node can only branch where its weight
@@ -426,10 +425,9 @@ Grower::Grown Grower::grow_one(const Root& r) const {
 
   bool ok = true;
   if (cfg_.collision_mode == CollisionMode::Luft) {
-    // Pass one of Luft's loop mirrors only at a triangle the segment crosses: those all lie within
-    // half its length of its midpoint. Only if one is crossed does the loop need every triangle the
-    // mirrored ends can reach, all within the segment's length of pos. (The slack covers rounding and
-    // the inside test's tolerance.)
+    // Pass one of Luft's loop mirrors only at a triangle the segment crosses. Only if one is crossed
+    // does the loop need every triangle the mirrored ends can reach, all within the segment's length
+    // of pos. (The slack covers rounding and the inside test's tolerance.)
     if (geometry_.crosses_any(pos, next)) {
       const float len = glm::length(next - pos);
       Candidates reach;
