@@ -14,6 +14,7 @@
 #include <new>
 #include <set>
 #include <sstream>
+#include <thread>
 
 #include <fmt/format.h>
 #include <log4cplus/config.hxx>
@@ -500,7 +501,13 @@ std::unique_ptr<Launcher> start_trial_launcher() {
   // parallel algorithm) is done here once, so each forked trial inherits it instead of paying ~3 ms.
   (void)tbb::info::default_concurrency();
   { tbb::global_control warm(tbb::global_control::max_allowed_parallelism, tbb::info::default_concurrency()); }
+  // The pool's threads are joined, but the kernel counts a joined thread until it has finished
+  // exiting, a moment later (longer on a loaded machine): wait for that, up to a second.
   g_threads_at_fork = process_thread_count();
+  for (int waited_ms = 0; g_threads_at_fork > 1 && waited_ms < 1000; ++waited_ms) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    g_threads_at_fork = process_thread_count();
+  }
   if (g_threads_at_fork != 1)
     fmt::print(stderr, "growbench: warning: {} threads in the suite process before forking trials (expected 1)\n",
                g_threads_at_fork);
