@@ -471,47 +471,57 @@ bool Grower::limits_reached() const {
 
 bool Grower::step() {
   if (limits_reached()) return false;
-  // Grow every alive root by one node (in parallel; each root writes its own slot).
+  // Grow every alive root by one node, in parallel. Root alive_[i] appends node base + i, so each
+  // root writes its own record and its own node slots; only the sums and the compaction of alive_
+  // below are serial, in root order.
   const std::size_t count = alive_.size();
-  grown_.resize(count);
+  const std::size_t base = plant_.nodes.size();
+  plant_.nodes.resize(base + count);
+  adhesion_.resize(base + count);
+  length_.resize(base + count);
+  floating_.resize(base + count);
+  outcome_.resize(count);
   auto grow_range = [&](std::size_t a, std::size_t b) {
-    for (std::size_t i = a; i < b; ++i) grown_[i] = grow_one(roots_[alive_[i]]);
+    for (std::size_t i = a; i < b; ++i) {
+      Root& r = roots_[alive_[i]];
+      const Grown g = grow_one(r);
+      const std::size_t k = base + i;
+      PlantNode& n = plant_.nodes[k];
+      n.position = g.pos;
+      n.parent = static_cast<std::int32_t>(r.nodes.back());
+      n.radius = 1.3f * base_radius(r.depth);
+      n.order = r.depth;
+      n.shoot = r.id;
+      n.birth_step = static_cast<std::uint32_t>(iteration_ + 1);
+      adhesion_[k] = g.adhesion;
+      length_[k] = g.length;
+      floating_[k] = g.floating;
+      outcome_[i] = {glm::length(g.pos - r.tip), g.length, g.reflections, g.climbing, g.floated_out, g.collision_death};
+      r.nodes.push_back(static_cast<std::uint32_t>(k));
+      r.dir = g.dir;
+      r.tip = g.pos;
+      r.tip_length = g.length;
+      r.tip_floating = g.floating;
+      r.hint = g.hint;
+    }
   };
+  // A node costs about a microsecond; small grains keep the two halves of a step even.
   if (count >= 128)
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 32),
                       [&](const tbb::blocked_range<std::size_t>& rg) { grow_range(rg.begin(), rg.end()); });
   else
     grow_range(0, count);
 
-  // Append in root order.
   std::size_t still = 0;
   for (std::size_t i = 0; i < count; ++i) {
-    Root& r = roots_[alive_[i]];
-    const Grown& g = grown_[i];
-    PlantNode n;
-    n.position = g.pos;
-    n.parent = static_cast<std::int32_t>(r.nodes.back());
-    n.radius = 1.3f * base_radius(r.depth);
-    n.order = r.depth;
-    n.shoot = r.id;
-    n.birth_step = static_cast<std::uint32_t>(iteration_ + 1);
-    total_length_ += glm::length(g.pos - r.tip);
-    longest_root_ = std::max(longest_root_, static_cast<double>(g.length));
-    r.nodes.push_back(static_cast<std::uint32_t>(plant_.nodes.size()));
-    plant_.nodes.push_back(n);
-    adhesion_.push_back(g.adhesion);
-    length_.push_back(g.length);
-    floating_.push_back(g.floating);
-    r.dir = g.dir;
-    r.tip = g.pos;
-    r.tip_length = g.length;
-    r.tip_floating = g.floating;
-    r.hint = g.hint;
-    climbing_nodes_ += g.climbing ? 1 : 0;
-    reflections_ += g.reflections;
-    floated_out_ += g.floated_out ? 1 : 0;
-    collision_deaths_ += g.collision_death ? 1 : 0;
-    if (!g.floated_out && !g.collision_death) alive_[still++] = alive_[i];
+    const Outcome& o = outcome_[i];
+    total_length_ += o.segment;
+    longest_root_ = std::max(longest_root_, static_cast<double>(o.length));
+    climbing_nodes_ += o.climbing ? 1 : 0;
+    reflections_ += o.reflections;
+    floated_out_ += o.floated_out ? 1 : 0;
+    collision_deaths_ += o.collision_death ? 1 : 0;
+    if (!o.floated_out && !o.collision_death) alive_[still++] = alive_[i];
   }
   alive_.resize(still);
 

@@ -97,8 +97,9 @@ std::unique_ptr<Geometry> make_embree_geometry(const SceneQuery& query, const Tr
                                                const Config& config);
 
 // Luft's generator: one step() is one of his grow() iterations. Deterministic for any thread count:
-// roots grow in parallel into per-root slots and are appended in root order; every random draw is a
-// pure function of (seed, root, node) or (seed, iteration, root).
+// roots grow in parallel, the i-th alive root writing the step's i-th new node, so nodes are in root
+// order whatever the thread count; every random draw is a pure function of (seed, root, node) or
+// (seed, iteration, root).
 class Grower {
  public:
   Grower(const Scene& scene, const Geometry& geometry, const TriangleTable& table, const Config& config,
@@ -130,6 +131,11 @@ class Grower {
     std::uint32_t reflections, hint;
     bool climbing, floated_out, collision_death;  // the root lives on unless one of the last two
   };
+  struct Outcome {  // what the serial part of a step needs of a grown node
+    float segment, length;
+    std::uint32_t reflections;
+    bool climbing, floated_out, collision_death;
+  };
   [[nodiscard]] float length_at(const Root& r, std::size_t k) const { return k == 0 ? 0.0f : length_[r.nodes[k]]; }
   [[nodiscard]] float floating_at(const Root& r, std::size_t k) const {
     return k == 0 ? r.first_floating : floating_[r.nodes[k]];
@@ -153,7 +159,7 @@ class Grower {
   std::vector<float> length_, floating_;
   std::vector<Root> roots_;
   std::vector<std::uint32_t> alive_;  // alive root indices, ascending (the only record of which live)
-  std::vector<Grown> grown_;          // per-iteration slots (reused)
+  std::vector<Outcome> outcome_;      // per-iteration slots (reused)
   int iteration_ = 0;
   double total_length_ = 0.0, longest_root_ = 0.0;
   std::size_t pending_seeds_ = 0;
