@@ -142,6 +142,8 @@ glm::vec3 cube(Rng& rng) {
 // are small and overlap little, so the traversal is cheap, and a target found there no farther than
 // that height is final (any triangle that could beat or tie it is that close too, so its short prism
 // holds p). On the bunny 79% of nodes end there (measured at two steps); the rest ask the full index.
+// A node whose segment crossed nothing got this lookup from the crossing test, whose traversal of the
+// same index passed every box that holds the segment's end (crosses_any).
 // Closest mode keeps growing balls around the previous target (the true closest point is found at
 // once when the root clings, and there is no rule under which nothing near counts).
 class EmbreeGeometry final : public ivy::Geometry {
@@ -196,29 +198,40 @@ class EmbreeGeometry final : public ivy::Geometry {
     query_.visit_near(centre, radius, &EmbreeGeometry::gather_visit, &st);
   }
 
-  bool crosses_any(const glm::vec3& o, const glm::vec3& q) const override {
-    Segment st{&table_, o, q};
+  bool crosses_any(const glm::vec3& o, const glm::vec3& q, ivy::Lookahead& at_q) const override {
+    Segment st{o, q, {this, {q, cfg_.max_adhesion, true}}};
     near_->visit_segment(o, q - o, &EmbreeGeometry::cross_visit, &st);
-    return st.crossed;
+    if (st.crossed || short_height_ <= 0.0f) return st.crossed;
+    // Nothing crossed, so the traversal went the whole way, through every box that holds q: the
+    // search at q saw all that the short lookup would offer (and some more, which the exact rule
+    // judges anyway). Finish it as adhesion(q) would.
+    const ivy::AdhesionSearch& s = st.at_q.search;
+    if (s.best_id == ivy::kNoTriangle || s.reject_beyond() > short_height_)
+      prisms_->visit_containing(q, &EmbreeGeometry::prism_visit, &st.at_q);
+    at_q = {s.vector(), s.best_id, true};
+    return false;
   }
 
   RayHit first_hit(const glm::vec3& o, const glm::vec3& d) const override { return query_.ray(o, d, 1.0f, 0.0f); }
 
  private:
-  struct Segment {
-    const ivy::TriangleTable* table;
-    glm::vec3 o, q;
-    bool crossed = false;
-  };
-  static bool cross_visit(void* user, std::uint32_t id) {
-    auto& st = *static_cast<Segment*>(user);
-    st.crossed = ivy::crosses(st.table->tris[id], st.o, st.q);
-    return st.crossed;
-  }
   struct State {
     const EmbreeGeometry* self;
     ivy::AdhesionSearch search;
   };
+  struct Segment {
+    glm::vec3 o, q;
+    State at_q;  // Luft's adhesion at q, over the boxes passed
+    bool crossed = false;
+  };
+  static bool cross_visit(void* user, std::uint32_t id) {
+    auto& st = *static_cast<Segment*>(user);
+    const EmbreeGeometry& self = *st.at_q.self;
+    const ivy::Triangle& t = self.table_.tris[id];
+    st.crossed = ivy::crosses(t, st.o, st.q);
+    if (!st.crossed && self.short_height_ > 0.0f) st.at_q.search.offer(t, id, geom::closest_point_on_triangle);
+    return st.crossed;
+  }
   static void visit(void* user, std::uint32_t mesh, std::uint32_t tri, float* radius) {
     auto& st = *static_cast<State*>(user);
     const auto& table = st.self->table_;
@@ -417,7 +430,7 @@ Grower::Grown Grower::grow_one(const Root& r) const {
   random = rl > 0.0f ? random / rl : kUp;
 
   const float fall = cfg_.gravity * std::pow(floating / cfg_.max_float, 0.7f);
-  const glm::vec3 adhesion = geometry_.adhesion(pos, g.hint);
+  const glm::vec3 adhesion = r.ahead_valid ? r.ahead : geometry_.adhesion(pos, g.hint);
 
   glm::vec3 grow = cfg_.step * (r.dir * cfg_.primary + random * cfg_.random + adhesion * cfg_.adhesion);
   const glm::vec3 gravity = cfg_.step * fall * glm::vec3(0.0f, -1.0f, 0.0f);
@@ -428,7 +441,7 @@ Grower::Grown Grower::grow_one(const Root& r) const {
     // Pass one of Luft's loop mirrors only at a triangle the segment crosses. Only if one is crossed
     // does the loop need every triangle the mirrored ends can reach, all within the segment's length
     // of pos. (The slack covers rounding and the inside test's tolerance.)
-    if (geometry_.crosses_any(pos, next)) {
+    if (geometry_.crosses_any(pos, next, g.ahead)) {
       const float len = glm::length(next - pos);
       Candidates reach;
       geometry_.gather(pos, len * (1.0f + 1e-3f) + cfg_.margin, reach);
@@ -502,7 +515,9 @@ bool Grower::step() {
       r.tip = g.pos;
       r.tip_length = g.length;
       r.tip_floating = g.floating;
-      r.hint = g.hint;
+      r.hint = g.ahead.valid ? g.ahead.hint : g.hint;
+      r.ahead = g.ahead.vector;
+      r.ahead_valid = g.ahead.valid;
     }
   };
   // A node costs about a microsecond; small grains keep the two halves of a step even.

@@ -75,6 +75,13 @@ class Candidates {
   std::size_t n_ = 0;
 };
 
+// An adhesion answer computed ahead of its node (see Geometry::crosses_any).
+struct Lookahead {
+  glm::vec3 vector{0.0f};
+  std::uint32_t hint = kNoTriangle;
+  bool valid = false;
+};
+
 // The scene queries the growth needs; the Embree implementation is make_embree_geometry, the tests
 // add a brute-force one over all triangles.
 class Geometry {
@@ -88,7 +95,9 @@ class Geometry {
   // `candidates`, for the Luft collision test.
   virtual void gather(const glm::vec3& centre, float radius, Candidates& candidates) const = 0;
   // Whether Luft's collision rule finds any triangle that the segment o -> q crosses (entering it).
-  virtual bool crosses_any(const glm::vec3& o, const glm::vec3& q) const = 0;
+  // When none is, an implementation may also settle adhesion(q) on the way (at_q.valid): exactly
+  // what adhesion(q, hint) would return and leave in hint.
+  virtual bool crosses_any(const glm::vec3& o, const glm::vec3& q, Lookahead& at_q) const = 0;
   // Blender's collision: the first hit on the segment o -> o + d (t in [0, 1]), any side.
   virtual RayHit first_hit(const glm::vec3& o, const glm::vec3& d) const = 0;
 };
@@ -123,6 +132,10 @@ class Grower {
     float tip_length = 0.0f, tip_floating = 0.0f;
     std::uint32_t hint = kNoTriangle;  // the triangle that attracted the tip
     std::uint32_t id = 0;
+    // The adhesion at the tip when the previous node's crossing test settled it (a valid ahead
+    // carries its hint in `hint`).
+    glm::vec3 ahead{0.0f};
+    bool ahead_valid = false;
     std::uint16_t depth = 0;
   };
   struct Grown {
@@ -130,6 +143,7 @@ class Grower {
     float length, floating;
     std::uint32_t reflections, hint;
     bool climbing, floated_out, collision_death;  // the root lives on unless one of the last two
+    Lookahead ahead;                              // the adhesion at pos, when already known
   };
   struct Outcome {  // what the serial part of a step needs of a grown node
     float segment, length;

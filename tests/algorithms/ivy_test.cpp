@@ -163,7 +163,7 @@ class BruteForceGeometry final : public ivy::Geometry {
   void gather(const glm::vec3&, float, ivy::Candidates& candidates) const override {
     for (std::uint32_t id = 0; id < t_.size(); ++id) candidates.push(id);  // every triangle, as Luft
   }
-  bool crosses_any(const glm::vec3& o, const glm::vec3& q) const override {
+  bool crosses_any(const glm::vec3& o, const glm::vec3& q, ivy::Lookahead&) const override {
     for (const auto& t : t_.tris)
       if (ivy::crosses(t, o, q)) return true;
     return false;
@@ -278,11 +278,20 @@ TEST(IvyReference, EmbreeAdhesionEqualsBruteForceOnTheBunny) {
     };
     // Luft's collision question, whether the segment crosses any triangle, as the box index answers it
     // and as the loop over every triangle does.
-    int crossed = 0, clear = 0;
+    int crossed = 0, clear = 0, settled = 0;
     auto cross = [&](const glm::vec3& o, const glm::vec3& q, int i) {
-      const bool want = slow.crosses_any(o, q);
-      ASSERT_EQ(fast->crosses_any(o, q), want) << mode << " segment " << i;
+      ivy::Lookahead none_ahead, ahead;
+      const bool want = slow.crosses_any(o, q, none_ahead);
+      ASSERT_EQ(fast->crosses_any(o, q, ahead), want) << mode << " segment " << i;
       (want ? crossed : clear) += 1;
+      // A clear segment may settle the adhesion at its end on the way: then it is adhesion(q)'s.
+      ASSERT_FALSE(want && ahead.valid) << mode << " segment " << i;
+      if (ahead.valid) {
+        std::uint32_t hint = ivy::kNoTriangle;
+        ASSERT_EQ(ahead.vector, slow.adhesion(q, hint)) << mode << " segment " << i;
+        ASSERT_EQ(ahead.hint, hint) << mode << " segment " << i;
+        ++settled;
+      }
     };
     for (int i = 0; i < 300; ++i) {
       const SurfaceSample s = query.sample_surface(11, static_cast<std::uint64_t>(i));
@@ -339,6 +348,9 @@ TEST(IvyReference, EmbreeAdhesionEqualsBruteForceOnTheBunny) {
     EXPECT_GT(clear, 150) << mode;
     if (std::string(mode) == "luft") {
       EXPECT_GT(none, 20) << mode;
+      EXPECT_EQ(settled, clear) << "every clear segment settles the adhesion at its end in luft mode";
+    } else {
+      EXPECT_EQ(settled, 0) << "closest adhesion is never settled by the crossing test";
     }
   }
 }
