@@ -482,6 +482,17 @@ bool Grower::limits_reached() const {
          (cfg_.max_total_length > 0.0 && total_length_ >= cfg_.max_total_length);
 }
 
+namespace {
+// Resizes v to n, growing its capacity by half when it must grow: the per-node arrays then hold at
+// most 1.5x their nodes (doubling, as push_back and resize do, left up to 2x: ~112 bytes per node
+// just past a power of two, against the 100 the issue allows).
+template <class T>
+void grow_by_half(std::vector<T>& v, std::size_t n) {
+  if (n > v.capacity()) v.reserve(std::max(n, v.capacity() + v.capacity() / 2));
+  v.resize(n);
+}
+}  // namespace
+
 bool Grower::step() {
   if (limits_reached()) return false;
   // Grow every alive root by one node, in parallel. Root alive_[i] appends node base + i, so each
@@ -489,10 +500,10 @@ bool Grower::step() {
   // below are serial, in root order.
   const std::size_t count = alive_.size();
   const std::size_t base = plant_.nodes.size();
-  plant_.nodes.resize(base + count);
-  adhesion_.resize(base + count);
-  length_.resize(base + count);
-  floating_.resize(base + count);
+  grow_by_half(plant_.nodes, base + count);
+  grow_by_half(adhesion_, base + count);
+  grow_by_half(length_, base + count);
+  grow_by_half(floating_, base + count);
   outcome_.resize(count);
   auto grow_range = [&](std::size_t a, std::size_t b) {
     for (std::size_t i = a; i < b; ++i) {
