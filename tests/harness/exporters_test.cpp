@@ -1,10 +1,13 @@
 #include "harness/exporters.hpp"
 
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <sstream>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 #include <tiny_gltf.h>
 #include <tiny_obj_loader.h>
 
@@ -79,6 +82,42 @@ TEST(Mesher, CustomLeafFromObj) {
   EXPECT_NE(message(flat).find("no length along z"), std::string::npos) << message(flat);
   const std::string empty = test::write_text(dir / "empty.obj", "v 0 0 0\n");
   EXPECT_NE(message(empty).find("empty.obj: the OBJ file has no faces"), std::string::npos) << message(empty);
+}
+
+// Large enough for the parallel formatting (chunks of 8192 records): the file must be exactly what a
+// serial loop writes, on one thread and on all of them.
+TEST(Exporters, LargeObjIsTheSerialTextOnAnyThreadCount) {
+  OutputMesh m;
+  for (std::uint32_t i = 0; i < 20000; ++i) {
+    m.positions.emplace_back(0.001f * static_cast<float>(i), std::sin(static_cast<float>(i)), -1e-7f * static_cast<float>(i));
+    m.normals.push_back(glm::normalize(glm::vec3(1.0f, std::cos(static_cast<float>(i)), 0.5f)));
+  }
+  for (std::uint32_t t = 0; t < 30001; ++t) m.triangles.emplace_back(t % 20000, (7 * t + 1) % 20000, (13 * t + 2) % 20000);
+  m.groups = {{"branches", "bark", 0, 17000}, {"leaves", "leaf", 17000, 13001}};
+  std::string expected = "# growbench plant: 20000 vertices, 30001 triangles\nmtllib plant.mtl\n";
+  for (const auto& v : m.positions) expected += fmt::format("v {:.6g} {:.6g} {:.6g}\n", v.x, v.y, v.z);
+  for (const auto& n : m.normals) expected += fmt::format("vn {:.4f} {:.4f} {:.4f}\n", n.x, n.y, n.z);
+  for (const auto& g : m.groups) {
+    expected += fmt::format("g {}\nusemtl {}\n", g.name, g.material);
+    for (std::uint32_t t = g.first_triangle; t < g.first_triangle + g.triangle_count; ++t) {
+      const glm::uvec3 f = m.triangles[t] + glm::uvec3(1);
+      expected += fmt::format("f {0}//{0} {1}//{1} {2}//{2}\n", f.x, f.y, f.z);
+    }
+  }
+  const auto dir = test::temp_dir("large_obj");
+  auto read = [](const std::filesystem::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  };
+  for (const int threads : {1, 2, 4}) {
+    const auto path = dir / fmt::format("t{}", threads) / "plant.obj";
+    std::filesystem::create_directories(path.parent_path());
+    tbb::task_arena(threads).execute([&] { write_obj(path.string(), m); });
+    const std::string text = read(path);
+    EXPECT_EQ(text.size(), expected.size()) << threads << " threads";
+    EXPECT_TRUE(text == expected) << threads << " threads";
+    EXPECT_FALSE(std::filesystem::exists(path.string() + ".tmp"));
+  }
 }
 
 TEST(Exporters, ObjReadsBackWithGroupsAndMaterials) {
