@@ -1,5 +1,8 @@
 #include "harness/metrics.hpp"
 
+#include <algorithm>
+#include <random>
+
 #include <gtest/gtest.h>
 #include <glm/gtc/quaternion.hpp>
 
@@ -92,6 +95,73 @@ TEST(Metrics, SelfIntersectionOfCrossingBranches) {
   EXPECT_EQ(m["self_intersections"], 0);
   // A straight chain never intersects itself (neighbours are excluded even at a thick radius).
   EXPECT_EQ(compute_metrics(chain({{0, 0, 0}, {0, 0.01f, 0}, {0, 0.02f, 0}, {0, 0.03f, 0}}, 0.5f), q)["self_intersections"], 0);
+}
+
+// A tangle with thin and thick segments of mixed lengths, and leaves of mixed sizes: the kd-tree searches
+// (each pair judged once, from its larger side; the first overlapping leaf ends a search) must count
+// exactly what comparing every pair counts.
+TEST(Metrics, SelfIntersectionAndLeafOverlapMatchAllPairs) {
+  const Scene s = scene_with(unit_quad());
+  SceneQuery q(s, {.build_sdf = false});
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  Plant p;
+  p.nodes.push_back({{0.5f, 0.5f, 0.5f}, 0.01f, kNoParent, 0, 0, 0});
+  for (int i = 1; i < 700; ++i) {
+    const auto parent = static_cast<std::int32_t>(u(rng) * static_cast<float>(i)) % i;
+    const glm::vec3 dir = glm::normalize(glm::vec3(u(rng) - 0.5f, u(rng) - 0.5f, u(rng) - 0.5f) + glm::vec3(1e-3f));
+    const float len = u(rng) < 0.1f ? 0.25f : 0.02f + 0.05f * u(rng);
+    const float r = u(rng) < 0.05f ? 0.06f : 0.001f + 0.004f * u(rng);
+    glm::vec3 pos = glm::clamp(p.nodes[static_cast<std::size_t>(parent)].position + len * dir, glm::vec3(0.0f), glm::vec3(1.0f));
+    p.nodes.push_back({pos, r, parent, 0, 0, 0});
+  }
+  const glm::quat up(1, 0, 0, 0);
+  for (int i = 0; i < 400; ++i)
+    p.organs.push_back({{u(rng), u(rng), u(rng)}, up, u(rng) < 0.1f ? 0.3f : 0.01f + 0.03f * u(rng), OrganKind::Leaf, 0});
+
+  const auto& n = p.nodes;
+  auto up_of = [&](std::int32_t v) { return v == kNoParent ? kNoParent : n[static_cast<std::size_t>(v)].parent; };
+  auto neighbours = [&](std::int32_t x, std::int32_t y) {
+    const std::int32_t X[3] = {x, up_of(x), up_of(up_of(x))}, Y[3] = {y, up_of(y), up_of(up_of(y))};
+    for (const auto a : X)
+      for (const auto b : Y)
+        if (a != kNoParent && a == b) return true;
+    return false;
+  };
+  std::size_t pairs = 0;
+  std::vector<int> involved(n.size(), 0);
+  for (std::int32_t k = 1; k < static_cast<std::int32_t>(n.size()); ++k)
+    for (std::int32_t l = k + 1; l < static_cast<std::int32_t>(n.size()); ++l) {
+      if (neighbours(k, l)) continue;
+      const auto& a = n[static_cast<std::size_t>(k)];
+      const auto& b = n[static_cast<std::size_t>(l)];
+      const float d = segment_distance(n[static_cast<std::size_t>(a.parent)].position, a.position,
+                                       n[static_cast<std::size_t>(b.parent)].position, b.position);
+      if (d < a.radius + b.radius) {
+        ++pairs;
+        involved[static_cast<std::size_t>(k)] = involved[static_cast<std::size_t>(l)] = 1;
+      }
+    }
+  std::size_t overlapping = 0;
+  for (std::size_t i = 0; i < p.organs.size(); ++i)
+    for (std::size_t j = 0; j < p.organs.size(); ++j) {
+      const auto& a = p.organs[i];
+      const auto& b = p.organs[j];
+      const glm::vec3 ca = a.position + 0.5f * a.size * glm::vec3(0, 0, 1), cb = b.position + 0.5f * b.size * glm::vec3(0, 0, 1);
+      if (i != j && glm::length(ca - cb) < 0.5f * (a.size + b.size)) {
+        ++overlapping;
+        break;
+      }
+    }
+  ASSERT_GT(pairs, 20u);  // the tangle does cross itself, thick and thin
+  ASSERT_GT(overlapping, 20u);
+  ASSERT_LT(overlapping, p.organs.size());
+
+  const auto m = compute_metrics(p, q);
+  EXPECT_EQ(m["self_intersections"], pairs);
+  EXPECT_NEAR(m["self_intersection_fraction"].get<double>(),
+              static_cast<double>(std::count(involved.begin(), involved.end(), 1)) / static_cast<double>(n.size() - 1), 1e-12);
+  EXPECT_NEAR(m["leaf_overlap"].get<double>(), static_cast<double>(overlapping) / static_cast<double>(p.organs.size()), 1e-12);
 }
 
 TEST(Metrics, LeafOverlapAndLightExposure) {
