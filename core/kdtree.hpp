@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -27,5 +28,23 @@ struct Vec3Cloud {
 using Vec3Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Vec3Cloud>, Vec3Cloud, 3, std::uint32_t>;
 using Vec3DynamicTree =
     nanoflann::KDTreeSingleIndexDynamicAdaptor<nanoflann::L2_Simple_Adaptor<float, Vec3Cloud>, Vec3Cloud, 3, std::uint32_t>;
+
+// Visits the points of `tree` closer than `radius` to `centre`: visit(index, d2) gets each with its
+// squared distance as nanoflann computes it, in the tree's order, and returns false to end the search.
+// Nothing is listed, so a search allocates nothing.
+template <class Visit>
+struct KdVisitor {
+  float radius2;
+  Visit visit;
+  [[nodiscard]] float worstDist() const { return radius2; }
+  [[nodiscard]] bool full() const { return true; }
+  [[nodiscard]] std::size_t size() const { return 0; }
+  bool addPoint(float d2, std::uint32_t i) { return visit(i, d2); }
+};
+template <class Tree, class Visit>
+void kd_visit_within(const Tree& tree, const glm::vec3& centre, float radius, Visit visit) {
+  KdVisitor<Visit> v{radius * radius, std::move(visit)};
+  tree.radiusSearchCustomCallback(&centre.x, v, nanoflann::SearchParams(32, 0.0f, false));
+}
 
 }  // namespace growbench

@@ -31,26 +31,6 @@ double quantile(std::vector<float> v, double q) {
   return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
 }
 
-// Visits the points of a nanoflann tree closer than `radius` to a point: visit(index, d2) gets each one with
-// its squared distance as nanoflann computes it, and returns false to end the search. Nothing is listed,
-// so a search allocates nothing (a result list per query cost ~8.5M allocations and 9 GB for the wall's
-// 416k-node ivy), and the phase's allocation count is the same from run to run.
-template <class Visit>
-struct Visitor {
-  float radius2;
-  Visit visit;
-  [[nodiscard]] float worstDist() const { return radius2; }
-  [[nodiscard]] bool full() const { return true; }
-  [[nodiscard]] std::size_t size() const { return 0; }
-  bool addPoint(float d2, std::uint32_t j) { return visit(j, d2); }
-};
-
-template <class Visit>
-void visit_within(const Tree& tree, const glm::vec3& centre, float radius, Visit visit) {
-  Visitor<Visit> v{radius * radius, std::move(visit)};
-  tree.radiusSearchCustomCallback(&centre.x, v, nanoflann::SearchParams(32, 0.0f, false));
-}
-
 }  // namespace
 
 float segment_distance(const glm::vec3& p1, const glm::vec3& q1, const glm::vec3& p2, const glm::vec3& q2) {
@@ -118,13 +98,19 @@ nlohmann::json compute_metrics(const Plant& plant, const SceneQuery& query, cons
   m["bbox_max"] = {hi.x, hi.y, hi.z};
 
   // Segment midpoints in a kd-tree: exact point-segment and segment-segment distances near them.
+  // A segment's reach: its half length plus its radius.
   std::vector<glm::vec3> mid(seg.size());
+  std::vector<float> reach(seg.size());
   float max_half = 0.0f;
   for (std::size_t k = 0; k < seg.size(); ++k) {
     const glm::vec3 a = a_of(seg[k]), b = nodes[seg[k]].position;
+    const float half = 0.5f * glm::length(b - a);
     mid[k] = 0.5f * (a + b);
-    max_half = std::max(max_half, 0.5f * glm::length(b - a));
+    max_half = std::max(max_half, half);
+    reach[k] = half + nodes[seg[k]].radius;
   }
+  // Searches visit candidates in place (kd_visit_within): a result list per query cost ~8.5M allocations
+  // (9 GB) on the wall's 416k-node ivy, and this phase's allocation count must repeat run to run.
   PointsAdaptor adaptor{&mid};
   std::unique_ptr<Tree> tree;
   if (!seg.empty()) tree = std::make_unique<Tree>(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16));
@@ -135,7 +121,7 @@ nlohmann::json compute_metrics(const Plant& plant, const SceneQuery& query, cons
   if (tree) {
     tbb::parallel_for(0, ns, [&](int i) {
       const glm::vec3 p = query.sample_surface(o.coverage_seed, static_cast<std::uint64_t>(i)).position;
-      visit_within(*tree, p, o.coverage_distance + max_half, [&](std::uint32_t k, float) {
+      kd_visit_within(*tree, p, o.coverage_distance + max_half, [&](std::uint32_t k, float) {
         if (point_segment_distance(p, a_of(seg[k]), nodes[seg[k]].position) > o.coverage_distance) return true;
         covered[static_cast<std::size_t>(i)] = 1;
         return false;
@@ -197,16 +183,13 @@ nlohmann::json compute_metrics(const Plant& plant, const SceneQuery& query, cons
   // the lower index): a pair can only meet within the sum of the two reaches, at most twice the larger
   // one. Searching with the plant's largest radius and half length instead made every thin segment near
   // a thick stem visit hundreds of candidates.
-  std::vector<float> reach(seg.size());
-  for (std::size_t k = 0; k < seg.size(); ++k)
-    reach[k] = 0.5f * glm::length(nodes[seg[k]].position - a_of(seg[k])) + nodes[seg[k]].radius;
   auto judged_from = [&](std::size_t k, std::size_t l) { return reach[l] < reach[k] || (reach[l] == reach[k] && l > k); };
   std::vector<std::uint32_t> pairs_of(seg.size(), 0);
   std::vector<std::atomic<std::uint8_t>> involved(seg.size());  // zero-initialised; set from either side
   if (tree) {
     tbb::parallel_for(std::size_t{0}, seg.size(), [&](std::size_t k) {
       const glm::vec3 a = a_of(seg[k]), b = nodes[seg[k]].position;
-      visit_within(*tree, mid[k], 2.0f * reach[k] * (1.0f + 1e-4f), [&](std::uint32_t l, float) {
+      kd_visit_within(*tree, mid[k], 2.0f * reach[k] * (1.0f + 1e-4f), [&](std::uint32_t l, float) {
         if (!judged_from(k, l) || neighbours(seg[k], seg[l])) return true;
         // Always the lower index first, so a pair's verdict does not depend on the side judging it.
         const float d = k < l ? segment_distance(a, b, a_of(seg[l]), nodes[seg[l]].position)
@@ -248,7 +231,7 @@ nlohmann::json compute_metrics(const Plant& plant, const SceneQuery& query, cons
       const float r = radius[i] + rmax;
       // Stops at the first overlapping disc: dense foliage (the wall's ivy has ~230 leaf centres within
       // reach of each leaf) would otherwise list every candidate only to learn one thing.
-      visit_within(leaf_tree, centre[i], r, [&](std::uint32_t j, float d2) {
+      kd_visit_within(leaf_tree, centre[i], r, [&](std::uint32_t j, float d2) {
         if (j == i || std::sqrt(d2) >= radius[i] + radius[j]) return true;
         overlap[i] = 1;
         return false;

@@ -161,17 +161,9 @@ class EmbreeGeometry final : public ivy::Geometry {
 
   glm::vec3 adhesion(const glm::vec3& p, std::uint32_t& hint) const override {
     State st{this, {p, cfg_.max_adhesion, cfg_.adhesion_mode == ivy::AdhesionMode::Luft}};
-    if (short_height_ > 0.0f) {
-      near_->visit_containing(p, &EmbreeGeometry::prism_visit, &st);
-      if (st.search.best_id != ivy::kNoTriangle && st.search.reject_beyond() <= short_height_) {
-        hint = st.search.best_id;
-        return st.search.vector();
-      }
-    }
     if (prisms_) {
-      prisms_->visit_containing(p, &EmbreeGeometry::prism_visit, &st);
-      hint = st.search.best_id;
-      return st.search.vector();
+      if (short_height_ > 0.0f) near_->visit_containing(p, &EmbreeGeometry::prism_visit, &st);
+      return finish_luft(p, st, hint);
     }
     // A clinging root's next target is usually the same triangle: offered first, its distance bounds
     // the traversal from the start. The visit offers it again; ties resolve the same either way.
@@ -205,10 +197,8 @@ class EmbreeGeometry final : public ivy::Geometry {
     // Nothing crossed, so the traversal went the whole way, through every box that holds q: the
     // search at q saw all that the short lookup would offer (and some more, which the exact rule
     // judges anyway). Finish it as adhesion(q) would.
-    const ivy::AdhesionSearch& s = st.at_q.search;
-    if (s.best_id == ivy::kNoTriangle || s.reject_beyond() > short_height_)
-      prisms_->visit_containing(q, &EmbreeGeometry::prism_visit, &st.at_q);
-    at_q = {s.vector(), s.best_id, true};
+    at_q.vector = finish_luft(q, st.at_q, at_q.hint);
+    at_q.valid = true;
     return false;
   }
 
@@ -224,6 +214,15 @@ class EmbreeGeometry final : public ivy::Geometry {
     State at_q;  // Luft's adhesion at q, over the boxes passed
     bool crossed = false;
   };
+  // Luft's adhesion at p from a search that has seen the short-prism boxes holding p (or nothing, when
+  // there is no short index): a target no farther than the short height is final; else the full
+  // prisms decide.
+  glm::vec3 finish_luft(const glm::vec3& p, State& st, std::uint32_t& hint) const {
+    if (st.search.best_id == ivy::kNoTriangle || st.search.reject_beyond() > short_height_)
+      prisms_->visit_containing(p, &EmbreeGeometry::prism_visit, &st);
+    hint = st.search.best_id;
+    return st.search.vector();
+  }
   static bool cross_visit(void* user, std::uint32_t id) {
     auto& st = *static_cast<Segment*>(user);
     const EmbreeGeometry& self = *st.at_q.self;
