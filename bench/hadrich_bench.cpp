@@ -33,7 +33,7 @@ Grown& grown(std::size_t particles, int which, std::size_t threads) {
     if (which == 0) {
       g.scene = load_scene("wall", {"width=12", "height=6", fmt::format("seeds={}", std::max<std::size_t>(3, particles / 2500))});
     } else {
-      g.scene = load_scene("mesh:" GROWBENCH_SHARED_DIR "/meshes/stanford-bunny.obj");
+      g.scene = load_scene("mesh:stanford-bunny");
     }
     g.query = std::make_unique<SceneQuery>(g.scene);
     if (which == 1) {

@@ -25,7 +25,7 @@ IvyScene& ivy_scene(int which) {
   static IvyScene scenes[2];
   IvyScene& s = scenes[which];
   if (!s.query) {
-    s.scene = which == 0 ? load_scene("wall") : load_scene("mesh:" GROWBENCH_SHARED_DIR "/meshes/stanford-bunny.obj");
+    s.scene = which == 0 ? load_scene("wall") : load_scene("mesh:stanford-bunny");
     s.query = std::make_unique<SceneQuery>(s.scene, SceneQueryOptions{.build_sdf = false});
     if (which == 1) s.scene.seeds = {{s.query->closest_point({0.0f, 0.8f, 1.0f}).point, {0, 1, 0}, 0}};
     s.table = std::make_unique<ivy::TriangleTable>(s.scene);

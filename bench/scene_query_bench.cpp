@@ -10,7 +10,7 @@ namespace growbench {
 namespace {
 
 struct Bunny {
-  Scene scene = load_scene("mesh:" GROWBENCH_SHARED_DIR "/meshes/stanford-bunny.obj");
+  Scene scene = load_scene("mesh:stanford-bunny");
   SceneQuery query{scene};
   std::vector<glm::vec3> pts;
   Bunny() {
@@ -55,7 +55,7 @@ void BM_SignedDistance(benchmark::State& state) {
 BENCHMARK(BM_SignedDistance);
 
 void BM_QueryBuild(benchmark::State& state) {
-  const Scene s = load_scene("mesh:" GROWBENCH_SHARED_DIR "/meshes/stanford-bunny.obj");
+  const Scene s = load_scene("mesh:stanford-bunny");
   for (auto _ : state) {
     SceneQuery q(s);
     benchmark::DoNotOptimize(q.voxel_size());

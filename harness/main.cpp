@@ -61,7 +61,8 @@ int main(int argc, char** argv) {
   std::string sides_help = "tube sides of the branch mesh (3..64)";
   run->add_option("-a,--algorithm", spec.algorithm, "algorithm name (see `growbench list`)")->required();
   run->add_option("-s,--scene", spec.scene,
-                  "scene: a standard scene's name (see `growbench scenes`), a scene file *.json, or mesh:PATH.obj")
+                  "scene: a standard scene's name (see `growbench scenes`), a scene file *.json, mesh:PATH.obj, or mesh:NAME "
+                  "for a bundled mesh (e.g. mesh:stanford-bunny)")
       ->required();
   run->add_option("--scene-param", spec.scene_params, "scene parameter key=value (repeatable)");
   run->add_option("--seed", spec.seed, "random seed")->default_val(1);
@@ -244,8 +245,10 @@ int main(int argc, char** argv) {
         fmt::print("{}\n  {}\n", s.name, s.summary);
         print_param_table(s.params);
       }
-      fmt::print("mesh:PATH.obj\n  any OBJ file; fitted to the standard size unless size=0; one seed at its lowest vertex "
-                 "(or --seed-at)\n");
+      fmt::print("mesh:PATH.obj or mesh:NAME\n  any OBJ file, or a mesh the repository carries ({}); fitted to the "
+                 "standard size unless size=0, on a ground slab unless ground=false; one seed at the foot of its lit "
+                 "side (or --seed-at)\n",
+                 fmt::join(gb::bundled_meshes(), ", "));
       print_param_table(gb::mesh_scene_params());
       fmt::print("FILE.json\n  a scene file (schema_version 1): meshes, seeds, light, envelope, zones, camera; see "
                  "scenes/README.md\n");

@@ -55,9 +55,9 @@ class SuiteReader : public JsonPathReader {
     const fs::path p(path);
     return (p.is_absolute() ? p : dir_ / p).lexically_normal().string();
   }
-  // Scene specs in suites: mesh:PATH and *.json are relative to the suite file.
+  // Scene specs in suites: mesh:PATH and *.json are relative to the suite file (mesh:NAME is a bundled mesh).
   std::string scene_spec(const std::string& spec) const {
-    if (spec.rfind("mesh:", 0) == 0) return "mesh:" + relative_to_suite(spec.substr(5));
+    if (spec.rfind("mesh:", 0) == 0 && !is_mesh_name(spec.substr(5))) return "mesh:" + relative_to_suite(spec.substr(5));
     if (spec.size() > 5 && spec.substr(spec.size() - 5) == ".json") return relative_to_suite(spec);
     return spec;
   }

@@ -1,5 +1,5 @@
 // Loading scenes: standard scenes by name, scene JSON files (validated, errors name the JSON path),
-// and OBJ meshes as scenes (mesh:PATH).
+// and OBJ meshes as scenes (mesh:PATH, or mesh:NAME for a mesh the repository carries).
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -17,6 +17,31 @@
 namespace growbench {
 namespace fs = std::filesystem;
 using nlohmann::json;
+
+bool is_mesh_name(const std::string& ref) {
+  return !ref.empty() && ref.find('/') == std::string::npos && !fs::path(ref).has_extension();
+}
+
+std::vector<std::string> bundled_meshes() {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(GROWBENCH_MESH_DIR, ec))
+    if (e.path().extension() == ".obj") names.push_back(e.path().stem().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+std::string mesh_path(const std::string& ref) {
+  if (!is_mesh_name(ref)) return ref;
+  const fs::path p = fs::path(GROWBENCH_MESH_DIR) / (ref + ".obj");
+  if (fs::exists(p)) return p.string();
+  const std::vector<std::string> names = bundled_meshes();
+  const std::string near = closest_match(ref, names);
+  throw InputError(fmt::format("unknown mesh '{}'{}; expected a bundled mesh ({}) or a path to an OBJ file", ref,
+                               near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near),
+                               names.empty() ? fmt::format("none found in {}", GROWBENCH_MESH_DIR)
+                                             : fmt::format("{}", fmt::join(names, ", "))));
+}
 
 TriangleMesh load_obj(const std::string& path) {
   if (!fs::exists(path)) throw InputError(fmt::format("{}: no such file", path));
@@ -168,7 +193,9 @@ class JsonScene : public JsonPathReader {
     if (!j.is_string()) fail(path, fmt::format("expected a string, got {}", j.dump()));
     return j.get<std::string>();
   }
+  // A path in the scene file, relative to the file; a bundled mesh's name stays a name.
   std::string resolve(const std::string& rel) const {
+    if (is_mesh_name(rel)) return mesh_path(rel);
     const fs::path p(rel);
     return (p.is_absolute() ? p : dir_ / p).string();
   }
@@ -286,7 +313,7 @@ class JsonScene : public JsonPathReader {
           params.push_back(k + "=" + (v.is_string() ? v.get<std::string>() : v.dump()));
       }
       std::string base = string(j["base"], "/base");
-      if (base.rfind("mesh:", 0) == 0) base = "mesh:" + resolve(base.substr(5));
+      if (base.rfind("mesh:", 0) == 0 && !is_mesh_name(base.substr(5))) base = "mesh:" + resolve(base.substr(5));
       try {
         s = load_scene(base, params);
       } catch (const InputError& e) {
@@ -383,7 +410,7 @@ Scene json_scene(const std::string& path) {
 Scene load_scene(const std::string& spec, const std::vector<std::string>& assignments) {
   Scene s;
   if (spec.rfind("mesh:", 0) == 0) {
-    const std::string path = spec.substr(5);
+    const std::string path = mesh_path(spec.substr(5));
     Params p(fmt::format("scene '{}'", spec), mesh_scene_params());
     for (const auto& a : assignments) p.set_assignment(a);
     s = mesh_scene(path, p);

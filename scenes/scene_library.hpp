@@ -21,7 +21,16 @@ const std::vector<StandardScene>& standard_scenes();
 // Parameters of `mesh:PATH` scenes (size, ground).
 const std::vector<ParamSpec>& mesh_scene_params();
 
-// Loads a scene from a spec: a standard scene's name, a scene JSON file (*.json), or mesh:PATH for an OBJ.
+// The test meshes the repository carries (scenes/meshes/), named by file stem: `mesh:stanford-bunny`.
+// A mesh reference without a '/' and without an extension is such a name; anything else is a path.
+bool is_mesh_name(const std::string& ref);
+std::vector<std::string> bundled_meshes();
+// The OBJ file a mesh reference names: a bundled mesh's file, or `ref` itself. Throws InputError for an
+// unknown name, listing the bundled meshes.
+std::string mesh_path(const std::string& ref);
+
+// Loads a scene from a spec: a standard scene's name, a scene JSON file (*.json), or mesh:PATH for an OBJ
+// (or mesh:NAME for a bundled mesh).
 // `assignments` are key=value scene parameters (for standard and mesh scenes). Throws InputError.
 Scene load_scene(const std::string& spec, const std::vector<std::string>& assignments = {});
 

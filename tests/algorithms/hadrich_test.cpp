@@ -139,7 +139,7 @@ TEST(Hadrich, NoNodeInsideClosedSolids) {
     const auto inside = test::nodes_inside_solids(plant, q);
     EXPECT_TRUE(inside.empty()) << name << ": " << inside.size() << " nodes inside";
   }
-  Scene bunny = load_scene("mesh:" + test::shared_mesh("stanford-bunny.obj"));
+  Scene bunny = load_scene("mesh:stanford-bunny");
   SceneQuery q(bunny);
   const Plant plant = test::grow("hadrich", bunny, q, {"max_particles=3000"});
   ASSERT_GT(plant.nodes.size(), 2000u);
@@ -308,7 +308,7 @@ TEST(Hadrich, WallPlantClimbsAndLeavesFaceOut) {
 // plant is up on the climbable surfaces and close to them. With the former default gravity of 1 the
 // shoots peeled off and lay on the ground (bunny: median node height 0.011 m; corner: 0.038 m).
 TEST(Hadrich, PlantsClimbTheCornerAndTheBunnyRatherThanTheGround) {
-  for (const std::string& name : std::vector<std::string>{"corner", "mesh:" + test::shared_mesh("stanford-bunny.obj")}) {
+  for (const std::string& name : std::vector<std::string>{"corner", "mesh:stanford-bunny"}) {
     const Scene s = load_scene(name);
     SceneQuery q(s);
     const Plant plant = test::grow("hadrich", s, q, {"max_particles=3000"});

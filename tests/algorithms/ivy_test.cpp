@@ -217,7 +217,7 @@ TEST(IvyReference, EmbreePathGrowsExactlyLuftsBruteForcePlant) {
 // bisector of two faces sharing an edge, where the two distances differ only by rounding (the case
 // in which a rejection test without enough slack let the triangle offered first win).
 TEST(IvyReference, EmbreeAdhesionEqualsBruteForceOnTheBunny) {
-  const Scene bunny = load_scene("mesh:" + test::shared_mesh("stanford-bunny.obj"));
+  const Scene bunny = load_scene("mesh:stanford-bunny");
   const SceneQuery query(bunny, {.build_sdf = false});
   const ivy::TriangleTable table(bunny);
   // The triangle across t's edge a-b (kNoTriangle on the rim of a hole), and the edge's midpoint.
@@ -373,7 +373,7 @@ TEST(IvyScenes, NoNodeEndsInsideAClosedMesh) {
     ASSERT_GT(p.nodes.size(), 1000u) << name;
     EXPECT_EQ(nodes_inside(p, q), 0u) << name;
   }
-  Scene bunny = load_scene("mesh:" + test::shared_mesh("stanford-bunny.obj"));
+  Scene bunny = load_scene("mesh:stanford-bunny");
   const SceneQuery q(bunny);
   // The scan's lowest vertex (the default seed) is on the rim of a hole in its base; start on its flank.
   bunny.seeds = {{q.closest_point({0.0f, 0.8f, 1.0f}).point, {0, 1, 0}, 0}};
@@ -411,7 +411,7 @@ TEST(IvyScenes, IvyClingsToTheWallAndItsLeavesFaceAway) {
 }
 
 TEST(IvyScenes, BlenderPresetStopsAtItsMaximumRootLength) {
-  Scene bunny = load_scene("mesh:" + test::shared_mesh("stanford-bunny.obj"));
+  Scene bunny = load_scene("mesh:stanford-bunny");
   const SceneQuery q(bunny, {.build_sdf = false});
   bunny.seeds = {{q.closest_point({0.0f, 0.8f, 1.0f}).point, {0, 1, 0}, 0}};
   std::vector<std::pair<std::string, double>> stats;

@@ -155,7 +155,7 @@ TEST(SpaceColonization, FreeGrowsThroughAWallAvoidDoesNot) {
 }
 
 TEST(SpaceColonization, ClingStaysOnTheBunny) {
-  const Scene bunny = load_scene("mesh:" + test::shared_mesh("stanford-bunny.obj"));
+  const Scene bunny = load_scene("mesh:stanford-bunny");
   SceneQuery q(bunny);
   const Plant p = grow("spacecol", bunny, q, {"surface=cling", "point_count=8000"});
   ASSERT_GT(p.nodes.size(), 500u);

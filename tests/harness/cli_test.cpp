@@ -28,6 +28,10 @@ TEST(Cli, HelpAndLists) {
   EXPECT_EQ(r.status, 0);
   for (const char* s : {"wall", "facade", "column", "corner", "pergola", "boulder", "trunk", "envelope", "mesh:PATH"})
     EXPECT_NE(r.out.find(s), std::string::npos) << s;
+  EXPECT_NE(r.out.find("(cow, spot, stanford-bunny, suzanne, teapot)"), std::string::npos) << r.out;
+  r = growbench("run -a ivy -s mesh:bunny -o " + test::temp_dir("cli_badmesh").string());
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("unknown mesh 'bunny'"), std::string::npos) << r.out;
 }
 
 TEST(Cli, LsystemPrintsTheDerivedStringAndGrowsExamplesFromFiles) {
@@ -120,8 +124,7 @@ TEST(Cli, CustomLeafObjForHadrich) {
 
 TEST(Cli, SeedAtSnapsToTheSurface) {
   const auto dir = test::temp_dir("cli_seedat");
-  const auto r = growbench("run -q -a spacecol -s mesh:" + test::shared_mesh("suzanne.obj") +
-                           " --seed-at 0,5,0 --set surface=cling --set point_count=2000 -o " + dir.string());
+  const auto r = growbench("run -q -a spacecol -s mesh:suzanne --seed-at 0,5,0 --set surface=cling --set point_count=2000 -o " + dir.string());
   ASSERT_EQ(r.status, 0) << r.out;
   std::ifstream in(dir / "skeleton.obj");
   std::string line;

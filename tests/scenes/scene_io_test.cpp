@@ -33,7 +33,7 @@ TEST(StandardScenes, ParametersAreValidated) {
 }
 
 TEST(MeshScene, FittedToStandardSizeOnAGroundWithSeedAtTheFootOfItsLitSide) {
-  const Scene s = load_scene("mesh:" + test::shared_mesh("stanford-bunny.obj"));
+  const Scene s = load_scene("mesh:stanford-bunny");
   const Aabb b = s.meshes[0].bounds();
   const glm::vec3 e = b.size();
   EXPECT_NEAR(std::max({e.x, e.y, e.z}), 2.0f, 1e-4f);
@@ -43,7 +43,7 @@ TEST(MeshScene, FittedToStandardSizeOnAGroundWithSeedAtTheFootOfItsLitSide) {
   ASSERT_EQ(s.meshes.size(), 2u);
   EXPECT_FALSE(s.meshes[1].climbable);
   EXPECT_NEAR(s.meshes[1].bounds().max.y, 0.0f, 1e-6f);
-  EXPECT_EQ(load_scene("mesh:" + test::shared_mesh("stanford-bunny.obj"), {"ground=false"}).meshes.size(), 1u);
+  EXPECT_EQ(load_scene("mesh:stanford-bunny", {"ground=false"}).meshes.size(), 1u);
   // The seed: the lowest vertex among those whose (area-weighted) normal is within 60 degrees of
   // horizontal and faces the light, growing up along the surface.
   ASSERT_EQ(s.seeds.size(), 1u);
@@ -68,8 +68,30 @@ TEST(MeshScene, FittedToStandardSizeOnAGroundWithSeedAtTheFootOfItsLitSide) {
   EXPECT_NEAR(glm::dot(s.seeds[0].direction, n), 0.0f, 1e-5f);  // along the surface
   EXPECT_GT(s.seeds[0].direction.y, 0.9f);                       // and up
   EXPECT_NEAR(glm::length(s.seeds[0].direction), 1.0f, 1e-5f);
-  const Scene raw = load_scene("mesh:" + test::shared_mesh("stanford-bunny.obj"), {"size=0"});
+  const Scene raw = load_scene("mesh:stanford-bunny", {"size=0"});
   EXPECT_NEAR(raw.meshes[0].bounds().max.y, 0.187321f, 1e-5f);  // the file's own units
+}
+
+TEST(MeshScene, BundledMeshesByNameAreTheRepositorysFiles) {
+  EXPECT_EQ(bundled_meshes(), (std::vector<std::string>{"cow", "spot", "stanford-bunny", "suzanne", "teapot"}));
+  const std::string file = std::string(GROWBENCH_SOURCE_DIR) + "/scenes/meshes/suzanne.obj";
+  EXPECT_EQ(mesh_path("suzanne"), file);
+  EXPECT_EQ(mesh_path("./suzanne"), "./suzanne");  // a path stays a path
+  EXPECT_EQ(mesh_path("suzanne.obj"), "suzanne.obj");
+  const Scene named = load_scene("mesh:suzanne");
+  EXPECT_EQ(named.name, "suzanne");
+  EXPECT_EQ(named.source, "mesh:suzanne");
+  EXPECT_EQ(named.content_hash(), load_scene("mesh:" + file).content_hash());
+  const std::string e = error_of([] { load_scene("mesh:suzane"); });
+  EXPECT_NE(e.find("unknown mesh 'suzane' (did you mean 'suzanne'?)"), std::string::npos) << e;
+  EXPECT_NE(e.find("cow, spot, stanford-bunny, suzanne, teapot"), std::string::npos) << e;
+  // A scene file names them the same way, as its base or as a mesh's obj.
+  const auto dir = test::temp_dir("bundled");
+  const std::string based = test::write_text(dir / "s.json", R"({"schema_version": 1, "base": "mesh:suzanne",
+      "meshes": [{"name": "cow", "obj": "cow"}]})");
+  const Scene s = load_scene(based);
+  ASSERT_EQ(s.meshes.size(), 3u);  // suzanne, its ground, the cow
+  EXPECT_EQ(s.meshes[2].triangles.size(), load_obj(mesh_path("cow")).triangles.size());
 }
 
 TEST(MeshScene, BadFilesGiveClearErrors) {

@@ -303,7 +303,7 @@ TEST(SceneQuery, OcclusionBehindAWall) {
 }
 
 TEST(SceneQuery, InsideOutsideOfTheBunnyMatchesRayParity) {
-  const Scene s = load_scene("mesh:" + test::shared_mesh("stanford-bunny.obj"));
+  const Scene s = load_scene("mesh:stanford-bunny");
   EXPECT_FALSE(s.meshes[0].is_closed()) << "the scan keeps a few small holes (223 boundary edges)";
   SceneQuery q(s);
   ASSERT_TRUE(q.mesh_solid()[0]) << "its small holes are filled for the distance field";
