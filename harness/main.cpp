@@ -96,6 +96,11 @@ int main(int argc, char** argv) {
   suite_cmd->add_flag("--resume", resume, "continue an interrupted run in --out, skipping finished trials");
   suite_cmd->add_option("--shard", shard, "run only shard I of N (I/N, 0-based): a deterministic slice of the cells");
   suite_cmd->add_flag("-q,--quiet", suite_quiet, "no progress lines");
+  int suite_repetitions = 0;
+  suite_cmd->add_option("--repetitions", suite_repetitions,
+                        "repetitions per cell instead of the suite file's (recorded in results.json; a quicker look "
+                        "with wider intervals)")
+      ->check(CLI::Range(1, 1000));
   bool suite_instructions = false;
   suite_cmd->add_flag("--instructions", suite_instructions,
                       "run each trial once, single-threaded, under valgrind's callgrind, and record instructions per "
@@ -223,7 +228,8 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help prints and exits 0; any other command-line error is bad input, status 2 like every other.
+    return app.exit(e) == 0 ? 0 : 2;
   }
 
   try {
@@ -258,7 +264,8 @@ int main(int argc, char** argv) {
       // First, while this process is small: the launcher that forks the trials (harness/process.hpp).
       std::unique_ptr<gb::Launcher> launcher;
       if (!suite_instructions) launcher = gb::start_trial_launcher();
-      const gb::Suite suite = gb::load_suite(suite_file);
+      gb::Suite suite = gb::load_suite(suite_file);
+      if (suite_repetitions > 0) suite.repetitions = suite_repetitions;
       gb::SuiteRunOptions o;
       o.launcher = launcher.get();
       o.out_dir = suite_out;

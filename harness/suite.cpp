@@ -421,6 +421,9 @@ json merge_results(const std::vector<json>& shards, const std::vector<std::strin
     if (s.value("suite_hash", "") != first.value("suite_hash", ""))
       throw InputError(fmt::format("{}: a shard of another suite (suite_hash {} vs {} in {})", names[k], s.value("suite_hash", ""),
                                    first.value("suite_hash", ""), names[0]));
+    if (s.value("repetitions", 0) != first.value("repetitions", 0))
+      throw InputError(fmt::format("{}: {} repetitions, but {} has {}", names[k], s.value("repetitions", 0), names[0],
+                                   first.value("repetitions", 0)));
     if (s.value("mode", "timing") != first.value("mode", "timing"))
       throw InputError(fmt::format("{}: mode '{}' differs from {}'s", names[k], s.value("mode", "timing"), names[0]));
     const int n = s.at("shard").value("count", 1), i = s.at("shard").value("index", 0);
@@ -559,6 +562,9 @@ std::string run_suite(const Suite& suite_in, const SuiteRunOptions& o) {
     }
     if (results.value("suite_hash", "") != suite.hash)
       throw InputError(fmt::format("{}: cannot resume, it was written for a different version of {}", results_path.string(), suite.file));
+    if (results.value("repetitions", 0) != suite.repetitions)
+      throw InputError(fmt::format("{}: cannot resume, it ran {} repetitions per cell and this run asks {}", results_path.string(),
+                                   results.value("repetitions", 0), suite.repetitions));
   } else {
     results = {{"schema_version", 1},
                {"kind", "growbench-results"},

@@ -186,6 +186,26 @@ TEST(Suite, ResumeAfterKillLosesNothing) {
   }
 }
 
+TEST(Suite, RepetitionsOverrideIsRecordedAndGuardsResume) {
+  const auto dir = test::temp_dir("suite_reps");
+  const json algos = json::array({{{"name", "spacecol"}, {"params", kSmall}}});
+  const std::string file = suite_file(dir, {{"repetitions", 5}, {"algorithms", algos}});
+  const std::string out = (dir / "out").string();
+  auto r = growbench("suite -q --repetitions 2 -o " + out + " " + file);
+  ASSERT_EQ(r.status, 0) << r.out;
+  const json res = read_json(dir / "out" / "results.json");
+  EXPECT_EQ(res["repetitions"], 2);
+  ASSERT_EQ(res["trials"].size(), 1u);
+  EXPECT_EQ(res["trials"][0]["samples"].size(), 2u);
+  r = growbench("suite -q --resume -o " + out + " " + file);  // the file's 5 are not the run's 2
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("cannot resume, it ran 2 repetitions per cell and this run asks 5"), std::string::npos) << r.out;
+  r = growbench("suite -q --repetitions 2 --resume -o " + out + " " + file);
+  EXPECT_EQ(r.status, 0) << r.out;
+  r = growbench("suite -q --repetitions 0 -o " + (dir / "o2").string() + " " + file);
+  EXPECT_EQ(r.status, 2) << r.out;
+}
+
 TEST(Suite, QuickSuiteEndToEndAndSummary) {
   const auto dir = test::temp_dir("suite_quick");
   const std::string out = (dir / "out").string();
