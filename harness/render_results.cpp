@@ -188,6 +188,10 @@ json render_directory(const std::string& dir_arg, const RenderDirOptions& o) {
       }
     }
   };
+  // Renders report as they finish; say at once how many there are, since the first can take a while.
+  if (!o.quiet)
+    fmt::print(stderr, "render: {} image{} at {} quality, {} POV-Ray process{} at once\n", jobs.size(), jobs.size() == 1 ? "" : "s",
+               to_string(o.render.quality), workers, workers == 1 ? "" : "es");
   std::vector<std::thread> pool;
   for (int i = 0; i < workers; ++i) pool.emplace_back(worker);
   for (auto& th : pool) th.join();
