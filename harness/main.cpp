@@ -15,6 +15,7 @@
 #include "core/errors.hpp"
 #include "harness/ab.hpp"
 #include "harness/compare.hpp"
+#include "harness/exporters.hpp"
 #include "harness/history.hpp"
 #include "harness/render_results.hpp"
 #include "harness/report.hpp"
@@ -188,6 +189,10 @@ int main(int argc, char** argv) {
   std::string merge_out;
   merge_cmd->add_option("shards", merge_inputs, "results.json of every shard")->required();
   merge_cmd->add_option("-o,--out", merge_out, "the merged results.json")->required();
+  bool merge_mixed = false;
+  merge_cmd->add_flag("--mixed-machines", merge_mixed,
+                      "merge shards that ran on different CPU models or builds (their timings are not comparable; the "
+                      "merged context is marked mixed_machines)");
 
   auto* baseline_cmd = app.add_subcommand("baseline", "Manage the committed baselines of the regression gate");
   auto* baseline_update = baseline_cmd->add_subcommand(
@@ -359,10 +364,13 @@ int main(int argc, char** argv) {
     if (*merge_cmd) {
       std::vector<nlohmann::json> shards;
       for (const auto& f : merge_inputs) shards.push_back(gb::read_results_file(f));
-      const auto merged = gb::merge_results(shards, merge_inputs);
+      const auto merged = gb::merge_results(shards, merge_inputs, merge_mixed);
       const auto parent = std::filesystem::path(merge_out).parent_path();
       if (!parent.empty()) std::filesystem::create_directories(parent);
-      std::ofstream(merge_out) << merged.dump(1) << "\n";
+      const std::string text = merged.dump(1) + "\n";
+      gb::write_file_atomic(merge_out, text.data(), text.size());
+      if (merged["context"].value("mixed_machines", false))
+        fmt::print(stderr, "growbench: warning: the shards ran on different machines or builds; their timings are not comparable\n");
       fmt::print("merged {} shards, {} cells, into {}\n", shards.size(), merged["trials"].size(), merge_out);
       return 0;
     }

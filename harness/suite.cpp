@@ -408,7 +408,11 @@ Suite load_suite(const std::string& path) {
   return SuiteReader(path).read();
 }
 
-json merge_results(const std::vector<json>& shards, const std::vector<std::string>& names) {
+// What a shard's context must share with the others for their timings to be compared: the machine type
+// and the build. Host names and dates may differ.
+const char* const kMachineKeys[] = {"cpu_model", "hardware_threads", "growbench_commit", "dirty", "build_type", "compiler", "cxx_flags"};
+
+json merge_results(const std::vector<json>& shards, const std::vector<std::string>& names, bool mixed_machines) {
   if (shards.empty()) throw InputError("merge: no shard results given");
   const json& first = shards.front();
   const int count = first.at("shard").value("count", 1);
@@ -433,6 +437,20 @@ json merge_results(const std::vector<json>& shards, const std::vector<std::strin
       throw InputError(fmt::format("{}: shard {}/{} given twice", names[k], i, n));
     slot[static_cast<std::size_t>(i)] = k;
   }
+  std::vector<std::string> differ;
+  const json none = json::object();
+  const json& ctx0 = first.contains("context") ? first["context"] : none;
+  for (std::size_t k = 1; k < shards.size(); ++k) {
+    const json& ctx = shards[k].contains("context") ? shards[k]["context"] : none;
+    for (const char* key : kMachineKeys)
+      if (ctx.value(key, json()) != ctx0.value(key, json()))
+        differ.push_back(fmt::format("{} {} in {} vs {} in {}", key, ctx.value(key, json()).dump(), names[k],
+                                     ctx0.value(key, json()).dump(), names[0]));
+  }
+  if (!differ.empty() && !mixed_machines)
+    throw InputError(fmt::format("merge: the shards ran on different machines or builds, so their timings cannot be compared "
+                                 "({}); run every shard on identical nodes, or pass --mixed-machines to merge them marked as mixed",
+                                 fmt::join(differ, "; ")));
   for (int i = 0; i < count; ++i)
     if (slot[static_cast<std::size_t>(i)] == shards.size()) throw InputError(fmt::format("merge: shard {}/{} is missing", i, count));
   // Cell k of the suite ran in shard k % count, as its (k / count)-th cell.
@@ -452,6 +470,7 @@ json merge_results(const std::vector<json>& shards, const std::vector<std::strin
     if (at >= trials.size()) throw InputError(fmt::format("merge: shard {} has fewer cells than its suite gives it", k % count));
     merged["trials"].push_back(trials[at]);
   }
+  if (!differ.empty()) merged["context"]["mixed_machines"] = true;
   merged.erase("renders");  // per-shard render summaries do not describe the merged grid
   return merged;
 }

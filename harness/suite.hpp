@@ -77,8 +77,11 @@ std::string run_suite(const Suite& suite, const SuiteRunOptions& options);
 // Joins the results of the shards of one suite run (`--shard I/N`, every I from 0 to N-1, the same suite
 // file) into one results document whose trials are in the unsharded run's order: identical to an
 // unsharded run apart from timings and the context (the first shard's; all of them under "shards").
-// Throws InputError naming the file that does not fit (another suite, a missing or repeated shard).
-nlohmann::json merge_results(const std::vector<nlohmann::json>& shards, const std::vector<std::string>& names);
+// Throws InputError naming the file that does not fit (another suite, a missing or repeated shard), and
+// for shards whose machines or builds differ (kMachineKeys of their contexts): their timings cannot be
+// compared with each other, so that takes `mixed_machines`, and the merged context then says so.
+nlohmann::json merge_results(const std::vector<nlohmann::json>& shards, const std::vector<std::string>& names,
+                             bool mixed_machines = false);
 
 // The summary table of a results file (median and 95% interval of timings, warnings on noise).
 std::string summarize_results(const nlohmann::json& results);

@@ -276,6 +276,20 @@ TEST(Suite, ShardsMergeIntoTheUnshardedRun) {
   r = growbench("merge " + s0 + " " + s1 + " --out " + (dir / "x.json").string());
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.out.find("shard 2/3 is missing"), std::string::npos) << r.out;
+  // A shard from another machine type: its timings cannot stand beside the others' unless asked for.
+  nlohmann::json other = nlohmann::json::parse(std::ifstream(s1));
+  other["context"]["cpu_model"] = "Another CPU";
+  const std::string s1x = test::write_text(dir / "sh_1x.json", other.dump());
+  const std::string s2 = (dir / "sh_2" / "results.json").string();
+  r = growbench("merge " + s0 + " " + s1x + " " + s2 + " --out " + (dir / "x.json").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("different machines or builds"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("cpu_model \"Another CPU\" in " + s1x), std::string::npos) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.json"));
+  r = growbench("merge --mixed-machines " + s0 + " " + s1x + " " + s2 + " --out " + (dir / "x.json").string());
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_TRUE(nlohmann::json::parse(std::ifstream(dir / "x.json"))["context"]["mixed_machines"]);
+  EXPECT_FALSE(b["context"].contains("mixed_machines"));
 }
 
 }  // namespace
