@@ -36,7 +36,9 @@ std::string mesh_path(const std::string& ref) {
   const fs::path p = fs::path(GROWBENCH_MESH_DIR) / (ref + ".obj");
   if (fs::exists(p)) return p.string();
   const std::vector<std::string> names = bundled_meshes();
-  const std::string near = closest_match(ref, names);
+  std::string near = closest_match(ref, names);
+  for (const auto& n : names)  // "bunny" means the Stanford bunny
+    if (near.empty() && n.find(ref) != std::string::npos) near = n;
   throw InputError(fmt::format("unknown mesh '{}'{}; expected a bundled mesh ({}) or a path to an OBJ file", ref,
                                near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near),
                                names.empty() ? fmt::format("none found in {}", GROWBENCH_MESH_DIR)

@@ -31,7 +31,7 @@ TEST(Cli, HelpAndLists) {
   EXPECT_NE(r.out.find("(cow, spot, stanford-bunny, suzanne, teapot)"), std::string::npos) << r.out;
   r = growbench("run -a ivy -s mesh:bunny -o " + test::temp_dir("cli_badmesh").string());
   EXPECT_EQ(r.status, 2) << r.out;
-  EXPECT_NE(r.out.find("unknown mesh 'bunny'"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("unknown mesh 'bunny' (did you mean 'stanford-bunny'?)"), std::string::npos) << r.out;
 }
 
 TEST(Cli, LsystemPrintsTheDerivedStringAndGrowsExamplesFromFiles) {
