@@ -409,8 +409,9 @@ Suite load_suite(const std::string& path) {
 }
 
 // What a shard's context must share with the others for their timings to be compared: the machine type
-// and the build. Host names and dates may differ.
-const char* const kMachineKeys[] = {"cpu_model", "hardware_threads", "growbench_commit", "dirty", "build_type", "compiler", "cxx_flags"};
+// and the binary (its content hash, not the source tree's commit, which may move while shards run).
+// Host names and dates may differ.
+const char* const kMachineKeys[] = {"cpu_model", "hardware_threads", "binary_hash"};
 
 json merge_results(const std::vector<json>& shards, const std::vector<std::string>& names, bool mixed_machines) {
   if (shards.empty()) throw InputError("merge: no shard results given");

@@ -14,6 +14,7 @@
 #include <fstream>
 #include <map>
 #include <thread>
+#include <vector>
 
 #include <embree3/rtcore_config.h>
 #include <fmt/format.h>
@@ -21,6 +22,7 @@
 #include <tbb/global_control.h>
 #include <tbb/version.h>
 #include <valgrind/callgrind.h>
+#include <xxhash.h>
 
 #include "algorithms/algorithm.hpp"
 #include "core/errors.hpp"
@@ -208,6 +210,20 @@ void inject_fault(const std::string& fault) {
 
 }  // namespace
 
+// The running binary's content hash: what identifies the build whose timings these are, whatever the
+// source tree's state is by the time it runs (a commit made while a sharded run is under way).
+std::string binary_hash() {
+  std::ifstream in("/proc/self/exe", std::ios::binary);
+  XXH3_state_t* st = XXH3_createState();
+  XXH3_64bits_reset(st);
+  std::vector<char> buf(1 << 16);
+  while (in.read(buf.data(), static_cast<std::streamsize>(buf.size())) || in.gcount() > 0)
+    XXH3_64bits_update(st, buf.data(), static_cast<std::size_t>(in.gcount()));
+  const std::uint64_t h = XXH3_64bits_digest(st);
+  XXH3_freeState(st);
+  return in.bad() ? std::string("unknown") : fmt::format("{:016x}", h);
+}
+
 nlohmann::json run_context() {
   const std::time_t now = std::time(nullptr);
   char date[32];
@@ -232,6 +248,7 @@ nlohmann::json run_context() {
           {"build_type", GROWBENCH_BUILD_TYPE},
           {"compiler", fmt::format("g++ {}", __VERSION__)},
           {"cxx_flags", GROWBENCH_CXX_FLAGS},
+          {"binary_hash", binary_hash()},
           {"cpu_model", cpu_model()},
           {"hardware_threads", std::thread::hardware_concurrency()},
           {"date", date},
