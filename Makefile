@@ -1,12 +1,15 @@
 # The two entry points of the README. Both install dependencies (Debian packages), configure and build.
-#   make demo   the standard suite, rendered, with the report: out/demo/report/index.html
+#   make demo   the standard suite (one repetition per cell), rendered, with the report: out/demo/report/index.html
 #   make test   run the test suite
+#   make demo-full   the standard suite with its own five repetitions: out/demo-full/report/index.html
 PRESET ?= release
 BUILD := build/$(PRESET)
 GROWBENCH := $(BUILD)/harness/growbench
 JOBS ?= $(shell nproc)
+# Repetitions per cell in `make demo` (a number, or "suite" for the standard suite's own).
+DEMO_REPETITIONS ?= 1
 
-.PHONY: all deps configure build test demo bench gate baseline clean
+.PHONY: all deps configure build cli test demo demo-full bench gate baseline clean
 
 all: build
 
@@ -19,11 +22,18 @@ configure: deps
 build: configure
 	cmake --build $(BUILD) -j $(JOBS)
 
+# Only the growbench binary: what the demos need (no tests, no micro-benchmarks).
+cli: configure
+	cmake --build $(BUILD) -j $(JOBS) --target growbench
+
 test: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
 
-demo: build
-	bash scripts/demo $(GROWBENCH) out/demo
+demo: cli
+	bash scripts/demo $(GROWBENCH) out/demo $(DEMO_REPETITIONS)
+
+demo-full: cli
+	bash scripts/demo $(GROWBENCH) out/demo-full suite
 
 # The deterministic regression gate (CI runs it after the tests): the quick suite once, single-threaded,
 # under callgrind, compared with the committed baseline. Instruction counts depend on the compiler flags:
