@@ -189,6 +189,7 @@ json render_directory(const std::string& dir_arg, const RenderDirOptions& o) {
     }
   };
   // Renders report as they finish; say at once how many there are, since the first can take a while.
+  std::fflush(stdout);  // what the caller printed (a suite's summary) comes before the progress lines
   if (!o.quiet)
     fmt::print(stderr, "render: {} image{} at {} quality, {} POV-Ray process{} at once\n", jobs.size(), jobs.size() == 1 ? "" : "s",
                to_string(o.render.quality), workers, workers == 1 ? "" : "es");
