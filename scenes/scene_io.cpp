@@ -195,9 +195,15 @@ class JsonScene : public JsonPathReader {
     if (!j.is_string()) fail(path, fmt::format("expected a string, got {}", j.dump()));
     return j.get<std::string>();
   }
-  // A path in the scene file, relative to the file; a bundled mesh's name stays a name.
-  std::string resolve(const std::string& rel) const {
-    if (is_mesh_name(rel)) return mesh_path(rel);
+  // A path in the scene file (at JSON path `where`), relative to the file, or a bundled mesh's name.
+  std::string resolve(const std::string& rel, const std::string& where) const {
+    if (is_mesh_name(rel)) {
+      try {
+        return mesh_path(rel);
+      } catch (const InputError& e) {
+        fail(where, e.what());
+      }
+    }
     const fs::path p(rel);
     return (p.is_absolute() ? p : dir_ / p).string();
   }
@@ -209,7 +215,7 @@ class JsonScene : public JsonPathReader {
     int kinds = 0;
     if (j.contains("obj")) {
       ++kinds;
-      const std::string f = resolve(string(j["obj"], path + "/obj"));
+      const std::string f = resolve(string(j["obj"], path + "/obj"), path + "/obj");
       try {
         m = load_obj(f);
       } catch (const InputError& e) {
@@ -288,7 +294,7 @@ class JsonScene : public JsonPathReader {
       only_keys(j, path, {"type", "obj"});
       s.kind = Shape::Kind::Mesh;
       try {
-        s.mesh = load_obj(resolve(string(need(j, path, "obj"), path + "/obj")));
+        s.mesh = load_obj(resolve(string(need(j, path, "obj"), path + "/obj"), path + "/obj"));
       } catch (const InputError& e) {
         fail(path + "/obj", e.what());
       }
@@ -315,7 +321,7 @@ class JsonScene : public JsonPathReader {
           params.push_back(k + "=" + (v.is_string() ? v.get<std::string>() : v.dump()));
       }
       std::string base = string(j["base"], "/base");
-      if (base.rfind("mesh:", 0) == 0 && !is_mesh_name(base.substr(5))) base = "mesh:" + resolve(base.substr(5));
+      if (base.rfind("mesh:", 0) == 0 && !is_mesh_name(base.substr(5))) base = "mesh:" + resolve(base.substr(5), "/base");
       try {
         s = load_scene(base, params);
       } catch (const InputError& e) {

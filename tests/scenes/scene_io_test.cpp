@@ -92,6 +92,11 @@ TEST(MeshScene, BundledMeshesByNameAreTheRepositorysFiles) {
   const Scene s = load_scene(based);
   ASSERT_EQ(s.meshes.size(), 3u);  // suzanne, its ground, the cow
   EXPECT_EQ(s.meshes[2].triangles.size(), load_obj(mesh_path("cow")).triangles.size());
+  const std::string bad = test::write_text(dir / "bad.json", R"({"schema_version": 1, "base": "wall",
+      "meshes": [{"name": "x", "obj": "cwo"}]})");
+  const std::string e2 = error_of([&] { load_scene(bad); });
+  EXPECT_NE(e2.find("/meshes/0/obj"), std::string::npos) << e2;
+  EXPECT_NE(e2.find("unknown mesh 'cwo' (did you mean 'cow'?)"), std::string::npos) << e2;
 }
 
 TEST(MeshScene, BadFilesGiveClearErrors) {
