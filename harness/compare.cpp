@@ -129,11 +129,12 @@ CompareResult compare_results(const json& base, const json& now, const CompareOp
     for (std::size_t k = before; k < r.changes.size(); ++k) {
       Change& c = r.changes[k];
       const bool bytes = c.quantity.size() > 6 && c.quantity.compare(c.quantity.size() - 6, 6, ".bytes") == 0;
-      if (c.fails && bytes && c.ratio > 0.0) {
+      if (c.fails && c.ratio > 0.0) {
         const double delta = std::abs(std::stod(c.new_value) - std::stod(c.old_value));
-        if (delta <= o.alloc_bytes_slack) {
+        const double slack = bytes ? o.alloc_bytes_slack : o.alloc_count_slack;
+        if (delta <= slack) {
           c.fails = false;
-          c.why = fmt::format("allocated bytes within {:g} (paths differ by checkout)", o.alloc_bytes_slack);
+          c.why = fmt::format("{} within {:g} (paths differ by checkout)", bytes ? "allocated bytes" : "allocations", slack);
         }
       }
     }
