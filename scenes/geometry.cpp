@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <utility>
@@ -10,26 +11,138 @@
 
 namespace growbench::geom {
 
+namespace {
+template <class V>
+std::pair<V, TriangleFeature> closest_feature(const V& p, const V& a, const V& b, const V& c) {
+  using F = TriangleFeature;
+  using T = typename V::value_type;
+  const V ab = b - a, ac = c - a, ap = p - a;
+  const T d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
+  if (d1 <= T(0) && d2 <= T(0)) return {a, F::VertexA};
+  const V bp = p - b;
+  const T d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
+  if (d3 >= T(0) && d4 <= d3) return {b, F::VertexB};
+  const T vc = d1 * d4 - d3 * d2;
+  if (vc <= T(0) && d1 >= T(0) && d3 <= T(0)) return {a + ab * (d1 / (d1 - d3)), F::EdgeAB};
+  const V cp = p - c;
+  const T d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
+  if (d6 >= T(0) && d5 <= d6) return {c, F::VertexC};
+  const T vb = d5 * d2 - d1 * d6;
+  if (vb <= T(0) && d2 >= T(0) && d6 <= T(0)) return {a + ac * (d2 / (d2 - d6)), F::EdgeCA};
+  const T va = d3 * d6 - d5 * d4;
+  if (va <= T(0) && (d4 - d3) >= T(0) && (d5 - d6) >= T(0))
+    return {b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))), F::EdgeBC};
+  const T denom = T(1) / (va + vb + vc);
+  return {a + ab * (vb * denom) + ac * (vc * denom), F::Face};
+}
+}  // namespace
+
+TriangleFeaturePoint closest_feature_on_triangle(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b,
+                                                const glm::dvec3& c) {
+  const auto [q, f] = closest_feature(p, a, b, c);
+  return {q, f};
+}
+
 glm::vec3 closest_point_on_triangle(const glm::vec3& p, const glm::vec3& a, const glm::vec3& b,
                                     const glm::vec3& c) {
-  const glm::vec3 ab = b - a, ac = c - a, ap = p - a;
-  const float d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
-  if (d1 <= 0.0f && d2 <= 0.0f) return a;
-  const glm::vec3 bp = p - b;
-  const float d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
-  if (d3 >= 0.0f && d4 <= d3) return b;
-  const float vc = d1 * d4 - d3 * d2;
-  if (vc <= 0.0f && d1 >= 0.0f && d3 <= 0.0f) return a + ab * (d1 / (d1 - d3));
-  const glm::vec3 cp = p - c;
-  const float d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
-  if (d6 >= 0.0f && d5 <= d6) return c;
-  const float vb = d5 * d2 - d1 * d6;
-  if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) return a + ac * (d2 / (d2 - d6));
-  const float va = d3 * d6 - d5 * d4;
-  if (va <= 0.0f && (d4 - d3) >= 0.0f && (d5 - d6) >= 0.0f)
-    return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-  const float denom = 1.0f / (va + vb + vc);
-  return a + ab * (vb * denom) + ac * (vc * denom);
+  return closest_feature(p, a, b, c).first;
+}
+
+namespace {
+
+// The interval that triangle t covers on the line (point o, direction d) where its plane meets the
+// other's: dist holds t's signed distances to the other plane (not all zero, not all on one side). The
+// line crosses the two edges from the vertex alone on its side (Moller 1997).
+std::pair<double, double> line_interval(const glm::dvec3 t[3], const glm::dvec3& dist, const glm::dvec3& o, const glm::dvec3& d) {
+  int lone = 2;
+  if (dist[0] * dist[1] > 0) lone = 2;
+  else if (dist[0] * dist[2] > 0) lone = 1;
+  else if (dist[1] * dist[2] > 0 || dist[0] != 0) lone = 0;
+  else if (dist[1] != 0) lone = 1;
+  auto cross_at = [&](int other) {  // never divides by zero: dist[lone] and dist[other] differ in sign or one is 0
+    const double s = dist[lone] / (dist[lone] - dist[other]);
+    return glm::dot(t[lone] + s * (t[other] - t[lone]) - o, d);
+  };
+  double a = cross_at((lone + 1) % 3), b = cross_at((lone + 2) % 3);
+  if (a > b) std::swap(a, b);
+  return {a, b};
+}
+
+// Area of the part of triangle a inside triangle b, both in one plane (a clipped by b's three edges).
+double overlap_area_2d(const glm::dvec2 (&a)[3], const glm::dvec2 (&b)[3]) {
+  auto cross2 = [](const glm::dvec2& u, const glm::dvec2& v) { return u.x * v.y - u.y * v.x; };
+  const double orient = cross2(b[1] - b[0], b[2] - b[0]) >= 0.0 ? 1.0 : -1.0;
+  std::vector<glm::dvec2> poly(a, a + 3), next;
+  for (int e = 0; e < 3 && !poly.empty(); ++e) {
+    const glm::dvec2 p = b[e], q = b[(e + 1) % 3];
+    auto side = [&](const glm::dvec2& v) { return orient * cross2(q - p, v - p); };
+    next.clear();
+    for (std::size_t i = 0; i < poly.size(); ++i) {
+      const glm::dvec2 u = poly[i], v = poly[(i + 1) % poly.size()];
+      const double su = side(u), sv = side(v);
+      if (su >= 0.0) next.push_back(u);
+      if ((su >= 0.0) != (sv >= 0.0)) next.push_back(u + (v - u) * (su / (su - sv)));
+    }
+    poly.swap(next);
+  }
+  double area = 0.0;
+  for (std::size_t i = 0; i < poly.size(); ++i) area += cross2(poly[i], poly[(i + 1) % poly.size()]);
+  return 0.5 * std::abs(area);
+}
+
+}  // namespace
+
+bool triangles_overlap(const glm::vec3 (&t1)[3], const glm::vec3 (&t2)[3]) {
+  const glm::dvec3 a[3] = {t1[0], t1[1], t1[2]}, b[3] = {t2[0], t2[1], t2[2]};
+  auto size_of = [](const glm::dvec3 (&t)[3]) {
+    return std::max({glm::length(t[1] - t[0]), glm::length(t[2] - t[1]), glm::length(t[0] - t[2])});
+  };
+  const double scale = std::max(size_of(a), size_of(b));
+  if (!(scale > 0.0)) return false;
+  // Lengths below eps are rounding: a touch, not an overlap. It covers the float rounding of the
+  // coordinates (a leaf lying on a wall at 1 m is placed to within about 1e-7 m) and a part per million of
+  // the triangles' size, so blades that lie in one plane to that tolerance are tested as coplanar.
+  double reach = 0.0;
+  for (const auto* t : {&a, &b})
+    for (const auto& v : *t) reach = std::max({reach, std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+  const double eps = 1e-6 * scale + 8.0 * static_cast<double>(std::numeric_limits<float>::epsilon()) * reach;
+  glm::dvec3 na = glm::cross(a[1] - a[0], a[2] - a[0]), nb = glm::cross(b[1] - b[0], b[2] - b[0]);
+  const double la = glm::length(na), lb = glm::length(nb);
+  if (la <= eps * eps || lb <= eps * eps) return false;  // a degenerate triangle has no area to share
+  na /= la;
+  nb /= lb;
+  // Each triangle's vertices against the other's plane; within eps counts as on it.
+  auto against = [&](const glm::dvec3 (&t)[3], const glm::dvec3& n, const glm::dvec3& o) {
+    glm::dvec3 d;
+    for (int i = 0; i < 3; ++i) {
+      d[i] = glm::dot(n, t[i] - o);
+      if (std::abs(d[i]) <= eps) d[i] = 0.0;
+    }
+    return d;
+  };
+  const glm::dvec3 da = against(a, nb, b[0]), db = against(b, na, a[0]);
+  auto zeros = [](const glm::dvec3& d) { return (d[0] == 0.0) + (d[1] == 0.0) + (d[2] == 0.0); };
+  auto one_side = [](const glm::dvec3& d) { return (d[0] >= 0 && d[1] >= 0 && d[2] >= 0) || (d[0] <= 0 && d[1] <= 0 && d[2] <= 0); };
+  if (zeros(da) < 3 && zeros(db) < 3) {
+    // A triangle on one side of the other's plane meets it in a vertex at most, or in an edge lying on
+    // it. Otherwise both cut the line where the planes meet, and their intervals there must share more
+    // than a point.
+    if ((one_side(da) && zeros(da) < 2) || (one_side(db) && zeros(db) < 2)) return false;
+    const glm::dvec3 c = glm::cross(na, nb);
+    if (!(glm::length(c) > 1e-12)) return false;  // parallel planes, apart by more than eps
+    const glm::dvec3 d = c / glm::length(c);
+    const auto [a0, a1] = line_interval(a, da, a[0], d);
+    const auto [b0, b1] = line_interval(b, db, a[0], d);
+    return std::min(a1, b1) - std::max(a0, b0) > eps;
+  }
+  // Coplanar: the area they share, in the plane's dominant projection.
+  const glm::dvec3 an = glm::abs(na);
+  const int drop = an.x >= an.y && an.x >= an.z ? 0 : (an.y >= an.z ? 1 : 2);
+  auto flat = [&](const glm::dvec3& v) {
+    return drop == 0 ? glm::dvec2(v.y, v.z) : drop == 1 ? glm::dvec2(v.x, v.z) : glm::dvec2(v.x, v.y);
+  };
+  const glm::dvec2 pa[3] = {flat(a[0]), flat(a[1]), flat(a[2])}, pb[3] = {flat(b[0]), flat(b[1]), flat(b[2])};
+  return overlap_area_2d(pa, pb) > eps * scale;
 }
 
 TriangleMesh make_box(const std::string& name, const glm::vec3& lo, const glm::vec3& hi) {
@@ -129,6 +242,60 @@ std::vector<glm::vec3> vertex_normal_sums(const TriangleMesh& m) {
   return n;
 }
 
+namespace {
+
+// Triangulates a hole's loop (in patch order) by ear clipping in the plane of its Newell normal, so a
+// flat or gently curved hole gets a patch that does not fold over itself (a fan from the centroid folds
+// wherever the loop is not star-shaped around it, and a folded patch has no consistent inside). False
+// when the projected loop is not simple enough to clip; the caller then fans it.
+bool ear_clip(const std::vector<glm::vec3>& vertices, const std::vector<unsigned>& loop, std::vector<glm::uvec3>& out) {
+  const std::size_t n = loop.size();
+  if (n < 3) return false;
+  glm::dvec3 normal(0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const glm::dvec3 a(vertices[loop[i]]), b(vertices[loop[(i + 1) % n]]);
+    normal += glm::dvec3((a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y));
+  }
+  if (!(glm::length(normal) > 0.0)) return false;
+  normal = glm::normalize(normal);
+  const glm::dvec3 helper = std::abs(normal.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+  const glm::dvec3 u = glm::normalize(glm::cross(normal, helper)), v = glm::cross(normal, u);
+  std::vector<glm::dvec2> p(n);
+  for (std::size_t i = 0; i < n; ++i) p[i] = {glm::dot(glm::dvec3(vertices[loop[i]]), u), glm::dot(glm::dvec3(vertices[loop[i]]), v)};
+  auto cross2 = [](const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c) {
+    return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+  };
+  std::vector<std::size_t> left(n);
+  for (std::size_t i = 0; i < n; ++i) left[i] = i;
+  std::vector<glm::uvec3> tris;
+  while (left.size() > 3) {
+    bool clipped = false;
+    for (std::size_t k = 0; k < left.size() && !clipped; ++k) {
+      const std::size_t a = left[(k + left.size() - 1) % left.size()], b = left[k], c = left[(k + 1) % left.size()];
+      if (cross2(p[a], p[b], p[c]) <= 0.0) continue;  // reflex or flat: not an ear
+      bool empty = true;
+      for (const auto o : left) {
+        if (o == a || o == b || o == c) continue;
+        if (cross2(p[a], p[b], p[o]) >= 0.0 && cross2(p[b], p[c], p[o]) >= 0.0 && cross2(p[c], p[a], p[o]) >= 0.0) {
+          empty = false;
+          break;
+        }
+      }
+      if (!empty) continue;
+      tris.emplace_back(loop[a], loop[b], loop[c]);
+      left.erase(left.begin() + static_cast<std::ptrdiff_t>(k));
+      clipped = true;
+    }
+    if (!clipped) return false;
+  }
+  if (cross2(p[left[0]], p[left[1]], p[left[2]]) <= 0.0) return false;
+  tris.emplace_back(loop[left[0]], loop[left[1]], loop[left[2]]);
+  out.insert(out.end(), tris.begin(), tris.end());
+  return true;
+}
+
+}  // namespace
+
 bool fill_small_holes(TriangleMesh& m, double max_boundary_fraction) {
   if (m.is_closed()) return true;
   std::map<std::pair<unsigned, unsigned>, int> directed;
@@ -154,11 +321,15 @@ bool fill_small_holes(TriangleMesh& m, double max_boundary_fraction) {
       v = it->second;
       if (v != start && used[v]) return false;  // a figure-eight boundary
     }
-    glm::dvec3 c(0.0);
-    for (const auto v : loop) c += glm::dvec3(m.vertices[v]);
-    const auto centre = static_cast<unsigned>(filled.vertices.size());
-    filled.vertices.emplace_back(c / static_cast<double>(loop.size()));
-    for (std::size_t i = 0; i < loop.size(); ++i) filled.triangles.emplace_back(centre, loop[(i + 1) % loop.size()], loop[i]);
+    // The patch runs against the boundary edges (a -> b is a triangle's, the patch takes b -> a).
+    std::reverse(loop.begin(), loop.end());
+    if (!ear_clip(m.vertices, loop, filled.triangles)) {
+      glm::dvec3 c(0.0);
+      for (const auto v : loop) c += glm::dvec3(m.vertices[v]);
+      const auto centre = static_cast<unsigned>(filled.vertices.size());
+      filled.vertices.emplace_back(c / static_cast<double>(loop.size()));
+      for (std::size_t i = 0; i < loop.size(); ++i) filled.triangles.emplace_back(centre, loop[i], loop[(i + 1) % loop.size()]);
+    }
   }
   if (!filled.is_closed()) return false;
   m = std::move(filled);

@@ -1,6 +1,7 @@
 // Small geometric building blocks for scenes and tests.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -12,6 +13,24 @@ namespace growbench::geom {
 // Closest point on triangle (a, b, c) to p (Ericson, Real-Time Collision Detection, 5.1.5).
 glm::vec3 closest_point_on_triangle(const glm::vec3& p, const glm::vec3& a, const glm::vec3& b,
                                     const glm::vec3& c);
+
+// The same in double precision, with the feature the point lies on: a vertex, the interior of an edge,
+// or the face. The feature picks the pseudonormal that decides the side of p (SceneQuery's exact inside
+// test); double precision keeps the point exact to far below a float's rounding even on long slivers,
+// where the float version can be off by microns.
+enum class TriangleFeature : std::uint8_t { VertexA, VertexB, VertexC, EdgeAB, EdgeBC, EdgeCA, Face };
+struct TriangleFeaturePoint {
+  glm::dvec3 point;
+  TriangleFeature feature;
+};
+TriangleFeaturePoint closest_feature_on_triangle(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b,
+                                                const glm::dvec3& c);
+
+// Whether two triangles share more than isolated points: they cross along a segment, or lie in one plane
+// sharing area (Moller's interval test in double precision; coplanar pairs by clipping). Touching at a
+// point, such as two leaves on one petiole, is not an overlap; lengths below 1e-7 of the larger
+// triangle's size are taken as rounding.
+bool triangles_overlap(const glm::vec3 (&a)[3], const glm::vec3 (&b)[3]);
 
 // Per vertex, the sum of its faces' (b - a) x (c - a): area-weighted, not normalised (zero for a vertex
 // no face uses).
@@ -25,7 +44,8 @@ TriangleMesh make_icosphere(const std::string& name, const glm::vec3& center, fl
                             int subdivisions);
 
 // Closes the holes of a nearly closed mesh (boundary edges at most `max_boundary_fraction` of all
-// edges) by fanning each boundary loop to its centroid. Returns whether the mesh is closed afterwards;
+// edges): each boundary loop is triangulated by ear clipping in its best-fit plane, or, when its
+// projection there is not simple, fanned to its centroid. Returns whether the mesh is closed afterwards;
 // leaves it unchanged when the boundary is not a set of simple loops or is too large.
 bool fill_small_holes(TriangleMesh& mesh, double max_boundary_fraction = 0.01);
 
