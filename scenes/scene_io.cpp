@@ -89,6 +89,12 @@ TriangleMesh load_obj(const std::string& path) {
   return m;
 }
 
+TriangleMesh load_scene_obj(const std::string& path) {
+  TriangleMesh m = load_obj(path);
+  geom::fill_small_holes(m);  // leaves an open or badly holed mesh as it is: it has no inside
+  return m;
+}
+
 void fit_scene(Scene& s, float size) {
   Aabb b;
   for (const auto& m : s.meshes) b.extend(m.bounds());
@@ -151,7 +157,7 @@ Seed side_foot_seed(const TriangleMesh& m, const glm::vec3& light) {
 Scene mesh_scene(const std::string& path, const Params& p) {
   Scene s;
   s.name = fs::path(path).stem().string();
-  s.meshes.push_back(load_obj(path));
+  s.meshes.push_back(load_scene_obj(path));
   const auto size = static_cast<float>(p.real("size"));
   if (size > 0.0f) fit_scene(s, size);
   const Aabb b = s.meshes[0].bounds();
@@ -217,7 +223,7 @@ class JsonScene : public JsonPathReader {
       ++kinds;
       const std::string f = resolve(string(j["obj"], path + "/obj"), path + "/obj");
       try {
-        m = load_obj(f);
+        m = load_scene_obj(f);
       } catch (const InputError& e) {
         fail(path + "/obj", e.what());
       }
@@ -294,7 +300,7 @@ class JsonScene : public JsonPathReader {
       only_keys(j, path, {"type", "obj"});
       s.kind = Shape::Kind::Mesh;
       try {
-        s.mesh = load_obj(resolve(string(need(j, path, "obj"), path + "/obj"), path + "/obj"));
+        s.mesh = load_scene_obj(resolve(string(need(j, path, "obj"), path + "/obj"), path + "/obj"));
       } catch (const InputError& e) {
         fail(path + "/obj", e.what());
       }

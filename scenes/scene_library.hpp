@@ -36,6 +36,10 @@ Scene load_scene(const std::string& spec, const std::vector<std::string>& assign
 
 // Reads an OBJ file as one triangle mesh (polygons are triangulated). Throws InputError naming the file.
 TriangleMesh load_obj(const std::string& path);
+// The same, as a scene's solid: a nearly closed mesh (a scan with a few small holes) is sealed
+// (geom::fill_small_holes), so that what algorithms collide with, what renders show and what the
+// metrics judge are one surface. Every mesh a scene reads from a file comes through here.
+TriangleMesh load_scene_obj(const std::string& path);
 
 // Uniformly scales `scene`'s meshes (and seeds, envelope, zones, camera) so the largest extent of the
 // meshes' bounds is `size`, resting on y = 0 and centred on x = z = 0.

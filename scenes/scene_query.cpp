@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <unordered_map>
 
 #include <embree3/rtcore.h>
 #include <fmt/format.h>
+#include <tbb/task_arena.h>
 
 #include "core/kdtree.hpp"
 #include "core/random.hpp"
@@ -129,9 +131,13 @@ bool point_query_callback(RTCPointQueryFunctionArguments* args) {
   if (st->skip && (*st->skip)[args->geomID]) return false;
   const TriangleMesh& m = *(*st->meshes)[args->geomID];
   const auto& t = m.triangles[args->primID];
-  const glm::vec3 p(args->query->x, args->query->y, args->query->z);
-  const glm::vec3 q = geom::closest_point_on_triangle(p, m.vertices[t.x], m.vertices[t.y], m.vertices[t.z]);
-  const float d = glm::length(q - p);
+  // In double precision: in float, the closest point on a long sliver (a column's 3 m side) is off by
+  // up to half a millimetre, more than a climbing plant's distance from its wall.
+  const glm::dvec3 p(args->query->x, args->query->y, args->query->z);
+  const auto c = geom::closest_feature_on_triangle(p, glm::dvec3(m.vertices[t.x]), glm::dvec3(m.vertices[t.y]),
+                                                   glm::dvec3(m.vertices[t.z]));
+  const glm::vec3 q(c.point);
+  const auto d = static_cast<float>(glm::length(c.point - p));
   // Ties go to the lower (mesh, triangle): the answer does not depend on BVH traversal order.
   if (d < args->query->radius ||
       (d == st->best.distance && std::pair(args->geomID, args->primID) < std::pair(st->best.mesh, st->best.triangle))) {
@@ -174,6 +180,98 @@ struct SceneQuery::VertexIndex {
     return std::sqrt(d2) * (1.0f + 1e-5f) + 1e-7f;
   }
 };
+
+// A solid's pseudonormals (Baerentzen & Aanaes 2005): per face its unit normal, per edge the sum of its
+// two faces' normals, per vertex the sum of its faces' normals weighted by their angles there. For the
+// closest point q on a closed mesh to p, p lies inside exactly when (p - q) points against the
+// pseudonormal of the feature q lies on, whichever triangle reported it.
+struct SceneQuery::Solid {
+  std::uint32_t mesh = 0;
+  Aabb bounds;
+  std::vector<glm::vec3> face, vertex, edge;  // edge: three per triangle (ab, bc, ca)
+  std::vector<glm::vec3> pts;                 // vertices, to bound the closest-point search
+  Vec3Cloud cloud{&pts};
+  std::unique_ptr<Vec3Tree> tree;
+
+  Solid(const TriangleMesh& m, std::uint32_t id) : mesh(id), bounds(m.bounds()) {
+    face.resize(m.triangles.size());
+    vertex.assign(m.vertices.size(), glm::vec3(0.0f));
+    std::unordered_map<std::uint64_t, glm::vec3> edges;
+    edges.reserve(m.triangles.size() * 2);
+    auto key = [](std::uint32_t a, std::uint32_t b) { return (std::uint64_t{std::min(a, b)} << 32) | std::max(a, b); };
+    for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+      const auto& tri = m.triangles[t];
+      const glm::vec3 n = glm::cross(m.vertices[tri.y] - m.vertices[tri.x], m.vertices[tri.z] - m.vertices[tri.x]);
+      const float len = glm::length(n);
+      face[t] = len > 0.0f ? n / len : glm::vec3(0.0f);  // a degenerate face has no side to give
+      for (int k = 0; k < 3; ++k) {
+        const glm::vec3 e1 = m.vertices[tri[(k + 1) % 3]] - m.vertices[tri[k]];
+        const glm::vec3 e2 = m.vertices[tri[(k + 2) % 3]] - m.vertices[tri[k]];
+        const float l1 = glm::length(e1), l2 = glm::length(e2);
+        if (l1 > 0.0f && l2 > 0.0f)
+          vertex[tri[k]] += std::acos(std::clamp(glm::dot(e1, e2) / (l1 * l2), -1.0f, 1.0f)) * face[t];
+        edges[key(tri[k], tri[(k + 1) % 3])] += face[t];
+      }
+    }
+    edge.resize(3 * m.triangles.size());
+    for (std::size_t t = 0; t < m.triangles.size(); ++t)
+      for (int k = 0; k < 3; ++k) edge[3 * t + static_cast<std::size_t>(k)] = edges.at(key(m.triangles[t][k], m.triangles[t][(k + 1) % 3]));
+    pts = m.vertices;
+    tree = std::make_unique<Vec3Tree>(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  }
+  float search_radius(const glm::vec3& p) const {
+    std::uint32_t idx = 0;
+    float d2 = 0.0f;
+    nanoflann::KNNResultSet<float, std::uint32_t> rs(1);
+    rs.init(&idx, &d2);
+    tree->findNeighbors(rs, &p.x, nanoflann::SearchParams());
+    return std::sqrt(d2) * (1.0f + 1e-5f) + 1e-7f;
+  }
+  glm::vec3 pseudonormal(const TriangleMesh& m, std::uint32_t t, geom::TriangleFeature f) const {
+    using F = geom::TriangleFeature;
+    const auto& tri = m.triangles[t];
+    switch (f) {
+      case F::VertexA: return vertex[tri.x];
+      case F::VertexB: return vertex[tri.y];
+      case F::VertexC: return vertex[tri.z];
+      case F::EdgeAB: return edge[3 * t];
+      case F::EdgeBC: return edge[3 * t + 1];
+      case F::EdgeCA: return edge[3 * t + 2];
+      case F::Face: break;
+    }
+    return face[t];
+  }
+};
+
+namespace {
+struct SideState {
+  const TriangleMesh* mesh;
+  std::uint32_t id;
+  bool found = false;
+  double distance = std::numeric_limits<double>::infinity();
+  std::uint32_t triangle = 0;
+  geom::TriangleFeaturePoint closest{};
+};
+bool side_callback(RTCPointQueryFunctionArguments* args) {
+  auto* st = static_cast<SideState*>(args->userPtr);
+  if (args->geomID != st->id) return false;
+  const auto& t = st->mesh->triangles[args->primID];
+  const glm::dvec3 p(args->query->x, args->query->y, args->query->z);
+  const auto& v = st->mesh->vertices;
+  const auto c = geom::closest_feature_on_triangle(p, glm::dvec3(v[t.x]), glm::dvec3(v[t.y]), glm::dvec3(v[t.z]));
+  const double d = glm::length(c.point - p);
+  if (d < st->distance || (st->found && d == st->distance && args->primID < st->triangle)) {
+    st->found = true;
+    st->distance = d;
+    st->triangle = args->primID;
+    st->closest = c;
+    // Embree prunes in float: a little slack keeps a triangle as near as this one in the running.
+    args->query->radius = static_cast<float>(d) * (1.0f + 1e-6f) + 1e-7f;
+    return true;
+  }
+  return false;
+}
+}  // namespace
 
 struct SceneQuery::Embree {
   RTCDevice device = nullptr;
@@ -230,22 +328,13 @@ SceneQuery::SceneQuery(const Scene& scene, SceneQueryOptions options)
   }
   total_area_ = acc;
 
-  // Solids for the distance field: closed meshes as they are, nearly closed ones (a scan with a few
-  // small holes) with their holes filled; Embree keeps answering on the original surfaces.
-  std::vector<TriangleMesh> repaired;
-  repaired.reserve(scene.meshes.size());
+  // Solids: the closed meshes, for the exact inside test and the distance field alike.
   std::vector<const TriangleMesh*> sdf_meshes;
-  for (const auto& m : scene.meshes) {
-    if (m.is_closed()) {
-      solid_.push_back(true);
-      sdf_meshes.push_back(&m);
-      continue;
-    }
-    TriangleMesh r = m;
-    const bool ok = geom::fill_small_holes(r);
-    solid_.push_back(ok);
-    repaired.push_back(ok ? std::move(r) : TriangleMesh{});
-    sdf_meshes.push_back(ok ? &repaired.back() : &m);
+  for (std::uint32_t i = 0; i < scene.meshes.size(); ++i) {
+    const auto& m = scene.meshes[i];
+    solid_.push_back(m.is_closed());
+    solids_.push_back(solid_.back() ? std::make_unique<Solid>(m, i) : nullptr);
+    sdf_meshes.push_back(&m);
   }
   Aabb b;
   for (const auto& m : scene.meshes) b.extend(m.bounds());
@@ -346,6 +435,122 @@ void BoxIndex::visit_segment(const glm::vec3& o, const glm::vec3& d, Visitor vis
 
 std::unique_ptr<BoxIndex> SceneQuery::box_index(std::vector<Aabb> boxes) const {
   return std::unique_ptr<BoxIndex>(new BoxIndex(embree_->device, std::move(boxes)));
+}
+
+struct Occluder::Impl {
+  RTCScene scene = nullptr;
+  ~Impl() {
+    if (scene) rtcReleaseScene(scene);
+  }
+};
+
+namespace {
+// The ray's ignored owner rides behind the intersect context, which Embree hands to the filter.
+struct OccluderContext {
+  RTCIntersectContext context;
+  std::uint32_t ignore;
+  const std::vector<std::uint32_t>* owners;
+};
+void owner_filter(const RTCFilterFunctionNArguments* args) {
+  const auto* c = reinterpret_cast<const OccluderContext*>(args->context);
+  for (unsigned i = 0; i < args->N; ++i)
+    if (args->valid[i] != 0 && (*c->owners)[RTCHitN_primID(args->hit, args->N, i)] == c->ignore) args->valid[i] = 0;
+}
+}  // namespace
+
+Occluder::Occluder(void* device, std::vector<Capsule> capsules, std::vector<Triangle> triangles)
+    : impl_(std::make_unique<Impl>()) {
+  auto* dev = static_cast<RTCDevice>(device);
+  impl_->scene = rtcNewScene(dev);
+  rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
+  if (!capsules.empty()) {
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE);
+    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float),
+                                                           2 * capsules.size()));
+    auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT, sizeof(unsigned),
+                                                              capsules.size()));
+    for (std::size_t i = 0; i < capsules.size(); ++i) {
+      const Capsule& c = capsules[i];
+      const float v[8] = {c.a.x, c.a.y, c.a.z, c.ra, c.b.x, c.b.y, c.b.z, c.rb};
+      std::copy_n(v, 8, vb + 8 * i);
+      ib[i] = static_cast<unsigned>(2 * i);
+    }
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(impl_->scene, g, 0);
+    rtcReleaseGeometry(g);
+  }
+  if (!triangles.empty()) {
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                                           3 * triangles.size()));
+    auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                              3 * sizeof(unsigned), triangles.size()));
+    owners_.reserve(triangles.size());
+    for (std::size_t i = 0; i < triangles.size(); ++i) {
+      for (int k = 0; k < 3; ++k) {
+        std::copy_n(&triangles[i].v[k].x, 3, vb + 9 * i + 3 * static_cast<std::size_t>(k));
+        ib[3 * i + static_cast<std::size_t>(k)] = static_cast<unsigned>(3 * i + static_cast<std::size_t>(k));
+      }
+      owners_.push_back(triangles[i].owner);
+    }
+    rtcSetGeometryOccludedFilterFunction(g, owner_filter);
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(impl_->scene, g, 1);
+    rtcReleaseGeometry(g);
+  }
+  // Built on one thread: a parallel build's own allocations vary run to run, and the phase that asks
+  // (the metrics) must allocate the same way every time.
+  tbb::task_arena one(1);
+  one.execute([&] { rtcCommitScene(impl_->scene); });
+  if (const RTCError e = rtcGetDeviceError(dev); e != RTC_ERROR_NONE)
+    throw std::runtime_error(fmt::format("Embree: building the plant's occluder failed (error {})", static_cast<int>(e)));
+}
+
+Occluder::~Occluder() = default;
+
+bool Occluder::occluded(const glm::vec3& o, const glm::vec3& d, float tmax, std::uint32_t ignore, float tmin) const {
+  OccluderContext c{{}, ignore, &owners_};
+  rtcInitIntersectContext(&c.context);
+  RTCRay ray = make_ray(o, d, tmin, tmax);
+  rtcOccluded1(impl_->scene, &c.context, &ray);
+  return ray.tfar < 0.0f;
+}
+
+std::unique_ptr<Occluder> SceneQuery::occluder(std::vector<Occluder::Capsule> capsules,
+                                               std::vector<Occluder::Triangle> triangles) const {
+  return std::unique_ptr<Occluder>(new Occluder(embree_->device, std::move(capsules), std::move(triangles)));
+}
+
+float SceneQuery::inside_screen() const {
+  // Beyond the band the field holds +/- the band width, and the sign there is the band's.
+  return sdf_ ? std::min(2.0f * voxel_size_, 0.999f * sdf_->background()) : std::numeric_limits<float>::infinity();
+}
+
+bool SceneQuery::inside(const glm::vec3& p) const {
+  if (sdf_) {
+    const float v = sdf_->sample(p), screen = inside_screen();
+    if (v >= screen) return false;
+    if (v <= -screen) return true;
+  }
+  return inside_exact(p);
+}
+
+bool SceneQuery::inside_exact(const glm::vec3& p) const {
+  for (std::uint32_t i = 0; i < solids_.size(); ++i)
+    if (solids_[i] && solids_[i]->bounds.contains(p) && inside_mesh(i, p)) return true;
+  return false;
+}
+
+bool SceneQuery::inside_mesh(std::uint32_t mesh, const glm::vec3& p) const {
+  if (mesh >= solids_.size() || !solids_[mesh]) return false;
+  const Solid& solid = *solids_[mesh];
+  if (!solid.bounds.contains(p)) return false;
+  SideState st{&scene_.meshes[mesh], mesh};
+  point_query(embree_->main->scene, p, solid.search_radius(p), side_callback, &st);
+  // Within a float's rounding of the surface (a micrometre at metre scale) a point is on it: outside.
+  const glm::vec3 a = glm::abs(p);
+  if (!st.found || st.distance <= 1e-6 * std::max({1.0f, a.x, a.y, a.z})) return false;
+  return glm::dot(glm::dvec3(p) - st.closest.point, glm::dvec3(solid.pseudonormal(scene_.meshes[mesh], st.triangle, st.closest.feature))) < 0.0;
 }
 
 ClosestHit SceneQuery::closest_point(const glm::vec3& p, float max_distance, bool climbable_only) const {

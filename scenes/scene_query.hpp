@@ -1,17 +1,20 @@
 // Spatial queries on a scene, built once and safe for concurrent use from many threads.
 //
 //  * Embree BVH: closest point (rtcPointQuery, optionally bounded), ray cast, occlusion, light visibility.
-//  * OpenVDB narrow-band level set: signed distance, gradient, inside test.
+//  * OpenVDB narrow-band level set: signed distance, gradient.
+//  * The exact inside test, which every judgement of "inside a solid" goes through (see inside()).
 //
-// Signed distance. Each solid mesh becomes a level set (negative inside) and the scene's field is their
-// CSG union, so touching or overlapping solids need no boolean meshing. A mesh is solid when it is closed
-// (every edge shared by two opposite triangles) or nearly closed: when its boundary edges are at most 1%
-// of its edges and form simple loops, each loop is fanned shut for the distance field only (the scanned
-// bunny keeps 223 boundary edges of 104k). An open mesh (a lone wall quad) has no inside: it contributes an unsigned distance, so points
-// near it are never "inside" and growth is kept off it only by distance. Within the narrow band (band_voxels on each side) the
-// value is OpenVDB's trilinear sample; beyond it the magnitude is Embree's exact closest-point distance
-// and the sign is the band's (inside tiles are negative), so distances are right everywhere, not
-// clamped at the band.
+// Solids. A mesh is solid when it is closed: every edge shared by two opposite triangles. Scans with a
+// few small holes are sealed when they are loaded (scene_io), so the solid an algorithm collides with
+// (Embree's triangles) is the solid the distance field and the metrics judge. An open mesh (a lone wall
+// quad) has no inside: it contributes an unsigned distance, so points near it are never "inside".
+//
+// Signed distance. Each solid becomes a level set (negative inside) and the scene's field is their CSG
+// union, so touching or overlapping solids need no boolean meshing. Within the narrow band (band_voxels
+// on each side) the value is OpenVDB's trilinear sample; beyond it the magnitude is Embree's exact
+// closest-point distance and the sign is the band's (inside tiles are negative), so distances are right
+// everywhere, not clamped at the band. The trilinear value is an approximation near the surface: in a
+// concave crease it reads negative a little outside. So its sign is not an inside test; inside() is.
 //
 // Lifetime: the query refers to the scene's meshes; the scene must outlive it.
 #pragma once
@@ -87,6 +90,36 @@ class BoxIndex {
   std::unique_ptr<Impl> impl_;
 };
 
+// An Embree scene of geometry that is not the scene's: a plant's branches as round capsules and its
+// organs and polygons as triangles, for "does the plant itself block this ray" (self-shadowing). Each
+// triangle has an owner (an organ index, or kNoOwner); a ray may ignore one owner, the leaf it leaves
+// from. Built by SceneQuery::occluder on its device; safe for concurrent queries.
+class Occluder {
+ public:
+  static constexpr std::uint32_t kNoOwner = 0xFFFFFFFFu;
+  struct Capsule {  // a cone from a (radius ra) to b (radius rb) with spheres at both ends
+    glm::vec3 a{0.0f}, b{0.0f};
+    float ra = 0.0f, rb = 0.0f;
+  };
+  struct Triangle {
+    glm::vec3 v[3]{};
+    std::uint32_t owner = kNoOwner;
+  };
+  ~Occluder();
+  Occluder(const Occluder&) = delete;
+  Occluder& operator=(const Occluder&) = delete;
+  // Whether anything but `ignore`'s triangles lies on the ray o + t d, t in [tmin, tmax].
+  [[nodiscard]] bool occluded(const glm::vec3& o, const glm::vec3& d, float tmax, std::uint32_t ignore = kNoOwner,
+                              float tmin = 0.0f) const;
+
+ private:
+  friend class SceneQuery;
+  struct Impl;
+  Occluder(void* device, std::vector<Capsule> capsules, std::vector<Triangle> triangles);
+  std::vector<std::uint32_t> owners_;
+  std::unique_ptr<Impl> impl_;
+};
+
 class SceneQuery {
  public:
   explicit SceneQuery(const Scene& scene, SceneQueryOptions options = {});
@@ -107,6 +140,8 @@ class SceneQuery {
   void visit_near(const glm::vec3& p, float radius, TriangleVisitor visit, void* user) const;
   // An index over `boxes` (an empty box never contains anything).
   [[nodiscard]] std::unique_ptr<BoxIndex> box_index(std::vector<Aabb> boxes) const;
+  [[nodiscard]] std::unique_ptr<Occluder> occluder(std::vector<Occluder::Capsule> capsules,
+                                                   std::vector<Occluder::Triangle> triangles) const;
   [[nodiscard]] RayHit ray(const glm::vec3& origin, const glm::vec3& dir,
                            float tmax = std::numeric_limits<float>::infinity(), float tmin = 0.0f) const;
   [[nodiscard]] bool occluded(const glm::vec3& origin, const glm::vec3& dir,
@@ -127,7 +162,19 @@ class SceneQuery {
   [[nodiscard]] BandSample band_sample(const glm::vec3& p) const;
   // Unit gradient of the signed distance (points away from the nearest surface, outwards).
   [[nodiscard]] glm::vec3 gradient(const glm::vec3& p) const;
-  [[nodiscard]] bool inside(const glm::vec3& p) const { return signed_distance(p) < 0.0f; }
+  // Whether p lies inside a solid; the surface itself, to within a micrometre per metre of |p| (a
+  // float's rounding), is outside. Exact: the distance field decides only
+  // where it reads beyond inside_screen() from zero, which its error cannot cross (the voxels hold
+  // distances, so the trilinear value is within sqrt(3)/2 voxel of the truth; the screen is two voxels).
+  // Nearer, each solid whose bounds hold p decides by its closest point: p is inside when it lies behind
+  // the angle-weighted pseudonormal of the face, edge or vertex that point is on (Baerentzen & Aanaes
+  // 2005), exact on closed meshes at edges and vertices alike. Without a distance field, every point
+  // takes the exact test.
+  [[nodiscard]] bool inside(const glm::vec3& p) const;
+  // The exact test alone for one mesh (false for a mesh that is not solid).
+  [[nodiscard]] bool inside_mesh(std::uint32_t mesh, const glm::vec3& p) const;
+  // |signed field| at or beyond which inside() trusts the field's sign.
+  [[nodiscard]] float inside_screen() const;
   // Inside a shape (envelope or zone). Boxes and ellipsoids analytically; mesh shapes by ray parity.
   [[nodiscard]] bool inside_shape(const Shape& shape, const glm::vec3& p) const;
 
@@ -143,18 +190,21 @@ class SceneQuery {
   [[nodiscard]] double bvh_build_seconds() const { return bvh_seconds_; }
   [[nodiscard]] double sdf_build_seconds() const { return sdf_seconds_; }
   [[nodiscard]] std::size_t sdf_active_voxels() const;
-  // Per mesh: whether it is a solid with an inside in the SDF (closed, or sealed at voxel resolution).
+  // Per mesh: whether it is a solid with an inside (closed).
   [[nodiscard]] const std::vector<bool>& mesh_solid() const { return solid_; }
 
  private:
   struct Embree;
   struct VertexIndex;
+  struct Solid;
+  bool inside_exact(const glm::vec3& p) const;
   const Scene& scene_;
   SceneQueryOptions options_;
   std::unique_ptr<Embree> embree_;
   std::unique_ptr<SdfGrid> sdf_;
   std::unique_ptr<VertexIndex> vertices_;
   std::vector<bool> solid_;
+  std::vector<std::unique_ptr<Solid>> solids_;  // per mesh; null when it is not solid
   std::vector<bool> not_climbable_;  // per mesh; empty when no mesh is marked climbable
   float voxel_size_ = 0.0f;
   double bvh_seconds_ = 0.0, sdf_seconds_ = 0.0;

@@ -91,8 +91,9 @@ class Geometry {
   // kNoTriangle): offered first, it may bound the search without changing the answer. It returns
   // holding this node's target.
   virtual glm::vec3 adhesion(const glm::vec3& p, std::uint32_t& hint) const = 0;
-  // Pushes every triangle whose bounds come within `radius` of `centre` (or a superset) into
-  // `candidates`, for the Luft collision test.
+  // Pushes every triangle that comes within `radius` of `centre` into `candidates`, and perhaps some
+  // more whose bounds do, for the Luft collision test. (Embree's BVH may split a long triangle's bounds,
+  // so one whose box reaches the ball while its surface does not can be left out.)
   virtual void gather(const glm::vec3& centre, float radius, Candidates& candidates) const = 0;
   // Whether Luft's collision rule finds any triangle that the segment o -> q crosses (entering it).
   // When none is, an implementation may also settle adhesion(q) on the way (at_q.valid): exactly
