@@ -309,12 +309,10 @@ class Interpreter {
   void snap(State& t) {
     glm::dvec3 dir(0.0);
     for (int iter = 0; iter < 6; ++iter) {
-      if (s_.wrap->has_sdf()) {  // inside a solid (e.g. near a face of another mesh): out along the gradient
-        const float sd = s_.wrap->signed_distance(glm::vec3(t.pos));
-        if (sd < 0.0f) {
-          t.pos += glm::dvec3(s_.wrap->gradient(glm::vec3(t.pos))) * (static_cast<double>(-sd) + s_.wrap_offset);
-          continue;
-        }
+      if (s_.wrap->has_sdf() && s_.wrap->inside(glm::vec3(t.pos))) {  // (e.g. near a face of another mesh): out along the gradient
+        const float sd = std::min(0.0f, s_.wrap->signed_distance(glm::vec3(t.pos)));
+        t.pos += glm::dvec3(s_.wrap->gradient(glm::vec3(t.pos))) * (static_cast<double>(-sd) + s_.wrap_offset);
+        continue;
       }
       const ClosestHit hit = s_.wrap->closest_point(glm::vec3(t.pos));
       if (!hit.found) break;

@@ -204,7 +204,7 @@ class SpaceColonization final : public GrowthAlgorithm {
       if (in && z.kind == Zone::Kind::Include) include_ok = true;
     }
     if (any_include && !include_ok) return false;
-    if (query_->has_sdf() && query_->signed_distance(q) < 0.0f) return false;  // never inside a solid
+    if (query_->inside(q)) return false;  // never inside a solid
     return true;
   }
 
@@ -427,13 +427,15 @@ class SpaceColonization final : public GrowthAlgorithm {
       for (std::size_t k = r.begin(); k < r.end(); ++k) {
         const auto v = static_cast<std::size_t>(influenced[k]);
         const Pull& p = pull[k];
+        // A node the field's push leaves inside a solid (one thinner than its voxels) does not grow.
+        auto outside = [&](const glm::vec3& c) { return surface_ != Surface::Free && query_->inside(c) ? none : c; };
         if (cancelling(p) && p.min_dot < 0.0f) {
-          target[k] = {place(node_pos_[v], steer(p.first, v, 1)), place(node_pos_[v], steer(p.opposite, v, 2))};
+          target[k] = {outside(place(node_pos_[v], steer(p.first, v, 1))), outside(place(node_pos_[v], steer(p.opposite, v, 2)))};
           continue;
         }
         const glm::vec3 dir = safe_normalize(p.sum, glm::vec3(0.0f));
         if (glm::dot(dir, dir) == 0.0f) continue;  // pulls cancel exactly and splitting is off: the node waits
-        target[k].first = place(node_pos_[v], steer(dir, v, 0));
+        target[k].first = outside(place(node_pos_[v], steer(dir, v, 0)));
       }
     });
     for (std::size_t k = 0; k < influenced.size(); ++k) {

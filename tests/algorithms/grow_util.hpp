@@ -30,29 +30,11 @@ inline Plant grow(const std::string& algorithm, const Scene& scene, const SceneQ
   return algo->plant();
 }
 
-// Indices of the nodes inside a solid. The distance field is a voxel approximation: in a concave
-// crease (a wall meeting the ground, the bunny's folds) it reads a few millimetres negative at points
-// just outside, exactly where climbing plants creep. So a node counts as inside when the field puts it
-// deeper than a voxel (creases read up to about 0.6 voxel), or when it reads negative at all and exact ray parity agrees (odd
-// crossings along at least two of three directions; parity alone would miss a node inside two
-// overlapping solids).
+// Indices of the nodes inside a solid, by the scene query's exact test (the one the metrics use).
 inline std::vector<std::size_t> nodes_inside_solids(const Plant& plant, const SceneQuery& q) {
-  const glm::vec3 dirs[3] = {glm::normalize(glm::vec3(0.5773f, 0.6170f, 0.5348f)),
-                             glm::normalize(glm::vec3(-0.3f, 0.2f, 0.93f)), glm::normalize(glm::vec3(0.1f, -0.9f, 0.4f))};
   std::vector<std::size_t> inside;
-  for (std::size_t i = 0; i < plant.nodes.size(); ++i) {
-    const glm::vec3 p = plant.nodes[i].position;
-    const float sd = q.signed_distance(p);
-    if (sd >= -1e-4f) continue;
-    int odd = 0;
-    for (const auto& d : dirs) {
-      int crossings = 0;
-      float t = 0.0f;
-      for (RayHit h; (h = q.ray(p, d, 1e9f, t)).hit && crossings < 10000; t = h.t + 1e-6f) ++crossings;
-      odd += crossings % 2;
-    }
-    if (sd < -q.voxel_size() || odd >= 2) inside.push_back(i);
-  }
+  for (std::size_t i = 0; i < plant.nodes.size(); ++i)
+    if (q.inside(plant.nodes[i].position)) inside.push_back(i);
   return inside;
 }
 

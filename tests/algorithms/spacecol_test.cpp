@@ -116,12 +116,15 @@ TEST(SpaceColonization, SeekGrowsTheTrunkUpToTheCrown) {
 
 void expect_outside_solids(const char* what, const SceneQuery& q, const Plant& p, float max_off_surface) {
   float worst = std::numeric_limits<float>::infinity(), farthest = 0;
+  std::size_t inside = 0;
   for (const auto& n : p.nodes) {
     const float d = q.signed_distance(n.position);
     worst = std::min(worst, d);
     farthest = std::max(farthest, d);
+    inside += q.inside(n.position) ? 1 : 0;
   }
-  EXPECT_GE(worst, 0.0f) << what << ": a node is inside a solid";
+  EXPECT_EQ(inside, 0u) << what << ": nodes inside a solid";
+  EXPECT_GE(worst, -q.inside_screen()) << what << ": the field reads a node deep inside";
   EXPECT_LE(farthest, max_off_surface) << what;
 }
 
