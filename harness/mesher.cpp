@@ -111,18 +111,20 @@ void add_tube(OutputMesh& m, const Plant& plant, const std::vector<std::int32_t>
 }
 
 void add_organ(OutputMesh& m, const Organ& organ, const TriangleMesh& shape) {
-  const glm::mat3 r = glm::mat3_cast(organ.orientation);
-  const float L = organ.size;
   const auto base = static_cast<std::uint32_t>(m.positions.size());
-  const glm::vec3 n = r * glm::vec3(0, 1, 0);
+  const glm::vec3 n = glm::mat3_cast(organ.orientation) * glm::vec3(0, 1, 0);
   for (const auto& v : shape.vertices) {
-    m.positions.push_back(organ.position + r * (v * L));
+    m.positions.push_back(organ_point(organ, v));
     m.normals.push_back(n);
   }
   for (const auto& t : shape.triangles) m.triangles.push_back(t + glm::uvec3(base));
 }
 
 }  // namespace
+
+glm::vec3 organ_point(const Organ& organ, const glm::vec3& local) {
+  return organ.position + glm::mat3_cast(organ.orientation) * (local * organ.size);
+}
 
 TriangleMesh load_leaf_mesh(const std::string& path) {
   TriangleMesh m = load_obj(path);  // InputError without faces

@@ -51,6 +51,11 @@ OutputMesh mesh_plant(const Plant& plant, const MesherOptions& options = {});
 // the organ's local frame at unit length. Shared with the POV-Ray writer so renders match the meshes.
 TriangleMesh organ_shape(const MesherOptions& options = {});
 
+// A point of an organ's shape (its local frame, unit length) placed in the world: scaled by the organ's
+// size, turned by its orientation, moved to its position. Meshes, renders, the metrics' leaf overlap and
+// self-shadowing all place organs through it, so they judge the organs that are exported.
+glm::vec3 organ_point(const Organ& organ, const glm::vec3& local);
+
 // Chains of nodes along which tubes run: each starts at a root or a branching point and follows the
 // main child (the one that continues the parent's shoot, else the first). Shared with the skeleton
 // exporter so polylines and tubes agree.

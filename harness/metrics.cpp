@@ -8,6 +8,8 @@
 #include <tbb/parallel_for.h>
 
 #include "core/kdtree.hpp"
+#include "harness/mesher.hpp"
+#include "scenes/geometry.hpp"
 
 namespace growbench {
 namespace {
@@ -32,6 +34,10 @@ double quantile(std::vector<float> v, double q) {
 }
 
 }  // namespace
+
+bool is_leaf(const Organ& o) { return o.kind == OrganKind::Leaf || o.kind == OrganKind::YoungLeaf; }
+glm::vec3 leaf_centre(const Organ& leaf) { return organ_point(leaf, {0.0f, 0.0f, 0.5f}); }
+glm::vec3 leaf_normal(const Organ& leaf) { return glm::mat3_cast(leaf.orientation)[1]; }
 
 float segment_distance(const glm::vec3& p1, const glm::vec3& q1, const glm::vec3& p2, const glm::vec3& q2) {
   const glm::vec3 d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
@@ -61,7 +67,7 @@ float segment_distance(const glm::vec3& p1, const glm::vec3& q1, const glm::vec3
   return glm::length((p1 + d1 * s) - (p2 + d2 * t));
 }
 
-nlohmann::json compute_metrics(const Plant& plant, const SceneQuery& query, const MetricOptions& o) {
+nlohmann::json compute_metrics(const Plant& plant, const SceneQuery& query, const MetricOptions& o, MetricDetails* details) {
   const auto& nodes = plant.nodes;
   nlohmann::json m;
   // Segments: node i (with a parent) and its parent.
@@ -72,7 +78,7 @@ nlohmann::json compute_metrics(const Plant& plant, const SceneQuery& query, cons
 
   std::size_t leaves = 0, flowers = 0;
   for (const auto& org : plant.organs) {
-    if (org.kind == OrganKind::Leaf || org.kind == OrganKind::YoungLeaf) ++leaves;
+    if (is_leaf(org)) ++leaves;
     else ++flowers;
   }
   m["nodes"] = nodes.size();
@@ -137,7 +143,7 @@ nlohmann::json compute_metrics(const Plant& plant, const SceneQuery& query, cons
   std::vector<std::uint8_t> inside(nodes.size());
   tbb::parallel_for(std::size_t{0}, nodes.size(), [&](std::size_t i) {
     dist[i] = query.closest_point(nodes[i].position).distance;
-    inside[i] = query.has_sdf() && query.signed_distance(nodes[i].position) < 0.0f ? 1 : 0;
+    inside[i] = query.inside(nodes[i].position) ? 1 : 0;
   });
   std::size_t attached = 0, inside_nodes = 0;
   double sum = 0.0;
@@ -152,19 +158,18 @@ nlohmann::json compute_metrics(const Plant& plant, const SceneQuery& query, cons
   m["adhesion_p90_m"] = quantile(dist, 0.9);
   m["attached_fraction"] = nodes.empty() ? 0.0 : static_cast<double>(attached) / n;
   m["penetration_nodes"] = nodes.empty() ? 0.0 : static_cast<double>(inside_nodes) / n;
-  std::vector<std::uint16_t> seg_inside(seg.size(), 0);
-  if (query.has_sdf()) {
-    tbb::parallel_for(std::size_t{0}, seg.size(), [&](std::size_t k) {
-      const glm::vec3 a = a_of(seg[k]), b = nodes[seg[k]].position;
-      for (int j = 1; j <= o.segment_samples; ++j) {
-        const float t = static_cast<float>(j) / static_cast<float>(o.segment_samples + 1);
-        seg_inside[k] = static_cast<std::uint16_t>(seg_inside[k] + (query.signed_distance(glm::mix(a, b, t)) < 0.0f ? 1 : 0));
-      }
-    });
-  }
+  const auto ss = static_cast<std::size_t>(std::max(0, o.segment_samples));
+  std::vector<std::uint8_t> sample_inside(seg.size() * ss, 0);
+  tbb::parallel_for(std::size_t{0}, seg.size(), [&](std::size_t k) {
+    const glm::vec3 a = a_of(seg[k]), b = nodes[seg[k]].position;
+    for (std::size_t j = 0; j < ss; ++j) {
+      const float t = static_cast<float>(j + 1) / static_cast<float>(ss + 1);
+      sample_inside[k * ss + j] = query.inside(glm::mix(a, b, t)) ? 1 : 0;
+    }
+  });
   std::size_t inside_samples = 0;
-  for (const auto c : seg_inside) inside_samples += c;
-  const double total_samples = static_cast<double>(seg.size()) * o.segment_samples;
+  for (const auto c : sample_inside) inside_samples += c;
+  const double total_samples = static_cast<double>(sample_inside.size());
   m["penetration_samples"] = total_samples > 0 ? static_cast<double>(inside_samples) / total_samples : 0.0;
 
   // Self-intersection: pairs (k < l) closer than r_k + r_l that are not neighbours in the tree.
@@ -211,42 +216,104 @@ nlohmann::json compute_metrics(const Plant& plant, const SceneQuery& query, cons
   m["self_intersections"] = pairs;
   m["self_intersection_fraction"] = seg.empty() ? 0.0 : static_cast<double>(inv) / static_cast<double>(seg.size());
 
-  // Leaves: bounding discs (centre half a blade along +Z, radius half the length), and light.
-  std::vector<glm::vec3> centre;
-  std::vector<float> radius;
-  std::vector<glm::vec3> normal;
-  for (const auto& org : plant.organs) {
-    if (!(org.kind == OrganKind::Leaf || org.kind == OrganKind::YoungLeaf)) continue;
-    const glm::mat3 r = glm::mat3_cast(org.orientation);
-    centre.push_back(org.position + 0.5f * org.size * r[2]);
-    radius.push_back(0.5f * org.size);
-    normal.push_back(r[1]);
+  // Leaves: their blades as exported (the organ shape placed by organ_point), and light.
+  const TriangleMesh shape = o.organ_shape.triangles.empty() ? organ_shape() : o.organ_shape;
+  auto organ_triangle = [&](const Organ& org, const glm::uvec3& t, glm::vec3 (&v)[3]) {
+    for (int k = 0; k < 3; ++k) v[k] = organ_point(org, shape.vertices[t[k]]);
+  };
+  std::vector<std::uint32_t> leaf;  // organ index of each leaf
+  for (std::uint32_t i = 0; i < plant.organs.size(); ++i)
+    if (is_leaf(plant.organs[i])) leaf.push_back(i);
+  // Each leaf's bounding sphere (around its box's centre) finds the leaves its blade can meet.
+  std::vector<glm::vec3> bcentre(leaf.size());
+  std::vector<float> bradius(leaf.size(), 0.0f);
+  std::vector<Aabb> lbox(leaf.size());
+  for (std::size_t i = 0; i < leaf.size(); ++i) {
+    for (const auto& v : shape.vertices) lbox[i].extend(organ_point(plant.organs[leaf[i]], v));
+    // Padded by the overlap test's tolerance, so blades coplanar within it are not kept apart here.
+    const glm::vec3 far = glm::max(glm::abs(lbox[i].min), glm::abs(lbox[i].max));
+    const float reach = std::max({far.x, far.y, far.z});
+    const float pad = 1e-6f * glm::length(lbox[i].size()) + 8.0f * std::numeric_limits<float>::epsilon() * reach;
+    lbox[i].min -= glm::vec3(2.0f * pad);
+    lbox[i].max += glm::vec3(2.0f * pad);
+    bcentre[i] = lbox[i].center();
+    bradius[i] = 0.5f * glm::length(lbox[i].size());
   }
-  std::vector<std::uint8_t> overlap(centre.size(), 0), lit(centre.size(), 0);
-  if (!centre.empty()) {
-    PointsAdaptor la{&centre};
+  auto blades_meet = [&](std::size_t i, std::size_t j) {
+    const Aabb &a = lbox[i], &b = lbox[j];
+    if (glm::any(glm::lessThan(a.max, b.min)) || glm::any(glm::lessThan(b.max, a.min))) return false;
+    glm::vec3 ta[3], tb[3];
+    for (const auto& t : shape.triangles) {
+      organ_triangle(plant.organs[leaf[i]], t, ta);
+      for (const auto& u : shape.triangles) {
+        organ_triangle(plant.organs[leaf[j]], u, tb);
+        if (geom::triangles_overlap(ta, tb)) return true;
+      }
+    }
+    return false;
+  };
+  std::vector<std::uint8_t> overlap(leaf.size(), 0), lit_scene(leaf.size(), 0), lit(leaf.size(), 0);
+  if (!leaf.empty()) {
+    PointsAdaptor la{&bcentre};
     Tree leaf_tree(3, la, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-    const float rmax = *std::max_element(radius.begin(), radius.end());
-    tbb::parallel_for(std::size_t{0}, centre.size(), [&](std::size_t i) {
-      const float r = radius[i] + rmax;
-      // Stops at the first overlapping disc: dense foliage (the wall's ivy has ~230 leaf centres within
-      // reach of each leaf) would otherwise list every candidate only to learn one thing.
-      kd_visit_within(leaf_tree, centre[i], r, [&](std::uint32_t j, float d2) {
-        if (j == i || std::sqrt(d2) >= radius[i] + radius[j]) return true;
+    const float rmax = *std::max_element(bradius.begin(), bradius.end());
+    // The plant as an occluder: branches as the mesher's tubes (capsules between node radii, raised to
+    // its minimum), every organ's triangles owned by the organ, and polygons.
+    std::vector<Occluder::Capsule> capsules;
+    capsules.reserve(seg.size());
+    for (const auto s : seg)
+      capsules.push_back({a_of(s), nodes[s].position, std::max(nodes[static_cast<std::size_t>(nodes[s].parent)].radius, 1e-4f),
+                          std::max(nodes[s].radius, 1e-4f)});
+    std::vector<Occluder::Triangle> tris;
+    tris.reserve(plant.organs.size() * shape.triangles.size());
+    for (std::uint32_t i = 0; i < plant.organs.size(); ++i)
+      for (const auto& t : shape.triangles) {
+        Occluder::Triangle ot;
+        organ_triangle(plant.organs[i], t, ot.v);
+        ot.owner = i;
+        tris.push_back(ot);
+      }
+    for (const auto& poly : plant.polygons)
+      for (std::size_t k = 1; k + 1 < poly.vertices.size(); ++k) tris.push_back({{poly.vertices[0], poly.vertices[k], poly.vertices[k + 1]}});
+    const auto occluder = query.occluder(std::move(capsules), std::move(tris));
+    tbb::parallel_for(std::size_t{0}, leaf.size(), [&](std::size_t i) {
+      // Stops at the first leaf it meets: dense foliage (the wall's ivy has hundreds of leaves within
+      // reach of each) would otherwise test every candidate only to learn one thing.
+      kd_visit_within(leaf_tree, bcentre[i], bradius[i] + rmax, [&](std::uint32_t j, float d2) {
+        if (j == i || std::sqrt(d2) > bradius[i] + bradius[j] || !blades_meet(i, j)) return true;
         overlap[i] = 1;
         return false;
       });
-      lit[i] = query.light_visible(centre[i] + 1e-3f * normal[i]) ? 1 : 0;
+      const Organ& org = plant.organs[leaf[i]];
+      const glm::vec3 from = leaf_centre(org) + o.light_bias * leaf_normal(org);
+      lit_scene[i] = query.light_visible(from) ? 1 : 0;
+      const Light& light = query.scene().light;
+      lit[i] = lit_scene[i] && !occluder->occluded(from, light.towards(from), light.distance(from), leaf[i]) ? 1 : 0;
     });
   }
-  std::size_t ov = 0, li = 0;
-  for (std::size_t i = 0; i < centre.size(); ++i) {
+  std::size_t ov = 0, li = 0, ls = 0;
+  for (std::size_t i = 0; i < leaf.size(); ++i) {
     ov += overlap[i];
     li += lit[i];
+    ls += lit_scene[i];
   }
-  const double nl = static_cast<double>(centre.size());
-  m["leaf_overlap"] = centre.empty() ? 0.0 : static_cast<double>(ov) / nl;
-  m["leaf_light_exposure"] = centre.empty() ? 0.0 : static_cast<double>(li) / nl;
+  const double nl = static_cast<double>(leaf.size());
+  m["leaf_overlap"] = leaf.empty() ? 0.0 : static_cast<double>(ov) / nl;
+  m["leaf_light_exposure"] = leaf.empty() ? 0.0 : static_cast<double>(li) / nl;
+  m["leaf_light_exposure_scene"] = leaf.empty() ? 0.0 : static_cast<double>(ls) / nl;
+  if (details) {
+    details->covered = std::move(covered);
+    details->node_distance = std::move(dist);
+    details->node_inside = std::move(inside);
+    details->segments = std::move(seg);
+    details->sample_inside = std::move(sample_inside);
+    details->segment_crossed.resize(involved.size());
+    for (std::size_t k = 0; k < involved.size(); ++k) details->segment_crossed[k] = involved[k].load(std::memory_order_relaxed);
+    details->leaves = std::move(leaf);
+    details->leaf_overlaps = std::move(overlap);
+    details->leaf_lit_scene = std::move(lit_scene);
+    details->leaf_lit = std::move(lit);
+  }
   return m;
 }
 

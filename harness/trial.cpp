@@ -446,7 +446,11 @@ nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const P
     bytes["glb"] = write_glb((d / "plant.glb").string(), mesh);
     bytes["skeleton_obj"] = write_skeleton_obj((d / "skeleton.obj").string(), plant);
   });
-  if (spec.metrics) rec["metrics"] = timer.run("metrics", [&] { return compute_metrics(plant, *query); });
+  if (spec.metrics) {
+    MetricOptions metric_options;
+    metric_options.organ_shape = organ_shape(mesher);
+    rec["metrics"] = timer.run("metrics", [&] { return compute_metrics(plant, *query, metric_options); });
+  }
 
   std::size_t segments = 0;
   for (const auto& n : plant.nodes) segments += n.parent != kNoParent ? 1 : 0;

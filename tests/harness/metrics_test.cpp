@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <glm/gtc/quaternion.hpp>
 
+#include "harness/mesher.hpp"
 #include "scenes/geometry.hpp"
 #include "scenes/scene_library.hpp"
 #include "test_util.hpp"
@@ -115,9 +116,11 @@ TEST(Metrics, SelfIntersectionAndLeafOverlapMatchAllPairs) {
     glm::vec3 pos = glm::clamp(p.nodes[static_cast<std::size_t>(parent)].position + len * dir, glm::vec3(0.0f), glm::vec3(1.0f));
     p.nodes.push_back({pos, r, parent, 0, 0, 0});
   }
-  const glm::quat up(1, 0, 0, 0);
-  for (int i = 0; i < 400; ++i)
-    p.organs.push_back({{u(rng), u(rng), u(rng)}, up, u(rng) < 0.1f ? 0.3f : 0.01f + 0.03f * u(rng), OrganKind::Leaf, 0});
+  for (int i = 0; i < 400; ++i) {
+    const glm::vec3 axis = glm::normalize(glm::vec3(u(rng) - 0.5f, u(rng) - 0.5f, u(rng) - 0.5f) + glm::vec3(1e-3f));
+    const glm::quat turn = glm::angleAxis(6.2831853f * u(rng), axis);
+    p.organs.push_back({{u(rng), u(rng), u(rng)}, turn, u(rng) < 0.1f ? 0.3f : 0.05f + 0.1f * u(rng), OrganKind::Leaf, 0});
+  }
 
   const auto& n = p.nodes;
   auto up_of = [&](std::int32_t v) { return v == kNoParent ? kNoParent : n[static_cast<std::size_t>(v)].parent; };
@@ -142,17 +145,25 @@ TEST(Metrics, SelfIntersectionAndLeafOverlapMatchAllPairs) {
         involved[static_cast<std::size_t>(k)] = involved[static_cast<std::size_t>(l)] = 1;
       }
     }
+  // Every pair of leaves, every pair of their blades' triangles.
+  const TriangleMesh shape = organ_shape();
   std::size_t overlapping = 0;
-  for (std::size_t i = 0; i < p.organs.size(); ++i)
-    for (std::size_t j = 0; j < p.organs.size(); ++j) {
-      const auto& a = p.organs[i];
-      const auto& b = p.organs[j];
-      const glm::vec3 ca = a.position + 0.5f * a.size * glm::vec3(0, 0, 1), cb = b.position + 0.5f * b.size * glm::vec3(0, 0, 1);
-      if (i != j && glm::length(ca - cb) < 0.5f * (a.size + b.size)) {
-        ++overlapping;
-        break;
-      }
+  for (std::size_t i = 0; i < p.organs.size(); ++i) {
+    bool meets = false;
+    for (std::size_t j = 0; j < p.organs.size() && !meets; ++j) {
+      if (i == j) continue;
+      for (const auto& ta : shape.triangles)
+        for (const auto& tb : shape.triangles) {
+          glm::vec3 a[3], b[3];
+          for (int k = 0; k < 3; ++k) {
+            a[k] = organ_point(p.organs[i], shape.vertices[ta[k]]);
+            b[k] = organ_point(p.organs[j], shape.vertices[tb[k]]);
+          }
+          meets = meets || geom::triangles_overlap(a, b);
+        }
     }
+    overlapping += meets ? 1 : 0;
+  }
   ASSERT_GT(pairs, 20u);  // the tangle does cross itself, thick and thin
   ASSERT_GT(overlapping, 20u);
   ASSERT_LT(overlapping, p.organs.size());
@@ -176,6 +187,41 @@ TEST(Metrics, LeafOverlapAndLightExposure) {
   EXPECT_NEAR(m["leaf_overlap"].get<double>(), 2.0 / 3.0, 1e-9);
   EXPECT_NEAR(m["leaf_light_exposure"].get<double>(), 2.0 / 3.0, 1e-9);
   EXPECT_EQ(m["leaves"], 3);
+}
+
+}  // namespace
+}  // namespace growbench
+
+namespace growbench {
+namespace {
+
+// A leaf shades another when it lies on the second's ray to the sun, and so does a branch; the
+// scene-only figure sees neither.
+TEST(Metrics, LightExposureCountsThePlantsOwnShade) {
+  const Scene wall = load_scene("wall");  // sun from the front (+z)
+  SceneQuery q(wall);
+  const glm::vec3 sun = wall.light.towards({0, 0, 0});
+  const glm::quat flat(1, 0, 0, 0);  // blade along +z, upper side +y
+  Organ low{{0, 1, 0.5f}, flat, 0.1f, OrganKind::Leaf, 0};
+  const glm::vec3 from = leaf_centre(low) + 1e-3f * leaf_normal(low);
+  const glm::vec3 above = from + 0.2f * sun;  // where the upper leaf's centre sits on that ray
+  Organ high{above - glm::vec3(0, 0, 0.05f), flat, 0.1f, OrganKind::Leaf, 0};
+  Plant p = chain({{1, 0.5f, 0.5f}, {1, 1, 0.5f}});
+  p.organs = {low, high};
+  auto m = compute_metrics(p, q);
+  EXPECT_NEAR(m["leaf_light_exposure_scene"].get<double>(), 1.0, 1e-12);
+  EXPECT_NEAR(m["leaf_light_exposure"].get<double>(), 0.5, 1e-12) << "the upper leaf shades the lower";
+  // A thick branch across the ray instead of the upper leaf.
+  const glm::vec3 across = glm::normalize(glm::cross(sun, glm::vec3(0, 1, 0)));
+  p = chain({above - 0.3f * across, above + 0.3f * across}, 0.02f);
+  p.organs = {low};
+  m = compute_metrics(p, q);
+  EXPECT_NEAR(m["leaf_light_exposure_scene"].get<double>(), 1.0, 1e-12);
+  EXPECT_NEAR(m["leaf_light_exposure"].get<double>(), 0.0, 1e-12) << "the branch shades the leaf";
+  // Moved aside, it does not.
+  p = chain({above - 0.3f * across + glm::vec3(0, 0.2f, 0), above + 0.3f * across + glm::vec3(0, 0.2f, 0)}, 0.02f);
+  p.organs = {low};
+  EXPECT_NEAR(compute_metrics(p, q)["leaf_light_exposure"].get<double>(), 1.0, 1e-12);
 }
 
 }  // namespace
