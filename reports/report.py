@@ -35,7 +35,10 @@ QUALITY = [("coverage", "surface coverage", "fraction"),
            ("penetration_samples", "penetration (segment samples inside)", "fraction"),
            ("self_intersection_fraction", "self-intersecting segments", "fraction"),
            ("leaf_overlap", "leaf overlap", "fraction"),
-           ("leaf_light_exposure", "leaf light exposure", "fraction")]
+           ("leaf_light_exposure", "leaf light exposure (self-shadowed)", "fraction"),
+           ("leaf_light_exposure_scene", "leaf light exposure (scene shade only)", "fraction")]
+# The metrics' definitions and error bounds, rendered beside the report (docs/metrics.md).
+METRICS_DOC = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "docs", "metrics.md")
 
 
 class ReportError(Exception):
@@ -187,7 +190,7 @@ def time_with_ci(v):
 # ---------------------------------------------------------------- tables
 
 TABLE_HEAD = ["algorithm", "scene", "seeds", "growth time median [95% CI]", "peak memory", "GLB size", "nodes",
-              "coverage", "attached", "penetration"]
+              "coverage", "attached", "penetration", "leaf overlap", "leaf light"]
 
 
 def table_rows(cells):
@@ -211,7 +214,8 @@ def table_rows(cells):
             m = lambda k: median([c.metrics[k] for c in good if k in c.metrics]) if any(k in c.metrics for c in good) else None
             seeds = f"{len(good)}" + (f" ({len(bad)} failed: {', '.join(sorted({c.status for c in bad}))})" if bad else "")
             rows.append([label, scene, seeds, time_with_ci(times), fmt_bytes(rss), fmt_bytes(glb), f"{nodes:.0f}",
-                         fmt_frac(m("coverage")), fmt_frac(m("attached_fraction")), fmt_frac(m("penetration_samples"))])
+                         fmt_frac(m("coverage")), fmt_frac(m("attached_fraction")), fmt_frac(m("penetration_samples")),
+                         fmt_frac(m("leaf_overlap")), fmt_frac(m("leaf_light_exposure"))])
     return rows
 
 
@@ -375,10 +379,13 @@ def figures(cells, out, formats):
          "medians, points are the seeds.")
 
     # 5. Quality metrics side by side.
-    fig, axes = plt.subplots(2, 3, figsize=(13, 7), squeeze=False)
+    qcols = (len(QUALITY) + 1) // 2
+    fig, axes = plt.subplots(2, qcols, figsize=(4.3 * qcols, 7), squeeze=False)
     width = 0.8 / max(1, len(labels))
+    for idx in range(len(QUALITY), 2 * qcols):
+        axes[idx // qcols][idx % qcols].axis("off")
     for idx, (key, title, _) in enumerate(QUALITY):
-        a = axes[idx // 3][idx % 3]
+        a = axes[idx // qcols][idx % qcols]
         for i, label in enumerate(labels):
             vals = []
             for scene in scenes:
@@ -395,7 +402,7 @@ def figures(cells, out, formats):
     fig.tight_layout()
     save(fig, "fig-quality", "Quality metrics computed identically for every algorithm (harness/metrics.hpp): "
          "coverage of the climbable surface, fraction of nodes attached, penetration into solids, self-intersection, "
-         "leaf overlap and leaf light exposure; median over seeds.")
+         "leaf overlap and leaf light exposure with and without the plant's own shade; median over seeds.")
 
     # 6. Growth curves: nodes against step, one panel per scene, the lowest seed.
     fig, axes = plt.subplots(nrow, ncol, figsize=(4.2 * ncol, 3.0 * nrow), squeeze=False)
@@ -452,8 +459,28 @@ window.addEventListener('load', function () {
 """
 
 
-def write_html(path, doc, results_path, rows, figs, grids, failed, caption):
+def write_metrics_doc(out):
+    """docs/metrics.md beside the report, as metrics.html (python3-markdown) or as it is; its name, or None."""
+    if not os.path.exists(METRICS_DOC):
+        return None
+    with open(METRICS_DOC) as f:
+        text = f.read()
+    try:
+        import markdown
+    except ImportError:
+        shutil.copyfile(METRICS_DOC, os.path.join(out, "metrics.md"))
+        return "metrics.md"
+    body = markdown.markdown(text, extensions=["tables", "fenced_code"])
+    with open(os.path.join(out, "metrics.html"), "w") as f:
+        f.write("<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>growbench: quality metrics</title>"
+                f"<style>{CSS}</style></head><body>{body}</body></html>\n")
+    return "metrics.html"
+
+
+def write_html(path, doc, results_path, rows, figs, grids, failed, caption, metrics_doc=None):
     e = html.escape
+    how = (f" <a href='{e(metrics_doc)}'>How each quality metric is defined, and its error bound</a>."
+           if metrics_doc else "")
     ctx = doc.get("context", {})
     suite = doc.get("suite", {})
     renders = doc.get("renders", {})
@@ -502,12 +529,12 @@ def write_html(path, doc, results_path, rows, figs, grids, failed, caption):
         parts.append(f"<tr{cls}>" + "".join(f"<td>{e(x)}</td>" for x in r) + "</tr>")
     parts.append("</table>")
     parts.append(f"<p class='note'>{e(caption)} Also as <a href='table.tex'>LaTeX (booktabs)</a> and "
-                 "<a href='table.md'>Markdown</a>.</p>")
+                 f"<a href='table.md'>Markdown</a>.{how}</p>")
 
     parts.append("<h2>Figures</h2>")
     for name, cap in figs:
         parts.append(f"<figure><img src='{e(name)}.png' alt='{e(name)}'><figcaption>{e(cap)} "
-                     f"<a href='{e(name)}.pdf'>PDF</a></figcaption></figure>")
+                     f"<a href='{e(name)}.pdf'>PDF</a>{how if name == 'fig-quality' else ''}</figcaption></figure>")
     parts.append("<p class='note'>Generated by reports/report.py from the results file alone. Intervals: "
                  "distribution-free 95% intervals of the median from order statistics ('~': fewer than 6 repetitions, "
                  "the full range). Exponents: least squares on log-log medians, 95% interval from Student's t.</p>")
@@ -560,7 +587,8 @@ def main(argv=None):
             else:
                 print(f"report: warning: render grid {src} is missing", file=sys.stderr)
         failed = [c for c in cells if not c.ok]
-        write_html(os.path.join(args.out, "index.html"), doc, args.results, rows, figs, grids, failed, caption)
+        write_html(os.path.join(args.out, "index.html"), doc, args.results, rows, figs, grids, failed, caption,
+                   write_metrics_doc(args.out))
         print(f"report: wrote {len(figs)} figures ({', '.join(formats)}), table.tex, table.md and index.html "
               f"in {args.out}", file=sys.stderr)
     except ReportError as e:

@@ -33,6 +33,9 @@ for f in index.html table.tex table.md fig-time-vs-size.png fig-time-vs-size.pdf
   [[ -s "$work/report/$f" ]] || fail "report has no $f"
 done
 grep -q '\\toprule' "$work/report/table.tex" || fail "table.tex is not booktabs"
+# The quality figure links the metrics' definitions, rendered beside the page.
+grep -q "href='metrics.html'" "$work/report/index.html" || fail "index.html does not link metrics.html"
+grep -q '<h2>penetration_nodes, penetration_samples</h2>' "$work/report/metrics.html" || fail "metrics.html is not docs/metrics.md"
 grep -q 'http' "$work/report/index.html" && fail "index.html refers to the network"
 
 browser=$(command -v chromium || command -v chromium-browser || true)
