@@ -22,7 +22,6 @@
 #include "harness/metrics.hpp"
 #include "harness/trial.hpp"
 #include "scenes/scene_library.hpp"
-#include "scenes/geometry.hpp"
 #include "scenes/scene_query.hpp"
 
 namespace growbench {
@@ -275,10 +274,6 @@ TEST_P(MetricsReference, EveryVerdictMatchesBruteForce) {
       continue;
     }
     ++checked;
-    if ((d.node_inside[i] == 1) != ref && getenv("DBG")) {
-      for (std::size_t k = 0; k < scene.meshes.size(); ++k)
-        fprintf(stderr, "P %.9g %.9g %.9g\n", nodes[i].position.x, nodes[i].position.y, nodes[i].position.z), fprintf(stderr, "mesh %zu solid %d winding %.6f dist %.3g inside_mesh %d sdf %.4g\n", k, (int)q.mesh_solid()[k], winding(scene.meshes[k], pos(i)), distance_to_mesh(scene.meshes[k], pos(i)), (int)q.inside_mesh(k, nodes[i].position), q.signed_distance(nodes[i].position));
-    }
     EXPECT_EQ(d.node_inside[i] == 1, ref) << "node " << i << " at " << nodes[i].position.x << "," << nodes[i].position.y
                                           << "," << nodes[i].position.z;
   }
@@ -344,12 +339,6 @@ TEST_P(MetricsReference, EveryVerdictMatchesBruteForce) {
           leaf_triangle(a, ta, va);
           leaf_triangle(b, tb, vb);
           const int r = reference_overlap(va, vb);
-          glm::vec3 fa[3] = {va[0], va[1], va[2]}, fb[3] = {vb[0], vb[1], vb[2]};
-          if (r == 1 && !geom::triangles_overlap(fa, fb) && getenv("DBG")) {
-            fprintf(stderr, "pair %zu %zu\n", i, j);
-            for (auto& v : va) fprintf(stderr, "  a %.9g %.9g %.9g\n", v.x, v.y, v.z);
-            for (auto& v : vb) fprintf(stderr, "  b %.9g %.9g %.9g\n", v.x, v.y, v.z);
-          }
           verdict = r == 1 || verdict == 1 ? 1 : std::max(verdict, r);
         }
     }
