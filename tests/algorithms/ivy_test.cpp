@@ -278,8 +278,12 @@ TEST(IvyReference, EmbreeAdhesionEqualsBruteForceOnTheBunny) {
         const auto& t = table.tris[id];
         const bool near = glm::length(p - geom::closest_point_on_triangle(p, t.a, t.b, t.c)) < gather * (1.0f - 1e-5f);
         const bool listed = std::binary_search(got.begin(), got.end(), id);
-        if (near) ASSERT_TRUE(listed) << mode << " point " << i << " triangle " << id;
-        if (listed) ASSERT_LE(ivy::box_distance2(t, p), gather * gather) << mode << " point " << i << " triangle " << id;
+        if (near) {
+          ASSERT_TRUE(listed) << mode << " point " << i << " triangle " << id;
+        }
+        if (listed) {
+          ASSERT_LE(ivy::box_distance2(t, p), gather * gather) << mode << " point " << i << " triangle " << id;
+        }
       }
       (hf == ivy::kNoTriangle ? none : attracted) += 1;
     };
