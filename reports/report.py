@@ -397,7 +397,11 @@ def figures(cells, out, formats):
         a.set_xticklabels(scenes, rotation=30, ha="right", fontsize=7)
         a.set_title(title)
         a.set_ylim(0, 1.05)
-    axes[0][0].legend(fontsize=7)
+    if len(QUALITY) < 2 * qcols:  # the spare panel holds the legend, clear of the bars
+        spare = axes[1][qcols - 1]
+        spare.legend(*axes[0][0].get_legend_handles_labels(), loc="center", fontsize=9, frameon=False)
+    else:
+        axes[0][0].legend(fontsize=7)
     fig.suptitle("Quality metrics (median over seeds; the same definitions for every algorithm)")
     fig.tight_layout()
     save(fig, "fig-quality", "Quality metrics computed identically for every algorithm (harness/metrics.hpp): "
