@@ -404,7 +404,7 @@ def figures(cells, out, formats):
         axes[0][0].legend(fontsize=7)
     fig.suptitle("Quality metrics (median over seeds; the same definitions for every algorithm)")
     fig.tight_layout()
-    save(fig, "fig-quality", "Quality metrics computed identically for every algorithm (harness/metrics.hpp): "
+    save(fig, "fig-quality", "Quality metrics computed identically for every algorithm (harness/output/metrics.hpp): "
          "coverage of the climbable surface, fraction of nodes attached, penetration into solids, self-intersection, "
          "leaf overlap and leaf light exposure with and without the plant's own shade; median over seeds.")
 

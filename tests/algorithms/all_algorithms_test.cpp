@@ -4,7 +4,7 @@
 
 #include "algorithms/algorithm.hpp"
 #include "grow_util.hpp"
-#include "harness/trial.hpp"
+#include "harness/run/trial.hpp"
 #include "scenes/scene_library.hpp"
 #include "scenes/scene_query.hpp"
 

@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "harness/compare.hpp"
+#include "harness/gate/compare.hpp"
 #include "test_util.hpp"
 
 namespace growbench {

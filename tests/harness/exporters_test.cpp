@@ -1,4 +1,4 @@
-#include "harness/exporters.hpp"
+#include "harness/output/exporters.hpp"
 
 #include <cmath>
 #include <cstring>

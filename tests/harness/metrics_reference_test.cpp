@@ -18,9 +18,9 @@
 
 #include "algorithms/algorithm.hpp"
 #include "core/random.hpp"
-#include "harness/mesher.hpp"
-#include "harness/metrics.hpp"
-#include "harness/trial.hpp"
+#include "harness/output/mesher.hpp"
+#include "harness/output/metrics.hpp"
+#include "harness/run/trial.hpp"
 #include "scenes/scene_library.hpp"
 #include "scenes/scene_query.hpp"
 

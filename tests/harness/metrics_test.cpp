@@ -1,4 +1,4 @@
-#include "harness/metrics.hpp"
+#include "harness/output/metrics.hpp"
 
 #include <algorithm>
 #include <random>
@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 #include <glm/gtc/quaternion.hpp>
 
-#include "harness/mesher.hpp"
+#include "harness/output/mesher.hpp"
 #include "scenes/geometry.hpp"
 #include "scenes/scene_library.hpp"
 #include "test_util.hpp"

@@ -1,6 +1,6 @@
 // Child processes: the report channel that lets the parent read a trial's results while the kernel is
 // still tearing it down, and the launcher whose children inherit its small heap instead of their owner's.
-#include "harness/process.hpp"
+#include "harness/run/process.hpp"
 
 #include <signal.h>
 #include <unistd.h>

@@ -10,9 +10,9 @@
 #include <nlohmann/json.hpp>
 #include <stb_image.h>
 
-#include "harness/exporters.hpp"
-#include "harness/render.hpp"
-#include "harness/render_results.hpp"
+#include "harness/output/exporters.hpp"
+#include "harness/render/render.hpp"
+#include "harness/render/render_results.hpp"
 #include "scenes/geometry.hpp"
 #include "test_util.hpp"
 

@@ -1,5 +1,5 @@
 // The statistics behind the statistical gate, against values worked out by hand.
-#include "harness/stats.hpp"
+#include "harness/stats/stats.hpp"
 
 #include <cmath>
 #include <vector>

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "algorithms/plant.hpp"
-#include "harness/mesher.hpp"
+#include "harness/output/mesher.hpp"
 
 namespace growbench {
 
@@ -18,9 +18,6 @@ std::uint64_t write_ply(const std::string& path, const OutputMesh& mesh);
 // vertex gives its radius (comments are ignored by OBJ readers).
 std::uint64_t write_skeleton_obj(const std::string& path, const Plant& plant);
 
-// Writes `size` bytes to PATH through a temporary file and a rename, so a reader never sees half a file.
-std::uint64_t write_file_atomic(const std::string& path, const char* data, std::size_t size);
-
 // The plant itself (nodes, organs, polygons; not the optional per-node attributes) in a small binary
 // file, so a trial can be rendered again later (`growbench render`) without growing it again.
 // Little-endian: magic "GBPLANT1", three u64 counts, then fixed-size records.
@@ -28,9 +25,6 @@ std::uint64_t write_plant_snapshot(const std::string& path, const Plant& plant);
 // Throws InputError naming the file when it is not a snapshot, is cut short, or holds an invalid plant.
 Plant read_plant_snapshot(const std::string& path);
 
-}  // namespace growbench
-
-namespace growbench {
 // Binary glTF 2.0 (.glb) written with tinygltf: one mesh with a primitive (and material) per group,
 // float positions and normals, uint32 indices.
 std::uint64_t write_glb(const std::string& path, const OutputMesh& mesh);

@@ -1,4 +1,4 @@
-#include "harness/compare.hpp"
+#include "harness/gate/compare.hpp"
 
 #include <cmath>
 #include <fstream>

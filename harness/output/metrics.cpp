@@ -1,4 +1,4 @@
-#include "harness/metrics.hpp"
+#include "harness/output/metrics.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -8,7 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/kdtree.hpp"
-#include "harness/mesher.hpp"
+#include "harness/output/mesher.hpp"
 #include "scenes/geometry.hpp"
 
 namespace growbench {

@@ -1,4 +1,4 @@
-#include "harness/ab.hpp"
+#include "harness/gate/ab.hpp"
 
 #include <unistd.h>
 
@@ -11,10 +11,11 @@
 
 #include "core/errors.hpp"
 #include "core/json_util.hpp"
-#include "harness/exporters.hpp"
-#include "harness/process.hpp"
-#include "harness/stats.hpp"
-#include "harness/trial.hpp"
+#include "harness/output/exporters.hpp"
+#include "harness/record/files.hpp"
+#include "harness/run/process.hpp"
+#include "harness/stats/stats.hpp"
+#include "harness/run/trial.hpp"
 
 namespace growbench {
 namespace {

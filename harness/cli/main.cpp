@@ -13,14 +13,16 @@
 #include "algorithms/algorithm.hpp"
 #include "algorithms/lsystem/lsystem.hpp"
 #include "core/errors.hpp"
-#include "harness/ab.hpp"
-#include "harness/compare.hpp"
-#include "harness/exporters.hpp"
-#include "harness/history.hpp"
-#include "harness/render_results.hpp"
-#include "harness/report.hpp"
-#include "harness/suite.hpp"
-#include "harness/trial.hpp"
+#include "harness/gate/ab.hpp"
+#include "harness/gate/compare.hpp"
+#include "harness/output/exporters.hpp"
+#include "harness/gate/history.hpp"
+#include "harness/render/render_results.hpp"
+#include "harness/report/report.hpp"
+#include "harness/report/summary.hpp"
+#include "harness/record/files.hpp"
+#include "harness/suite/suite.hpp"
+#include "harness/run/trial.hpp"
 #include "scenes/scene_library.hpp"
 
 namespace gb = growbench;
@@ -266,7 +268,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (*suite_cmd) {
-      // First, while this process is small: the launcher that forks the trials (harness/process.hpp).
+      // First, while this process is small: the launcher that forks the trials (harness/run/process.hpp).
       std::unique_ptr<gb::Launcher> launcher;
       if (!suite_instructions) launcher = gb::start_trial_launcher();
       gb::Suite suite = gb::load_suite(suite_file);
@@ -394,7 +396,7 @@ int main(int argc, char** argv) {
       }
       std::filesystem::create_directories(std::filesystem::path(bl_file).parent_path().empty()
                                               ? std::filesystem::path(".") : std::filesystem::path(bl_file).parent_path());
-      std::ofstream(bl_file) << fresh.dump(1) << "\n";
+      gb::write_file_atomic(bl_file, fresh.dump(1) + "\n");
       return 0;
     }
     if (*render_cmd) {

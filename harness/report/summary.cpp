@@ -6,8 +6,8 @@
 
 #include <fmt/format.h>
 
-#include "harness/stats.hpp"
-#include "harness/suite.hpp"
+#include "harness/stats/stats.hpp"
+#include "harness/report/summary.hpp"
 
 namespace growbench {
 namespace {
@@ -16,28 +16,6 @@ using nlohmann::json;
 
 // NAN for none: the tables print it as "-".
 double median(std::vector<double> v) { return v.empty() ? NAN : median_of(std::move(v)); }
-
-// Distribution-free confidence interval for the median from order statistics: the widest-coverage
-// pair (x_(l), x_(n+1-l)) with binomial coverage >= 95%. Below 6 samples no pair reaches 95%: the
-// interval is then the full range and `exact` is false.
-std::pair<double, double> median_ci(std::vector<double> v, bool& exact) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  exact = false;
-  if (n == 0) return {NAN, NAN};
-  // P(l <= B(n, 1/2) <= n - l) for l = 1, 2, ...
-  auto coverage = [&](std::size_t l) {
-    double p = 0.0;
-    for (std::size_t k = l; k + l <= n; ++k) p += std::exp(std::lgamma(n + 1.0) - std::lgamma(k + 1.0) - std::lgamma(n - k + 1.0) - n * std::log(2.0));
-    return p;
-  };
-  std::size_t best = 0;
-  for (std::size_t l = 1; 2 * l <= n; ++l)
-    if (coverage(l) >= 0.95) best = l;
-  if (best == 0) return {v.front(), v.back()};
-  exact = true;
-  return {v[best - 1], v[n - best]};
-}
 
 std::string si_bytes(double b) {
   if (!std::isfinite(b)) return "-";
@@ -88,7 +66,7 @@ std::string summarize_results(const json& results) {
         rss.push_back(s["phases"]["growth"]["peak_rss_bytes"].get<double>());
       }
       bool exact = false;
-      const auto [lo, hi] = median_ci(growth, exact);
+      const auto [lo, hi] = median_interval(growth, exact);
       const double med = median(growth);
       const std::string ci = growth.empty() ? "-" : fmt::format("{} [{}{}, {}]", format_seconds(med), exact ? "" : "~", format_seconds(lo), format_seconds(hi));
       const json m = t.value("metrics", json::object());

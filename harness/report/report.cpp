@@ -1,4 +1,4 @@
-#include "harness/report.hpp"
+#include "harness/report/report.hpp"
 
 #include <unistd.h>
 
@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 
 #include "core/errors.hpp"
-#include "harness/process.hpp"
+#include "harness/run/process.hpp"
 
 #ifndef GROWBENCH_SOURCE_DIR
 #define GROWBENCH_SOURCE_DIR ""

@@ -1,4 +1,4 @@
-#include "harness/history.hpp"
+#include "harness/gate/history.hpp"
 
 #include <filesystem>
 #include <map>
@@ -8,11 +8,11 @@
 
 #include "core/errors.hpp"
 #include "core/json_util.hpp"
-#include "harness/compare.hpp"
-#include "harness/exporters.hpp"
-#include "harness/report.hpp"
-#include "harness/stats.hpp"
-#include "harness/suite.hpp"
+#include "harness/gate/compare.hpp"
+#include "harness/output/exporters.hpp"
+#include "harness/report/report.hpp"
+#include "harness/stats/stats.hpp"
+#include "harness/record/files.hpp"
 
 namespace growbench {
 namespace fs = std::filesystem;

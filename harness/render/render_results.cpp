@@ -1,4 +1,4 @@
-#include "harness/render_results.hpp"
+#include "harness/render/render_results.hpp"
 
 #include <unistd.h>
 
@@ -16,9 +16,9 @@
 #include <fmt/format.h>
 
 #include "core/errors.hpp"
-#include "harness/exporters.hpp"
-#include "harness/process.hpp"
-#include "harness/suite.hpp"
+#include "harness/output/exporters.hpp"
+#include "harness/run/process.hpp"
+#include "harness/record/files.hpp"
 #include "scenes/scene_library.hpp"
 
 namespace growbench {

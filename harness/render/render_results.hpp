@@ -8,7 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "harness/render.hpp"
+#include "harness/render/render.hpp"
 
 namespace growbench {
 

@@ -1,4 +1,4 @@
-#include "harness/mesher.hpp"
+#include "harness/output/mesher.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -12,8 +12,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "harness/process.hpp"
-#include "harness/trial.hpp"
+#include "harness/run/process.hpp"
+#include "harness/run/trial.hpp"
 
 namespace growbench {
 
@@ -34,8 +34,6 @@ struct Suite {
   std::vector<SuiteConfig> configs;  // in run order: interleaved across algorithm entries
 };
 
-// A label as a file name: letters, digits and - _ . = , kept, anything else '_' (trial folders, grid images).
-std::string safe_name(std::string s);
 
 // Reads and validates a suite file: every algorithm, scene and parameter (and every swept value) is
 // checked before anything runs; an error names the file and the JSON path.
@@ -82,8 +80,5 @@ std::string run_suite(const Suite& suite, const SuiteRunOptions& options);
 // compared with each other, so that takes `mixed_machines`, and the merged context then says so.
 nlohmann::json merge_results(const std::vector<nlohmann::json>& shards, const std::vector<std::string>& names,
                              bool mixed_machines = false);
-
-// The summary table of a results file (median and 95% interval of timings, warnings on noise).
-std::string summarize_results(const nlohmann::json& results);
 
 }  // namespace growbench

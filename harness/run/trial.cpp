@@ -1,4 +1,4 @@
-#include "harness/trial.hpp"
+#include "harness/run/trial.hpp"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -26,9 +26,10 @@
 
 #include "algorithms/algorithm.hpp"
 #include "core/errors.hpp"
-#include "harness/alloc_counter.hpp"
-#include "harness/exporters.hpp"
-#include "harness/metrics.hpp"
+#include "harness/record/files.hpp"
+#include "harness/run/alloc_counter.hpp"
+#include "harness/output/exporters.hpp"
+#include "harness/output/metrics.hpp"
 #include "scenes/scene_library.hpp"
 #include "scenes/scene_query.hpp"
 
@@ -474,8 +475,7 @@ nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const P
     const std::string path = (std::filesystem::path(spec.out_dir) / "record.json").string();
     // Indented for people reading `growbench run` output; compact when a suite parent parses it.
     const std::string text = rec.dump(spec.skip_teardown ? -1 : 2) + "\n";
-    std::ofstream(path + ".tmp") << text;
-    std::filesystem::rename(path + ".tmp", path);
+    write_file_atomic(path, text);
   }
   if (spec.skip_teardown) {
     struct Kept {

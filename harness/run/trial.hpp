@@ -10,7 +10,7 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
-#include "harness/mesher.hpp"
+#include "harness/output/mesher.hpp"
 
 namespace growbench {
 
@@ -31,7 +31,7 @@ struct TrialSpec {
   // length (0: no budget). Checked after every step.
   std::size_t budget_nodes = 0;
   double budget_length_m = 0.0;
-  bool metrics = true;                    // compute the quality metrics (harness/metrics.hpp)
+  bool metrics = true;                    // compute the quality metrics (harness/output/metrics.hpp)
   // Growth animation: every this many steps (and after the last) the plant is written to
   // OUT/frames/step_NNNNNN.gbplant for `growbench render` (0: no frames). The time this takes is
   // recorded and taken out of the growth phase's wall and CPU time.

@@ -14,7 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "algorithms/plant.hpp"
-#include "harness/mesher.hpp"
+#include "harness/output/mesher.hpp"
 #include "scenes/scene.hpp"
 
 namespace growbench {

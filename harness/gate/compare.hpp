@@ -2,7 +2,7 @@
 // on what must not change by accident: behaviour (geometry hash, counts, quality metrics), allocations
 // (count and bytes per phase), output bytes per format, and instruction counts per phase (from
 // `growbench suite --instructions`, callgrind). When both sides are timing runs with repetitions, their
-// wall and CPU times are compared too, statistically (harness/stats.hpp), and reported: a timing flag
+// wall and CPU times are compared too, statistically (harness/stats/stats.hpp), and reported: a timing flag
 // never fails here, because it has not been confirmed; `growbench ab` reruns and confirms.
 #pragma once
 
@@ -11,7 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "harness/stats.hpp"
+#include "harness/stats/stats.hpp"
 
 namespace growbench {
 

@@ -1,4 +1,4 @@
-#include "harness/exporters.hpp"
+#include "harness/output/exporters.hpp"
 
 #include <array>
 #include <bit>
@@ -17,62 +17,19 @@
 #include <tiny_gltf.h>
 
 #include "core/errors.hpp"
+#include "harness/record/files.hpp"
 
 namespace growbench {
 namespace {
 
 static_assert(std::endian::native == std::endian::little, "the PLY writer assumes a little-endian host");
 
-// The last step of every atomic write: the finished PATH.tmp becomes PATH.
-void rename_into_place(const std::string& tmp, const std::string& path) {
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) throw std::runtime_error(fmt::format("{}: cannot rename into place: {}", path, ec.message()));
-}
-
-// Writes a file atomically (PATH.tmp, renamed at the end) through a fixed 64 KiB buffer. A buffer the
-// size of the file would be fresh memory: on a paravirtualised VM its page faults (~20 us per 4 KiB)
-// cost more than the writing (18 ms for a 3.3 MB snapshot).
-class ChunkedFile {
- public:
-  explicit ChunkedFile(std::string path) : path_(std::move(path)), tmp_(path_ + ".tmp"), f_(std::fopen(tmp_.c_str(), "wb"), &std::fclose) {
-    if (!f_) throw std::runtime_error(fmt::format("{}: cannot open for writing", tmp_));
-  }
-  void bytes(const void* p, std::size_t n) {
-    if (used_ + n > buf_.size()) flush();
-    if (n > buf_.size()) return write(p, n);
-    std::memcpy(buf_.data() + used_, p, n);
-    used_ += n;
-  }
-  std::uint64_t finish() {
-    flush();
-    if (std::fclose(f_.release()) != 0) throw std::runtime_error(fmt::format("{}: write failed", tmp_));
-    rename_into_place(tmp_, path_);
-    return total_;
-  }
-
- private:
-  void flush() {
-    write(buf_.data(), used_);
-    used_ = 0;
-  }
-  void write(const void* p, std::size_t n) {
-    if (n > 0 && std::fwrite(p, 1, n, f_.get()) != n) throw std::runtime_error(fmt::format("{}: write failed", tmp_));
-    total_ += n;
-  }
-  std::string path_, tmp_;
-  std::unique_ptr<FILE, int (*)(FILE*)> f_;
-  std::array<char, 1 << 16> buf_;  // only the bytes written into it are read
-  std::size_t used_ = 0;
-  std::uint64_t total_ = 0;
-};
-
-// Formatted text streamed through a ChunkedFile: records are formatted into a small buffer that is handed
+// Formatted text streamed through an AtomicFile: records are formatted into a small buffer that is handed
 // on whenever it passes 64 KiB. Building a whole OBJ in memory first (560 MB for the wall's ivy) cost
 // more in page faults and reallocation copies than the formatting itself.
 class TextFile {
  public:
-  explicit TextFile(const std::string& path) : file_(std::make_unique<ChunkedFile>(path)) {}
+  explicit TextFile(const std::string& path) : file_(std::make_unique<AtomicFile>(path)) {}
   template <class... Args>
   void print(fmt::format_string<Args...> f, Args&&... args) {
     fmt::format_to(std::back_inserter(buf_), f, std::forward<Args>(args)...);
@@ -129,17 +86,11 @@ class TextFile {
     file_->bytes(buf_.data(), buf_.size());
     buf_.clear();
   }
-  std::unique_ptr<ChunkedFile> file_;  // its 64 KiB buffer on the heap, not on a worker's stack
+  std::unique_ptr<AtomicFile> file_;  // its 64 KiB buffer on the heap, not on a worker's stack
   fmt::memory_buffer buf_;
 };
 
 }  // namespace
-
-std::uint64_t write_file_atomic(const std::string& path, const char* data, std::size_t size) {
-  ChunkedFile f(path);
-  f.bytes(data, size);  // larger than the buffer: written straight through
-  return f.finish();
-}
 
 std::uint64_t write_obj(const std::string& path, const OutputMesh& m) {
   const std::filesystem::path p(path);
@@ -173,8 +124,8 @@ std::uint64_t write_obj(const std::string& path, const OutputMesh& m) {
 }
 
 std::uint64_t write_ply(const std::string& path, const OutputMesh& m) {
-  auto file = std::make_unique<ChunkedFile>(path);
-  ChunkedFile& f = *file;
+  auto file = std::make_unique<AtomicFile>(path);
+  AtomicFile& f = *file;
   const std::string header = fmt::format(
       "ply\nformat binary_little_endian 1.0\ncomment growbench plant\n"
       "element vertex {}\nproperty float x\nproperty float y\nproperty float z\n"
@@ -316,7 +267,7 @@ namespace {
 constexpr char kSnapshotMagic[8] = {'G', 'B', 'P', 'L', 'A', 'N', 'T', '1'};
 
 template <class T>
-void put(ChunkedFile& b, const T& v) {
+void put(AtomicFile& b, const T& v) {
   static_assert(std::is_trivially_copyable_v<T>);
   b.bytes(&v, sizeof(T));
 }
@@ -355,8 +306,8 @@ class SnapshotReader {
 }  // namespace
 
 std::uint64_t write_plant_snapshot(const std::string& path, const Plant& plant) {
-  auto file = std::make_unique<ChunkedFile>(path);  // its buffer on the heap, not on a worker's stack
-  ChunkedFile& b = *file;
+  auto file = std::make_unique<AtomicFile>(path);  // its buffer on the heap, not on a worker's stack
+  AtomicFile& b = *file;
   b.bytes(kSnapshotMagic, sizeof(kSnapshotMagic));
   put<std::uint64_t>(b, plant.nodes.size());
   for (const auto& n : plant.nodes) {

@@ -1,5 +1,5 @@
 // Replaced global allocation functions that count calls and requested bytes, then defer to malloc.
-#include "harness/alloc_counter.hpp"
+#include "harness/run/alloc_counter.hpp"
 
 #include <atomic>
 #include <cstdlib>

@@ -1,4 +1,4 @@
-#include "harness/render.hpp"
+#include "harness/render/render.hpp"
 
 
 #include <algorithm>
@@ -16,8 +16,9 @@
 
 #include "core/errors.hpp"
 #include "core/json_util.hpp"
-#include "harness/exporters.hpp"
-#include "harness/process.hpp"
+#include "harness/output/exporters.hpp"
+#include "harness/record/files.hpp"
+#include "harness/run/process.hpp"
 #include "scenes/geometry.hpp"
 
 namespace growbench {
@@ -502,10 +503,14 @@ void write_grid(const std::string& png_path, const std::string& title, const std
     }
   }
   cairo_surface_flush(surface.get());
-  const std::string tmp = png_path + ".tmp";
-  if (cairo_surface_write_to_png(surface.get(), tmp.c_str()) != CAIRO_STATUS_SUCCESS)
+  AtomicFile png(png_path);
+  const auto sink = [](void* f, const unsigned char* data, unsigned int n) {
+    static_cast<AtomicFile*>(f)->bytes(data, n);
+    return CAIRO_STATUS_SUCCESS;
+  };
+  if (cairo_surface_write_to_png_stream(surface.get(), sink, &png) != CAIRO_STATUS_SUCCESS)
     throw std::runtime_error(fmt::format("{}: cannot write the grid image", png_path));
-  fs::rename(tmp, png_path);
+  png.finish();
 }
 
 }  // namespace growbench

@@ -7,11 +7,17 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace growbench {
 
 double median_of(std::vector<double> v);
+
+// A distribution-free 95% confidence interval for the median: the order statistics (x_(l), x_(n+1-l)) of
+// the largest l whose binomial coverage is at least 95%. Below 6 samples no pair reaches it: the interval
+// is then the full range and `exact` is false. NANs for an empty sample.
+std::pair<double, double> median_interval(std::vector<double> v, bool& exact);
 
 // A duration for a table: "645.8 us", "12.34 ms", "1.234 s" ("-" when not finite).
 std::string format_seconds(double s);

@@ -1,4 +1,5 @@
-#include "harness/suite.hpp"
+#include "harness/record/files.hpp"
+#include "harness/suite/suite.hpp"
 
 #include <signal.h>
 #include <unistd.h>
@@ -25,8 +26,8 @@
 #include "algorithms/algorithm.hpp"
 #include "core/errors.hpp"
 #include "core/json_util.hpp"
-#include "harness/exporters.hpp"
-#include "harness/process.hpp"
+#include "harness/output/exporters.hpp"
+#include "harness/run/process.hpp"
 #include "scenes/scene_library.hpp"
 
 namespace growbench {
@@ -395,13 +396,6 @@ void apply_sample(json& t, const json& sample, const json& cell) {
 }
 
 }  // namespace
-
-std::string safe_name(std::string s) {
-  for (auto& c : s)
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.' || c == '=' || c == ','))
-      c = '_';
-  return s;
-}
 
 Suite load_suite(const std::string& path) {
   if (!fs::exists(path)) throw InputError(fmt::format("{}: no such suite file", path));

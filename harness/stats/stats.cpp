@@ -1,4 +1,4 @@
-#include "harness/stats.hpp"
+#include "harness/stats/stats.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,6 +8,25 @@
 #include "core/random.hpp"
 
 namespace growbench {
+
+std::pair<double, double> median_interval(std::vector<double> v, bool& exact) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  exact = false;
+  if (n == 0) return {NAN, NAN};
+  // P(l <= B(n, 1/2) <= n - l) for l = 1, 2, ...
+  auto coverage = [&](std::size_t l) {
+    double p = 0.0;
+    for (std::size_t k = l; k + l <= n; ++k) p += std::exp(std::lgamma(n + 1.0) - std::lgamma(k + 1.0) - std::lgamma(n - k + 1.0) - n * std::log(2.0));
+    return p;
+  };
+  std::size_t best = 0;
+  for (std::size_t l = 1; 2 * l <= n; ++l)
+    if (coverage(l) >= 0.95) best = l;
+  if (best == 0) return {v.front(), v.back()};
+  exact = true;
+  return {v[best - 1], v[n - best]};
+}
 
 double median_of(std::vector<double> v) {
   if (v.empty()) return 0.0;
