@@ -9,7 +9,7 @@ JOBS ?= $(shell nproc)
 # Repetitions per cell in `make demo` (a number, or "suite" for the standard suite's own).
 DEMO_REPETITIONS ?= 1
 
-.PHONY: all deps configure build cli test demo demo-full bench gate baseline clean
+.PHONY: all deps configure build cli test demo demo-full bench gate baseline format clean
 
 all: build
 
@@ -52,6 +52,10 @@ baseline: build
 
 bench: build
 	$(BUILD)/bench/growbench_bench
+
+# Reformat every C and C++ file with the committed .clang-format (CI checks it: scripts/check-format).
+format:
+	bash scripts/check-format --fix
 
 clean:
 	rm -rf build out
