@@ -33,40 +33,41 @@ const AlgorithmInfo kInfo = {
     "spacecol",
     "Runions space colonization: attraction points pull nodes; open or closed venation; free, avoid or cling",
     {
-        {"venation", ParamType::Choice, std::string("open"), -INFINITY, INFINITY, "",
-         "open: each point pulls its nearest node; closed: every node in its relative neighbourhood", {"open", "closed"}},
-        {"points", ParamType::Choice, std::string("auto"), -INFINITY, INFINITY, "",
-         "attraction points: in the scene envelope, on the surfaces (area-weighted), or from points_file; auto = "
-         "surface when surface=cling or the scene has no envelope, else envelope",
-         {"auto", "envelope", "surface", "file"}},
-        {"points_file", ParamType::String, std::string(""), -INFINITY, INFINITY, "",
-         "text file of attraction points, one 'x y z' (or x,y,z) per line, # comments (points=file)", {}},
-        {"point_count", ParamType::Int, std::int64_t{20000}, 1, 5e7, "", "number of attraction points sampled", {}},
-        {"surface_offset", ParamType::Real, 0.01, 0, 10, "m",
-         "surface-sampled points are lifted this far along the surface normal", {}},
-        {"influence", ParamType::Real, 0.25, 1e-4, 1e3, "m", "influence radius d_i: points farther from every node are ignored", {}},
-        {"kill", ParamType::Real, 0.05, 1e-5, 1e3, "m", "kill distance d_k: a point this close to a node is removed", {}},
-        {"step", ParamType::Real, 0.02, 1e-5, 1e2, "m", "step length D between a node and its child", {}},
-        {"tropism", ParamType::Vec3, glm::dvec3(0.0), -10, 10, "",
-         "added to each normalised growth direction (e.g. 0,0.2,0 bends growth upward)", {}},
-        {"noise", ParamType::Real, 0.0, 0, 10, "", "random unit vector times this is added to each growth direction", {}},
-        {"surface", ParamType::Choice, std::string("free"), -INFINITY, INFINITY, "",
-         "free: ignore solids; avoid: push nodes out of solids; cling: hold nodes at cling_distance from the "
-         "nearest surface (the Hyphae collision vector)",
-         {"free", "avoid", "cling"}},
-        {"cling_distance", ParamType::Real, 0.01, 0, 10, "m",
-         "distance kept from the surface (cling), minimum clearance (avoid)", {}},
-        {"split", ParamType::Real, 0.1, 0, 1, "",
-         "when the pulls on a node nearly cancel (|sum| < split * count), grow two children toward the two most "
-         "opposed points instead of stalling (0: such a node stalls)", {}},
-        {"seek", ParamType::Bool, true, -INFINITY, INFINITY, "",
-         "while no attraction point is within reach, roots grow along their seed direction", {}},
-        {"tip_radius", ParamType::Real, 0.002, 1e-6, 10, "m", "radius of branch tips (pipe model)", {}},
-        {"pipe_exponent", ParamType::Real, 2.5, 1, 4, "", "pipe model exponent n: r^n = sum of children's r^n", {}},
-        {"leaves", ParamType::Choice, std::string("tips"), -INFINITY, INFINITY, "",
-         "where leaves go: none, at branch tips, every leaf_interval nodes, or both", {"none", "tips", "interval", "both"}},
-        {"leaf_interval", ParamType::Int, std::int64_t{6}, 1, 1000, "", "a leaf every k nodes along a branch (leaves=interval/both)", {}},
-        {"leaf_size", ParamType::Real, 0.05, 0, 10, "m", "leaf blade length", {}},
+        param::choice("venation", "open", {"open", "closed"})
+            .doc("open: each point pulls its nearest node; closed: every node in its relative neighbourhood"),
+        param::choice("points", "auto", {"auto", "envelope", "surface", "file"})
+            .doc("attraction points: in the scene envelope, on the surfaces (area-weighted), or from points_file; "
+                 "auto = surface when surface=cling or the scene has no envelope, else envelope"),
+        param::text("points_file")
+            .doc("text file of attraction points, one 'x y z' (or x,y,z) per line, # comments (points=file)"),
+        param::integer("point_count", 20000).range(1, 5e7).doc("number of attraction points sampled"),
+        param::real("surface_offset", 0.01).range(0, 10).unit("m")
+            .doc("surface-sampled points are lifted this far along the surface normal"),
+        param::real("influence", 0.25).range(1e-4, 1e3).unit("m")
+            .doc("influence radius d_i: points farther from every node are ignored"),
+        param::real("kill", 0.05).range(1e-5, 1e3).unit("m")
+            .doc("kill distance d_k: a point this close to a node is removed"),
+        param::real("step", 0.02).range(1e-5, 1e2).unit("m").doc("step length D between a node and its child"),
+        param::vec3("tropism", glm::dvec3(0.0)).range(-10, 10)
+            .doc("added to each normalised growth direction (e.g. 0,0.2,0 bends growth upward)"),
+        param::real("noise", 0.0).range(0, 10).doc("random unit vector times this is added to each growth direction"),
+        param::choice("surface", "free", {"free", "avoid", "cling"})
+            .doc("free: ignore solids; avoid: push nodes out of solids; cling: hold nodes at cling_distance from the "
+                 "nearest surface (the Hyphae collision vector)"),
+        param::real("cling_distance", 0.01).range(0, 10).unit("m")
+            .doc("distance kept from the surface (cling), minimum clearance (avoid)"),
+        param::real("split", 0.1).range(0, 1)
+            .doc("when the pulls on a node nearly cancel (|sum| < split * count), grow two children toward the two "
+                 "most opposed points instead of stalling (0: such a node stalls)"),
+        param::boolean("seek", true)
+            .doc("while no attraction point is within reach, roots grow along their seed direction"),
+        param::real("tip_radius", 0.002).range(1e-6, 10).unit("m").doc("radius of branch tips (pipe model)"),
+        param::real("pipe_exponent", 2.5).range(1, 4).doc("pipe model exponent n: r^n = sum of children's r^n"),
+        param::choice("leaves", "tips", {"none", "tips", "interval", "both"})
+            .doc("where leaves go: none, at branch tips, every leaf_interval nodes, or both"),
+        param::integer("leaf_interval", 6).range(1, 1000)
+            .doc("a leaf every k nodes along a branch (leaves=interval/both)"),
+        param::real("leaf_size", 0.05).range(0, 10).unit("m").doc("leaf blade length"),
     },
     {}};
 
