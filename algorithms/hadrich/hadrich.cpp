@@ -164,7 +164,7 @@ class HadrichAlgorithm final : public GrowthAlgorithm {
   const AlgorithmInfo& describe() const override { return kInfo; }
   void start(const Scene& scene, const SceneQuery& query, const Params& params, std::uint64_t seed) override {
     if (!query.has_sdf()) throw InputError("hadrich: the scene query has no distance field (collision needs one)");
-    sim_ = std::make_unique<hadrich::Simulator>(scene, query, hadrich::make_config(params), seed);
+    sim_ = std::make_unique<hadrich::Simulator>(scene, query, hadrich::make_setup(params), seed);
   }
   bool step() override { return sim_->step(); }
   const Plant& plant() const override { return sim_ ? sim_->plant() : empty_; }
@@ -225,54 +225,55 @@ std::vector<Cut> parse_cuts(const std::string& text) {
   return cuts;
 }
 
-Config make_config(const Params& p) {
-  Config c;
+Setup make_setup(const Params& p) {
   auto f = [&](const char* k) { return static_cast<float>(p.real(k)); };
   auto i = [&](const char* k) { return static_cast<int>(p.integer(k)); };
-  c.particle_length = f("particle_length");
-  c.max_particles = static_cast<std::size_t>(p.integer("max_particles"));
-  c.growth_speed = f("growth_speed") * f("growth_factor");
-  c.shade_growth = f("shade_growth");
-  c.tip_radius = f("tip_radius");
-  c.max_radius = std::max(f("max_radius"), c.tip_radius);
-  c.thickening = f("thickening");
-  c.radius_falloff = f("radius_falloff");
-  c.adaptation = f("adaptation");
-  c.attraction_range = f("attraction_range");
-  c.approach_angle = f("approach_angle") * kDeg;
-  c.phototropism = f("phototropism");
-  c.light_rays = i("light_rays");
-  c.light_spread = f("light_spread") * kDeg;
-  c.direction_noise = f("direction_noise") * kDeg;
-  c.zone_rate = f("zone_rate");
-  c.max_laterals = i("max_laterals");
-  c.shoot_density = f("shoot_density");
-  c.branch_variance = f("branch_variance");
-  c.max_order = i("max_order");
-  c.leaf_density = f("leaf_density");
-  c.leaf_step = i("leaf_step");
-  c.phyllotaxis = f("phyllotaxis") * kDeg;
-  c.leaf_size = f("leaf_size");
-  c.leaf_light = f("leaf_light");
-  c.dt = f("dt");
-  c.gravity = f("gravity");
-  c.stiffness = f("stiffness");
-  c.iterations = i("iterations");
-  c.damping = f("damping");
-  c.friction = f("friction");
-  c.elasticity = f("elasticity");
-  c.anchor_pull = f("anchor_pull");
-  c.anchor_release = f("anchor_release");
-  c.break_sensitivity = f("break_sensitivity");
   const glm::vec3 w(p.vec3("wind"));
   if (glm::length(w) < 1e-12f && p.real("wind_strength") > 0.0)
     throw InputError("hadrich: parameter 'wind' is the zero vector but wind_strength > 0; expected a direction");
-  c.wind = glm::length(w) > 0.0f ? glm::normalize(w) : w;
-  c.wind_strength = f("wind_strength");
-  c.wind_gusts = f("wind_gusts");
-  c.gust_period = f("gust_period");
-  c.cuts = parse_cuts(p.text("prune"));
-  return c;
+  // Designated initializers: a member left out is a warning (-Wmissing-field-initializers), an error in CI.
+  const Config c = {
+      .particle_length = f("particle_length"),
+      .max_particles = static_cast<std::size_t>(p.integer("max_particles")),
+      .growth_speed = f("growth_speed") * f("growth_factor"),
+      .shade_growth = f("shade_growth"),
+      .tip_radius = f("tip_radius"),
+      .max_radius = std::max(f("max_radius"), f("tip_radius")),
+      .thickening = f("thickening"),
+      .radius_falloff = f("radius_falloff"),
+      .adaptation = f("adaptation"),
+      .attraction_range = f("attraction_range"),
+      .approach_angle = f("approach_angle") * kDeg,
+      .phototropism = f("phototropism"),
+      .light_rays = i("light_rays"),
+      .light_spread = f("light_spread") * kDeg,
+      .direction_noise = f("direction_noise") * kDeg,
+      .zone_rate = f("zone_rate"),
+      .max_laterals = i("max_laterals"),
+      .max_order = i("max_order"),
+      .leaf_step = i("leaf_step"),
+      .shoot_density = f("shoot_density"),
+      .branch_variance = f("branch_variance"),
+      .leaf_density = f("leaf_density"),
+      .phyllotaxis = f("phyllotaxis") * kDeg,
+      .leaf_size = f("leaf_size"),
+      .leaf_light = f("leaf_light"),
+      .dt = f("dt"),
+      .gravity = f("gravity"),
+      .stiffness = f("stiffness"),
+      .damping = f("damping"),
+      .iterations = i("iterations"),
+      .friction = f("friction"),
+      .elasticity = f("elasticity"),
+      .anchor_pull = f("anchor_pull"),
+      .anchor_release = f("anchor_release"),
+      .break_sensitivity = f("break_sensitivity"),
+      .wind = glm::length(w) > 0.0f ? glm::normalize(w) : w,
+      .wind_strength = f("wind_strength"),
+      .wind_gusts = f("wind_gusts"),
+      .gust_period = f("gust_period"),
+  };
+  return {c, parse_cuts(p.text("prune"))};
 }
 
 // ---- particles ----
@@ -292,8 +293,8 @@ std::size_t Particles::bytes_per_particle() {
 
 // ---- simulator ----
 
-Simulator::Simulator(const Scene& scene, const SceneQuery& query, const Config& config, std::uint64_t seed)
-    : scene_(scene), query_(query), cfg_(config), seed_(seed) {
+Simulator::Simulator(const Scene& scene, const SceneQuery& query, const Setup& setup, std::uint64_t seed)
+    : scene_(scene), query_(query), cfg_(setup.config), cuts_(setup.cuts), seed_(seed) {
   p_.reserve(cfg_.max_particles);
   seed_started_.assign(scene_.seeds.size(), 0);
   if (scene_.seeds.empty()) throw InputError(fmt::format("hadrich: scene '{}' has no seeds", scene_.name));
@@ -792,7 +793,7 @@ void Simulator::physics() {
 
 bool Simulator::step() {
   add_seeds();
-  for (const Cut& c : cfg_.cuts)
+  for (const Cut& c : cuts_)
     if (c.step == step_) prune(c.point, c.radius);
   if (!tips_.empty()) {
     grow_tips();
