@@ -330,38 +330,41 @@ float bounding_sphere_radius(const Scene& scene) {
 }
 
 Config make_config(const Params& p, const Scene& scene) {
-  Config c;
-  c.radius = bounding_sphere_radius(scene);
-  if (!(c.radius > 0.0f))
+  const float radius = bounding_sphere_radius(scene);
+  if (!(radius > 0.0f))
     throw InputError(fmt::format("ivy: scene '{}' has no climbable surface to size R by", scene.name));
   const bool relative = p.text("units") == "relative";
-  const float R = relative ? c.radius : 1.0f;
-  c.step = static_cast<float>(p.real("ivy_size")) * R;
+  const float R = relative ? radius : 1.0f;
+  const float step = static_cast<float>(p.real("ivy_size")) * R;
   const double sum = p.real("primary_weight") + p.real("random_weight") + p.real("adhesion_weight");
   if (!(sum > 0.0))
     throw InputError("ivy: primary_weight, random_weight and adhesion_weight are all 0; at least one must be > 0");
-  c.primary = static_cast<float>(p.real("primary_weight") / sum);
-  c.random = static_cast<float>(p.real("random_weight") / sum);
-  c.adhesion = static_cast<float>(p.real("adhesion_weight") / sum);
-  c.gravity = static_cast<float>(p.real("gravity_weight"));
-  c.branching = static_cast<float>(p.real("branching_probability"));
-  c.leaf_probability = static_cast<float>(p.real("leaf_probability"));
-  c.leaf_size = static_cast<float>(p.real("leaf_size")) * (relative ? c.step : 1.0f);
-  c.branch_size = static_cast<float>(p.real("branch_size")) * (relative ? c.step : 1.0f);
-  c.max_float = static_cast<float>(p.real("max_float_length")) * R;
-  c.max_adhesion = static_cast<float>(p.real("max_adhesion_distance")) * R;
-  c.max_root_length = p.real("max_root_length") * R;
-  c.max_total_length = p.real("max_total_length") * R;
-  c.adhesion_mode = p.text("adhesion") == "luft" ? AdhesionMode::Luft : AdhesionMode::Closest;
-  c.collision_mode = p.text("collision") == "luft" ? CollisionMode::Luft : CollisionMode::Blender;
   const std::string& leaves = p.text("leaves");
-  c.leaf_mode = leaves == "luft" ? LeafMode::Luft : leaves == "blender" ? LeafMode::Blender : LeafMode::None;
-  c.max_depth = static_cast<int>(p.integer("max_depth"));
-  c.branches_per_step = static_cast<int>(p.integer("branches_per_step"));
-  c.smoothing_passes = static_cast<int>(p.integer("smoothing_passes"));
-  c.leaf_passes = static_cast<int>(p.integer("leaf_passes"));
-  c.margin = 1e-5f * c.radius;
-  return c;
+  // Designated initializers: a member left out is a warning (-Wmissing-field-initializers), an error in CI.
+  return {
+      .radius = radius,
+      .step = step,
+      .primary = static_cast<float>(p.real("primary_weight") / sum),
+      .random = static_cast<float>(p.real("random_weight") / sum),
+      .adhesion = static_cast<float>(p.real("adhesion_weight") / sum),
+      .gravity = static_cast<float>(p.real("gravity_weight")),
+      .branching = static_cast<float>(p.real("branching_probability")),
+      .leaf_probability = static_cast<float>(p.real("leaf_probability")),
+      .leaf_size = static_cast<float>(p.real("leaf_size")) * (relative ? step : 1.0f),
+      .branch_size = static_cast<float>(p.real("branch_size")) * (relative ? step : 1.0f),
+      .max_float = static_cast<float>(p.real("max_float_length")) * R,
+      .max_adhesion = static_cast<float>(p.real("max_adhesion_distance")) * R,
+      .max_root_length = p.real("max_root_length") * R,
+      .max_total_length = p.real("max_total_length") * R,
+      .adhesion_mode = p.text("adhesion") == "luft" ? AdhesionMode::Luft : AdhesionMode::Closest,
+      .collision_mode = p.text("collision") == "luft" ? CollisionMode::Luft : CollisionMode::Blender,
+      .leaf_mode = leaves == "luft" ? LeafMode::Luft : leaves == "blender" ? LeafMode::Blender : LeafMode::None,
+      .max_depth = static_cast<int>(p.integer("max_depth")),
+      .branches_per_step = static_cast<int>(p.integer("branches_per_step")),
+      .smoothing_passes = static_cast<int>(p.integer("smoothing_passes")),
+      .leaf_passes = static_cast<int>(p.integer("leaf_passes")),
+      .margin = 1e-5f * radius,
+  };
 }
 
 std::span<const std::uint32_t> Candidates::sorted_unique() {
