@@ -244,48 +244,60 @@ Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* quer
     stbi_image_free(px);
   }
 
-  auto& d = s.derive;
-  d.host = s.host.get();
-  d.seed = seed;
-  d.probability = p.text("probability") == "normalized" ? lsys::ProbabilityMode::Normalized : lsys::ProbabilityMode::Sequential;
-  d.brackets_transparent = p.boolean("context_siblings") || s.grammar.ignore.test('[') || s.grammar.ignore.test(']');
-  d.max_symbols = static_cast<std::size_t>(p.integer("max_symbols"));
-  d.max_params = d.max_symbols * 2;
-  d.env.assign(lsys::kMaxSlots, 0.0);
-  d.env[lsys::kVarA] = p.real("angle");
-  d.env[lsys::kVarB] = p.real("b");
-  d.env[lsys::kVarC] = p.real("c");
-  d.env[lsys::kVarD] = p.real("d");
+  // Designated initializers: a member left out is a warning (-Wmissing-field-initializers), an error in CI.
+  const auto max_symbols = static_cast<std::size_t>(p.integer("max_symbols"));
+  s.derive = {
+      .host = s.host.get(),
+      .seed = seed,
+      .stream = 0,  // set for each plant before it is rewritten
+      .probability = p.text("probability") == "normalized" ? lsys::ProbabilityMode::Normalized
+                                                           : lsys::ProbabilityMode::Sequential,
+      .brackets_transparent =
+          p.boolean("context_siblings") || s.grammar.ignore.test('[') || s.grammar.ignore.test(']'),
+      .max_symbols = max_symbols,
+      .max_params = max_symbols * 2,
+      .env = {},
+  };
+  auto& env = s.derive.env;
+  env[lsys::kVarA] = p.real("angle");
+  env[lsys::kVarB] = p.real("b");
+  env[lsys::kVarC] = p.real("c");
+  env[lsys::kVarD] = p.real("d");
   for (const auto& [name, value] : vars) {
-    if (name == "b") d.env[lsys::kVarB] = value;
-    if (name == "c") d.env[lsys::kVarC] = value;
-    if (name == "d") d.env[lsys::kVarD] = value;
+    if (name == "b") env[lsys::kVarB] = value;
+    if (name == "c") env[lsys::kVarC] = value;
+    if (name == "d") env[lsys::kVarD] = value;
   }
-  d.env[lsys::kVarGravity] = p.real("gravity");
-  d.env[lsys::kVarLength] = p.real("step_size");
-  d.env[lsys::kVarWidth] = p.real("thickness");
-  for (std::size_t k = 0; k < user_values.size(); ++k) d.env[lsys::kUserVar0 + k] = user_values[k];
+  env[lsys::kVarGravity] = p.real("gravity");
+  env[lsys::kVarLength] = p.real("step_size");
+  env[lsys::kVarWidth] = p.real("thickness");
+  for (std::size_t k = 0; k < user_values.size(); ++k) env[lsys::kUserVar0 + k] = user_values[k];
 
-  auto& t = s.turtle;
-  t.step = p.real("step_size");
-  t.step_scale = p.real("step_scale");
-  t.angle = p.real("angle");
-  t.angle_scale = p.real("angle_scale");
-  t.thickness = p.real("thickness");
-  t.thickness_scale = p.real("thickness_scale");
-  t.gravity = p.real("gravity");
-  t.random_scale = p.real("random_scale");
-  t.uv_increment = {p.real("u_increment"), p.real("v_increment")};
-  t.convention = p.text("convention") == "abop" ? lsys::Convention::Abop : lsys::Convention::Houdini;
-  t.continuous_length = p.boolean("continuous_length");
-  t.continuous_angles = p.boolean("continuous_angles");
-  t.continuous_width = p.boolean("continuous_width");
-  t.seed = seed;
-  t.wrap_offset = p.real("wrap_offset");
-  if (p.text("surface") == "wrap") {
-    if (!query) throw InputError("surface=wrap needs a scene with surfaces");
-    t.wrap = query;
-  }
+  if (p.text("surface") == "wrap" && !query) throw InputError("surface=wrap needs a scene with surfaces");
+  s.turtle = {
+      .step = p.real("step_size"),
+      .step_scale = p.real("step_scale"),
+      .angle = p.real("angle"),
+      .angle_scale = p.real("angle_scale"),
+      .thickness = p.real("thickness"),
+      .thickness_scale = p.real("thickness_scale"),
+      .gravity = p.real("gravity"),
+      .random_scale = p.real("random_scale"),
+      .uv_increment = {p.real("u_increment"), p.real("v_increment")},
+      .convention = p.text("convention") == "abop" ? lsys::Convention::Abop : lsys::Convention::Houdini,
+      // The plant's own, set for each plant when it is drawn; these draw one plant at the origin, +Y.
+      .fraction = 1.0,
+      .continuous_length = p.boolean("continuous_length"),
+      .continuous_angles = p.boolean("continuous_angles"),
+      .continuous_width = p.boolean("continuous_width"),
+      .seed = seed,
+      .stream = 0,
+      .origin = glm::dvec3(0.0),
+      .heading = glm::dvec3(0.0, 1.0, 0.0),
+      .wrap = p.text("surface") == "wrap" ? query : nullptr,
+      .wrap_offset = p.real("wrap_offset"),
+      .birth_step = 0,
+  };
   const double generations = p.real("generations");
   const int full = static_cast<int>(std::floor(generations + 1e-9));
   s.fraction = generations - full < 1e-6 ? 0.0 : generations - full;
