@@ -43,10 +43,11 @@ constexpr float kDeg = std::numbers::pi_v<float> / 180.0f;
 
 // ---- parameter table (what `growbench list` prints) ----
 const AlgorithmInfo kInfo = {
-    "hadrich",
-    "Hädrich et al. 2017 climbing plants: oriented particles grow at the tips, adapt to surfaces, seek light, "
-    "branch (Leeuwenberg), carry leaves, anchor, collide with the distance field and bend under shape matching",
-    {
+    .name = "hadrich",
+    .summary =
+        "Hädrich et al. 2017 climbing plants: oriented particles grow at the tips, adapt to surfaces, seek light, "
+        "branch (Leeuwenberg), carry leaves, anchor, collide with the distance field and bend under shape matching",
+    .params = {
         // growth
         param::real("particle_length", 0.02).range(1e-4, 10).unit("m")
             .doc("length of a grown particle (one plant segment)"),
@@ -117,7 +118,8 @@ const AlgorithmInfo kInfo = {
             .doc("cuts during the run, 'x,y,z,radius@step; ...': at that step the particles whose head is within "
                  "radius of the point (radius 0: the nearest one) and all they grew are removed"),
     },
-    {}};
+    .test_params = {"max_particles=2000"},
+};
 
 constexpr std::uint64_t kNoiseStream = 0x4ad71c00ull << 32;
 constexpr std::uint64_t kBranchStream = 0x4ad7b400ull << 32;
@@ -179,8 +181,7 @@ class HadrichAlgorithm final : public GrowthAlgorithm {
 
 }  // namespace
 
-const AlgorithmInfo& hadrich_info() { return kInfo; }
-std::unique_ptr<GrowthAlgorithm> make_hadrich() { return std::make_unique<HadrichAlgorithm>(); }
+GROWBENCH_REGISTER_ALGORITHM(hadrich, HadrichAlgorithm, kInfo, hadrich::Config)
 
 namespace hadrich {
 

@@ -17,9 +17,6 @@
 
 namespace growbench {
 
-const AlgorithmInfo& hadrich_info();
-std::unique_ptr<GrowthAlgorithm> make_hadrich();
-
 namespace hadrich {
 
 constexpr int kMaxChildren = 4;  // one successor + at most 3 laterals (max_laterals <= 3)

@@ -37,10 +37,11 @@ namespace {
 
 // ---- parameter table (what `growbench list` prints) ----
 const AlgorithmInfo kInfo = {
-    "ivy",
-    "Luft's ivy generator (and Blender IvyGen): roots creep along surfaces by primary, random, adhesion and "
-    "gravity terms, mirror off what they hit, branch, and carry leaves facing away from the surface",
-    {
+    .name = "ivy",
+    .summary =
+        "Luft's ivy generator (and Blender IvyGen): roots creep along surfaces by primary, random, adhesion and "
+        "gravity terms, mirror off what they hit, branch, and carry leaves facing away from the surface",
+    .params = {
         param::choice("preset", "luft", {"luft", "blender"})
             .doc("luft: Luft's defaults, sizes relative to R (the scene's bounding-sphere radius); blender: Blender "
                  "IvyGen 0.1.5 (absolute metres, max_root_length 1, one ray collision without death, closest-point "
@@ -88,7 +89,7 @@ const AlgorithmInfo kInfo = {
         param::integer("leaf_passes", 10).range(0, 1000)
             .doc("leaf passes per root (luft) or tries per segment (blender)"),
     },
-    {
+    .presets = {
         {"luft", {}},
         {"blender",
          {{"units", std::string("absolute")},
@@ -104,7 +105,9 @@ const AlgorithmInfo kInfo = {
           {"collision", std::string("blender")},
           {"smoothing_passes", std::int64_t{1}},
           {"leaves", std::string("blender")}}},
-    }};
+    },
+    .test_params = {"max_root_length=1"},
+};
 
 constexpr glm::vec3 kUp{0.0f, 1.0f, 0.0f};
 constexpr std::uint64_t kGrowStream = 0x1f7a11ull << 32;
@@ -298,8 +301,7 @@ class IvyAlgorithm final : public GrowthAlgorithm {
 
 }  // namespace
 
-const AlgorithmInfo& ivy_info() { return kInfo; }
-std::unique_ptr<GrowthAlgorithm> make_ivy() { return std::make_unique<IvyAlgorithm>(); }
+GROWBENCH_REGISTER_ALGORITHM(ivy, IvyAlgorithm, kInfo, ivy::Config)
 
 namespace ivy {
 

@@ -12,9 +12,6 @@
 
 namespace growbench {
 
-const AlgorithmInfo& ivy_info();
-std::unique_ptr<GrowthAlgorithm> make_ivy();
-
 namespace ivy {
 
 constexpr std::uint32_t kNoTriangle = 0xFFFFFFFFu;

@@ -36,9 +36,11 @@ namespace {
 
 // ---- parameter table (what `growbench list` prints) ----
 const AlgorithmInfo kInfo = {
-    "lsystem",
-    "L-system, Houdini dialect: parametric, stochastic, context-sensitive rules, 3D turtle, J/K/M organs, in(), wrap",
-    {
+    .name = "lsystem",
+    .summary =
+        "L-system, Houdini dialect: parametric, stochastic, context-sensitive rules, 3D turtle, J/K/M organs, "
+        "in(), wrap",
+    .params = {
         param::text("grammar")
             .doc("a .lsys grammar file (premise, rules and values) or an example name (koch-island, bush, ...)"),
         param::text("premise", "FFFA").doc("the string at generation 0"),
@@ -89,7 +91,8 @@ const AlgorithmInfo kInfo = {
         param::integer("max_symbols", 50'000'000).range(1, 2e9)
             .doc("a generation that would exceed this many symbols stops the run with an error"),
     },
-    {}};
+    .test_params = {"surface=wrap"},  // a free tree passes through solids
+};
 
 const std::vector<std::string>& setting_names() {
   static const std::vector<std::string> names = [] {
@@ -422,8 +425,7 @@ class LSystem final : public GrowthAlgorithm {
 
 }  // namespace
 
-const AlgorithmInfo& lsystem_info() { return kInfo; }
-std::unique_ptr<GrowthAlgorithm> make_lsystem() { return std::make_unique<LSystem>(); }
+GROWBENCH_REGISTER_ALGORITHM(lsystem, LSystem, kInfo, lsys::TurtleSettings, lsys::DeriveSettings)
 
 std::vector<std::string> lsystem_examples() {
   std::vector<std::string> names;

@@ -30,9 +30,10 @@ namespace {
 
 // ---- parameter table (what `growbench list` prints) ----
 const AlgorithmInfo kInfo = {
-    "spacecol",
-    "Runions space colonization: attraction points pull nodes; open or closed venation; free, avoid or cling",
-    {
+    .name = "spacecol",
+    .summary =
+        "Runions space colonization: attraction points pull nodes; open or closed venation; free, avoid or cling",
+    .params = {
         param::choice("venation", "open", {"open", "closed"})
             .doc("open: each point pulls its nearest node; closed: every node in its relative neighbourhood"),
         param::choice("points", "auto", {"auto", "envelope", "surface", "file"})
@@ -69,7 +70,8 @@ const AlgorithmInfo kInfo = {
             .doc("a leaf every k nodes along a branch (leaves=interval/both)"),
         param::real("leaf_size", 0.05).range(0, 10).unit("m").doc("leaf blade length"),
     },
-    {}};
+    .test_params = {"surface=avoid", "point_count=4000"},
+};
 
 using Cloud = Vec3Cloud;
 using PointTree = Vec3Tree;
@@ -776,7 +778,6 @@ Config make_config(const Params& p) {
 
 }  // namespace spacecol
 
-const AlgorithmInfo& spacecol_info() { return kInfo; }
-std::unique_ptr<GrowthAlgorithm> make_spacecol() { return std::make_unique<SpaceColonization>(); }
+GROWBENCH_REGISTER_ALGORITHM(spacecol, SpaceColonization, kInfo, spacecol::Config)
 
 }  // namespace growbench

@@ -1,18 +1,12 @@
 #pragma once
 
 #include <cstddef>
-#include <memory>
 
 #include <glm/glm.hpp>
 
 #include "algorithms/algorithm.hpp"
 
-namespace growbench {
-
-const AlgorithmInfo& spacecol_info();
-std::unique_ptr<GrowthAlgorithm> make_spacecol();
-
-namespace spacecol {
+namespace growbench::spacecol {
 
 enum class Points { Auto, Envelope, Surface, File };
 enum class Surface { Free, Avoid, Cling };
@@ -39,5 +33,4 @@ struct Config {
 };
 Config make_config(const Params& params);
 
-}  // namespace spacecol
-}  // namespace growbench
+}  // namespace growbench::spacecol
