@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include "algorithms/plant.hpp"
@@ -17,8 +19,13 @@ namespace growbench {
 struct AlgorithmInfo {
   std::string name;
   std::string summary;
-  std::vector<ParamSpec> params;  // the table `growbench list` prints
-  std::vector<ParamPreset> presets;  // defaults selected by the `preset` parameter (may be empty)
+  // The table `growbench list` prints and `--set` validates: the only place a parameter's default,
+  // range, unit and doc live. The algorithm reads typed values from Params.
+  std::vector<ParamSpec> params;
+  std::vector<ParamPreset> presets{};  // defaults selected by the `preset` parameter (may be empty)
+  // Assignments under which the algorithm promises that no node enters a solid, at a size that keeps
+  // the every-algorithm-every-scene test quick.
+  std::vector<std::string> test_params;
 };
 
 class GrowthAlgorithm {
@@ -42,16 +49,53 @@ class GrowthAlgorithm {
   [[nodiscard]] virtual std::vector<std::pair<std::string, double>> stats() const { return {}; }
 };
 
+// A struct an algorithm reads its parameters into, as its registration names it.
+struct ParamStruct {
+  std::string type;  // as written in GROWBENCH_REGISTER_ALGORITHM
+  // False when the struct keeps defaults of its own beside the table: any default member initializer
+  // (or a member that constructs itself, such as a container) makes it non-trivial.
+  bool trivially_default_constructible;
+};
+
 struct AlgorithmEntry {
   const AlgorithmInfo& (*info)();
   std::unique_ptr<GrowthAlgorithm> (*make)();
+  std::vector<ParamStruct> param_structs;
 };
 
-// The explicit list of algorithms (algorithms/registry.cpp). Adding one is a folder plus one line there.
+// Every algorithm, in the order of the add_subdirectory lines in algorithms/CMakeLists.txt (the order
+// `growbench list` prints). The build generates it from the algorithms' growbench_algorithm() calls, so
+// adding an algorithm is its folder plus one line there.
 const std::vector<AlgorithmEntry>& algorithm_registry();
 // Finds an algorithm by name; InputError listing the valid names otherwise.
 const AlgorithmEntry& find_algorithm(const std::string& name);
 // Default parameters of an algorithm, with `owner` set for error messages.
 Params default_params(const AlgorithmEntry& entry);
 
+// Splits "a::X, b::Y<int, 2>" into its `count` type names (commas inside <> or () do not split); the
+// whole text for each when the count does not match.
+std::vector<std::string> split_type_list(std::string_view list, std::size_t count);
+
+template <class Algorithm, class... ParamStructs>
+AlgorithmEntry make_algorithm_entry(const AlgorithmInfo& (*info)(), std::string_view param_struct_names) {
+  static_assert(sizeof...(ParamStructs) > 0, "name the struct(s) the algorithm reads its parameters into");
+  AlgorithmEntry e{info, []() -> std::unique_ptr<GrowthAlgorithm> { return std::make_unique<Algorithm>(); }, {}};
+  const std::vector<std::string> names = split_type_list(param_struct_names, sizeof...(ParamStructs));
+  std::size_t k = 0;
+  (e.param_structs.push_back({names[k++], std::is_trivially_default_constructible_v<ParamStructs>}), ...);
+  return e;
+}
+
 }  // namespace growbench
+
+// Registers an algorithm from its main file: defines growbench::algorithm_entry_NAME(), which the
+// registry the build generates calls. NAME is the NAME of the folder's growbench_algorithm() call;
+// CLASS the GrowthAlgorithm; INFO the AlgorithmInfo its describe() returns; then the struct(s) it reads
+// its parameters into, which the registry test checks keep no defaults of their own. Use it at the
+// scope of namespace growbench, outside any anonymous namespace. There is no static registration
+// object: the linker would drop it from the static library.
+#define GROWBENCH_REGISTER_ALGORITHM(NAME, CLASS, INFO, ...)                                    \
+  ::growbench::AlgorithmEntry algorithm_entry_##NAME() {                                        \
+    return ::growbench::make_algorithm_entry<CLASS, __VA_ARGS__>(                               \
+        []() -> const ::growbench::AlgorithmInfo& { return INFO; }, #__VA_ARGS__);              \
+  }

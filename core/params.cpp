@@ -59,6 +59,45 @@ std::string ParamSpec::allowed() const {
   return "?";
 }
 
+namespace param {
+
+Row::Row(std::string name, ParamType type, ParamValue default_value) {
+  spec_.name = std::move(name);
+  spec_.type = type;
+  spec_.default_value = std::move(default_value);
+}
+Row&& Row::range(double min, double max) && {
+  spec_.min = min;
+  spec_.max = max;
+  return std::move(*this);
+}
+Row&& Row::unit(std::string unit) && {
+  spec_.unit = std::move(unit);
+  return std::move(*this);
+}
+Row&& Row::doc(std::string doc) && {
+  spec_.doc = std::move(doc);
+  return std::move(*this);
+}
+Row::operator ParamSpec() && { return std::move(spec_); }
+
+Row integer(std::string name, std::int64_t default_value) { return {std::move(name), ParamType::Int, default_value}; }
+Row real(std::string name, double default_value) { return {std::move(name), ParamType::Real, default_value}; }
+Row boolean(std::string name, bool default_value) { return {std::move(name), ParamType::Bool, default_value}; }
+Row text(std::string name, std::string default_value) {
+  return {std::move(name), ParamType::String, std::move(default_value)};
+}
+Row vec3(std::string name, const glm::dvec3& default_value) { return {std::move(name), ParamType::Vec3, default_value}; }
+Row choice(std::string name, std::string default_value, std::vector<std::string> choices) {
+  if (std::find(choices.begin(), choices.end(), default_value) == choices.end())
+    throw std::logic_error(fmt::format("parameter '{}': default '{}' is not one of its choices", name, default_value));
+  Row row(std::move(name), ParamType::Choice, std::move(default_value));
+  row.spec_.choices = std::move(choices);
+  return row;
+}
+
+}  // namespace param
+
 std::string closest_match(std::string_view name, const std::vector<std::string>& candidates) {
   // Optimal string alignment distance: insertions, deletions, substitutions and adjacent transpositions
   // ("stpe" is one edit from "step").

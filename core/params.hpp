@@ -37,6 +37,36 @@ struct ParamSpec {
 
 std::string format_value(const ParamValue& v);
 
+// Builders for the rows of a parameter table, so that a row states only what it has: its type, name and
+// default, then whichever of range, unit, doc it needs (a row without a range accepts any finite value):
+//   param::real("gravity", 0.5).range(0, 1000).unit("m/s^2").doc("a_g, downwards")
+//   param::choice("venation", "open", {"open", "closed"}).doc("...")
+// A row converts to its ParamSpec where the table is built.
+namespace param {
+
+class Row {
+ public:
+  Row(std::string name, ParamType type, ParamValue default_value);
+  Row&& range(double min, double max) &&;
+  Row&& unit(std::string unit) &&;
+  Row&& doc(std::string doc) &&;
+  operator ParamSpec() &&;  // NOLINT(google-explicit-constructor): a table is a list of rows
+
+ private:
+  friend Row choice(std::string name, std::string default_value, std::vector<std::string> choices);
+  ParamSpec spec_;
+};
+
+Row integer(std::string name, std::int64_t default_value);
+Row real(std::string name, double default_value);
+Row boolean(std::string name, bool default_value);
+Row text(std::string name, std::string default_value = {});
+Row vec3(std::string name, const glm::dvec3& default_value);
+// The default must be one of the choices (std::logic_error otherwise: a mistake in the table).
+Row choice(std::string name, std::string default_value, std::vector<std::string> choices);
+
+}  // namespace param
+
 // The closest candidate to `name` by edit distance, or "" when nothing is close.
 std::string closest_match(std::string_view name, const std::vector<std::string>& candidates);
 

@@ -15,13 +15,6 @@ namespace {
 
 constexpr float kSink = 0.05f;  // how far standing solids reach below y = 0
 
-ParamSpec real_param(const char* name, double def, double lo, double hi, const char* unit, const char* doc) {
-  return ParamSpec{name, ParamType::Real, def, lo, hi, unit, doc, {}};
-}
-ParamSpec int_param(const char* name, std::int64_t def, double lo, double hi, const char* doc) {
-  return ParamSpec{name, ParamType::Int, def, lo, hi, "", doc, {}};
-}
-
 TriangleMesh ground(float half) {
   auto g = geom::make_box("ground", {-half, -0.1f, -half}, {half, 0.0f, half});
   g.climbable = false;
@@ -222,45 +215,47 @@ Scene build_envelope(const Params& p) {
 const std::vector<StandardScene>& standard_scenes() {
   static const std::vector<StandardScene> list = {
       {"wall", "a 3 x 2.5 m wall standing on the ground, seeds at its foot",
-       {real_param("width", 3.0, 0.5, 50, "m", "wall width (x)"),
-        real_param("height", 2.5, 0.5, 50, "m", "wall height (y)"),
-        real_param("thickness", 0.2, 0.02, 5, "m", "wall thickness (z)"),
-        int_param("seeds", 3, 1, 64, "number of seeds along the wall's foot")},
+       {param::real("width", 3.0).range(0.5, 50).unit("m").doc("wall width (x)"),
+        param::real("height", 2.5).range(0.5, 50).unit("m").doc("wall height (y)"),
+        param::real("thickness", 0.2).range(0.02, 5).unit("m").doc("wall thickness (z)"),
+        param::integer("seeds", 3).range(1, 64).doc("number of seeds along the wall's foot")},
        build_wall},
       {"facade", "a wall with window openings and a ledge",
-       {real_param("width", 4.0, 1, 50, "m", "facade width"), real_param("height", 3.0, 1, 50, "m", "facade height"),
-        int_param("windows", 2, 1, 16, "number of window openings"),
-        int_param("seeds", 3, 1, 64, "number of seeds along the facade's foot")},
+       {param::real("width", 4.0).range(1, 50).unit("m").doc("facade width"),
+        param::real("height", 3.0).range(1, 50).unit("m").doc("facade height"),
+        param::integer("windows", 2).range(1, 16).doc("number of window openings"),
+        param::integer("seeds", 3).range(1, 64).doc("number of seeds along the facade's foot")},
        build_facade},
       {"column", "a cylindrical pillar",
-       {real_param("radius", 0.25, 0.02, 10, "m", "column radius"),
-        real_param("height", 3.0, 0.5, 50, "m", "column height"),
-        int_param("seeds", 3, 1, 64, "number of seeds around the base")},
+       {param::real("radius", 0.25).range(0.02, 10).unit("m").doc("column radius"),
+        param::real("height", 3.0).range(0.5, 50).unit("m").doc("column height"),
+        param::integer("seeds", 3).range(1, 64).doc("number of seeds around the base")},
        build_column},
       {"corner", "two walls meeting at a right angle under an overhanging roof",
-       {real_param("width", 3.0, 0.5, 50, "m", "length of each wall"),
-        real_param("height", 2.6, 0.5, 50, "m", "wall height"),
-        real_param("overhang", 1.2, 0, 20, "m", "how far the roof reaches out over the corner (z)"),
-        int_param("seeds", 3, 1, 64, "number of seeds (the first in the corner)")},
+       {param::real("width", 3.0).range(0.5, 50).unit("m").doc("length of each wall"),
+        param::real("height", 2.6).range(0.5, 50).unit("m").doc("wall height"),
+        param::real("overhang", 1.2).range(0, 20).unit("m").doc("how far the roof reaches out over the corner (z)"),
+        param::integer("seeds", 3).range(1, 64).doc("number of seeds (the first in the corner)")},
        build_corner},
       {"pergola", "four posts, two beams and rafters",
-       {real_param("width", 2.4, 0.5, 50, "m", "distance between posts along x"),
-        real_param("depth", 1.6, 0.5, 50, "m", "distance between posts along z"),
-        real_param("height", 2.4, 0.5, 50, "m", "post height"), int_param("rafters", 6, 2, 64, "number of rafters")},
+       {param::real("width", 2.4).range(0.5, 50).unit("m").doc("distance between posts along x"),
+        param::real("depth", 1.6).range(0.5, 50).unit("m").doc("distance between posts along z"),
+        param::real("height", 2.4).range(0.5, 50).unit("m").doc("post height"),
+        param::integer("rafters", 6).range(2, 64).doc("number of rafters")},
        build_pergola},
       {"boulder", "a noisy rock on the ground",
-       {real_param("radius", 1.0, 0.1, 20, "m", "rock radius"),
-        real_param("roughness", 0.15, 0, 0.5, "", "relative bump height"),
-        int_param("seeds", 3, 1, 64, "number of seeds around the rock")},
+       {param::real("radius", 1.0).range(0.1, 20).unit("m").doc("rock radius"),
+        param::real("roughness", 0.15).range(0, 0.5).doc("relative bump height"),
+        param::integer("seeds", 3).range(1, 64).doc("number of seeds around the rock")},
        build_boulder},
       {"trunk", "a tree trunk with one branch",
-       {real_param("radius", 0.3, 0.05, 5, "m", "trunk radius at the base"),
-        real_param("height", 3.5, 0.5, 50, "m", "trunk height"),
-        int_param("seeds", 3, 1, 64, "number of seeds around the base")},
+       {param::real("radius", 0.3).range(0.05, 5).unit("m").doc("trunk radius at the base"),
+        param::real("height", 3.5).range(0.5, 50).unit("m").doc("trunk height"),
+        param::integer("seeds", 3).range(1, 64).doc("number of seeds around the base")},
        build_trunk},
       {"envelope", "ground and a crown envelope, nothing to climb (free-growing trees)",
-       {real_param("crown_radius", 1.2, 0.1, 50, "m", "horizontal radius of the ellipsoidal crown"),
-        real_param("crown_height", 2.2, 0.2, 100, "m", "height of the crown's centre")},
+       {param::real("crown_radius", 1.2).range(0.1, 50).unit("m").doc("horizontal radius of the ellipsoidal crown"),
+        param::real("crown_height", 2.2).range(0.2, 100).unit("m").doc("height of the crown's centre")},
        build_envelope},
   };
   return list;
@@ -268,11 +263,11 @@ const std::vector<StandardScene>& standard_scenes() {
 
 const std::vector<ParamSpec>& mesh_scene_params() {
   static const std::vector<ParamSpec> specs = {
-      real_param("size", 2.0, 0.0, 1000, "m",
-                 "scale the mesh so its largest extent is this (0 keeps the file's units and placement)"),
-      ParamSpec{"ground", ParamType::Bool, true, -INFINITY, INFINITY, "",
-                "a ground slab under the mesh (not climbable), where shoots that fall or hang come to rest, as on the "
-                "floor every render shows; false: the mesh alone", {}},
+      param::real("size", 2.0).range(0.0, 1000).unit("m")
+          .doc("scale the mesh so its largest extent is this (0 keeps the file's units and placement)"),
+      param::boolean("ground", true)
+          .doc("a ground slab under the mesh (not climbable), where shoots that fall or hang come to rest, as on the "
+               "floor every render shows; false: the mesh alone"),
   };
   return specs;
 }

@@ -43,78 +43,83 @@ constexpr float kDeg = std::numbers::pi_v<float> / 180.0f;
 
 // ---- parameter table (what `growbench list` prints) ----
 const AlgorithmInfo kInfo = {
-    "hadrich",
-    "Hädrich et al. 2017 climbing plants: oriented particles grow at the tips, adapt to surfaces, seek light, "
-    "branch (Leeuwenberg), carry leaves, anchor, collide with the distance field and bend under shape matching",
-    {
+    .name = "hadrich",
+    .summary =
+        "Hädrich et al. 2017 climbing plants: oriented particles grow at the tips, adapt to surfaces, seek light, "
+        "branch (Leeuwenberg), carry leaves, anchor, collide with the distance field and bend under shape matching",
+    .params = {
         // growth
-        {"particle_length", ParamType::Real, 0.02, 1e-4, 10, "m", "length of a grown particle (one plant segment)", {}},
-        {"max_particles", ParamType::Int, std::int64_t{10000}, 1, 20000000, "",
-         "the preallocated pool; growth ends when it is full", {}},
-        {"growth_speed", ParamType::Real, 0.2, 0, 100, "m/s", "tip extension speed in full light", {}},
-        {"growth_factor", ParamType::Real, 1.0, 0, 100, "", "user factor on the growth speed", {}},
-        {"shade_growth", ParamType::Real, 0.25, 0, 1, "",
-         "growth in full shade as a fraction of full-light growth: speed x (this + (1 - this)(1 - O)) (the paper "
-         "scales growth with light but gives no formula)", {}},
-        {"tip_radius", ParamType::Real, 0.002, 1e-6, 10, "m", "radius of a new main-axis particle", {}},
-        {"max_radius", ParamType::Real, 0.012, 1e-6, 10, "m", "radius a main-axis particle thickens to", {}},
-        {"thickening", ParamType::Real, 0.002, 0, 10, "m/s", "secondary growth: radius gained per second by grown particles",
-         {}},
-        {"radius_falloff", ParamType::Real, 0.7, 0.01, 1, "", "a lateral branch's radii are its parent's times this", {}},
+        param::real("particle_length", 0.02).range(1e-4, 10).unit("m")
+            .doc("length of a grown particle (one plant segment)"),
+        param::integer("max_particles", 10000).range(1, 20000000)
+            .doc("the preallocated pool; growth ends when it is full"),
+        param::real("growth_speed", 0.2).range(0, 100).unit("m/s").doc("tip extension speed in full light"),
+        param::real("growth_factor", 1.0).range(0, 100).doc("user factor on the growth speed"),
+        param::real("shade_growth", 0.25).range(0, 1)
+            .doc("growth in full shade as a fraction of full-light growth: speed x (this + (1 - this)(1 - O)) (the "
+                 "paper scales growth with light but gives no formula)"),
+        param::real("tip_radius", 0.002).range(1e-6, 10).unit("m").doc("radius of a new main-axis particle"),
+        param::real("max_radius", 0.012).range(1e-6, 10).unit("m").doc("radius a main-axis particle thickens to"),
+        param::real("thickening", 0.002).range(0, 10).unit("m/s")
+            .doc("secondary growth: radius gained per second by grown particles"),
+        param::real("radius_falloff", 0.7).range(0.01, 1).doc("a lateral branch's radii are its parent's times this"),
         // tropisms
-        {"adaptation", ParamType::Real, 6.0, 0, 1000, "1/s",
-         "tau: surface adaptation, angle (v_s . v_f - sin(approach)) tau dt about v_s x v_f (the seed's tau in [0, 1] "
-         "turns too slowly at dt = 25 ms; a rate here)", {}},
-        {"attraction_range", ParamType::Real, 0.15, 0, 100, "m", "surfaces farther than this from a tip do not attract it",
-         {}},
-        {"approach_angle", ParamType::Real, 25.0, 0, 90, "deg",
-         "a tip in range turns to meet the surface at this angle, falling linearly to 0 (parallel) at contact; 0: the "
-         "paper's rule, which only aligns tips with surfaces", {}},
-        {"phototropism", ParamType::Real, 1.5, 0, 1000, "1/s", "eta: turn toward the light by (1 - O) eta dt", {}},
-        {"light_rays", ParamType::Int, std::int64_t{4}, 0, 256, "", "rays per tip to estimate occlusion O (0: O = 0)", {}},
-        {"light_spread", ParamType::Real, 5.0, 0, 60, "deg", "half-angle of the cone of light rays (soft shadows)", {}},
-        {"direction_noise", ParamType::Real, 6.0, 0, 90, "deg", "random turn of each new particle (at most)", {}},
-        {"zone_rate", ParamType::Real, 3.0, 0, 1000, "1/s",
-         "a tip in an attract (repel) zone turns toward (away from) its centre by strength x this x dt", {}},
+        param::real("adaptation", 6.0).range(0, 1000).unit("1/s")
+            .doc("tau: surface adaptation, angle (v_s . v_f - sin(approach)) tau dt about v_s x v_f (the seed's tau "
+                 "in [0, 1] turns too slowly at dt = 25 ms; a rate here)"),
+        param::real("attraction_range", 0.15).range(0, 100).unit("m")
+            .doc("surfaces farther than this from a tip do not attract it"),
+        param::real("approach_angle", 25.0).range(0, 90).unit("deg")
+            .doc("a tip in range turns to meet the surface at this angle, falling linearly to 0 (parallel) at "
+                 "contact; 0: the paper's rule, which only aligns tips with surfaces"),
+        param::real("phototropism", 1.5).range(0, 1000).unit("1/s").doc("eta: turn toward the light by (1 - O) eta dt"),
+        param::integer("light_rays", 4).range(0, 256).doc("rays per tip to estimate occlusion O (0: O = 0)"),
+        param::real("light_spread", 5.0).range(0, 60).unit("deg")
+            .doc("half-angle of the cone of light rays (soft shadows)"),
+        param::real("direction_noise", 6.0).range(0, 90).unit("deg").doc("random turn of each new particle (at most)"),
+        param::real("zone_rate", 3.0).range(0, 1000).unit("1/s")
+            .doc("a tip in an attract (repel) zone turns toward (away from) its centre by strength x this x dt"),
         // branching and leaves
-        {"max_laterals", ParamType::Int, std::int64_t{1}, 0, 3, "", "B: lateral buds per particle (Leeuwenberg)", {}},
-        {"shoot_density", ParamType::Real, 0.08, 0, 1, "", "BP: probability that each lateral bud grows a shoot", {}},
-        {"branch_variance", ParamType::Real, 0.8, 0, 1, "",
-         "V: a lateral leaves its parent at V x 90 deg (minus up to 30% at random)", {}},
-        {"max_order", ParamType::Int, std::int64_t{3}, 0, 100, "", "shoots of this branch order grow no laterals", {}},
-        {"leaf_density", ParamType::Real, 0.7, 0, 1, "", "probability of a leaf at each leaf_step-th particle", {}},
-        {"leaf_step", ParamType::Int, std::int64_t{1}, 1, 1000, "", "phyllotaxis step: particles between leaf sites", {}},
-        {"phyllotaxis", ParamType::Real, 137.5, 0, 360, "deg", "turn between successive leaf sites of a shoot", {}},
-        {"leaf_size", ParamType::Real, 0.05, 0, 10, "m", "leaf blade length", {}},
-        {"leaf_light", ParamType::Real, 0.7, 0, 1, "",
-         "how far a leaf turns its upper side from its phyllotactic pose to face the light", {}},
+        param::integer("max_laterals", 1).range(0, 3).doc("B: lateral buds per particle (Leeuwenberg)"),
+        param::real("shoot_density", 0.08).range(0, 1).doc("BP: probability that each lateral bud grows a shoot"),
+        param::real("branch_variance", 0.8).range(0, 1)
+            .doc("V: a lateral leaves its parent at V x 90 deg (minus up to 30% at random)"),
+        param::integer("max_order", 3).range(0, 100).doc("shoots of this branch order grow no laterals"),
+        param::real("leaf_density", 0.7).range(0, 1).doc("probability of a leaf at each leaf_step-th particle"),
+        param::integer("leaf_step", 1).range(1, 1000).doc("phyllotaxis step: particles between leaf sites"),
+        param::real("phyllotaxis", 137.5).range(0, 360).unit("deg")
+            .doc("turn between successive leaf sites of a shoot"),
+        param::real("leaf_size", 0.05).range(0, 10).unit("m").doc("leaf blade length"),
+        param::real("leaf_light", 0.7).range(0, 1)
+            .doc("how far a leaf turns its upper side from its phyllotactic pose to face the light"),
         // physics
-        {"dt", ParamType::Real, 0.025, 1e-4, 1, "s", "time step (the paper: 25 ms)", {}},
-        {"gravity", ParamType::Real, 0.5, 0, 1000, "m/s^2",
-         "a_g, downwards. Growth runs in time-lapse (0.2 m per simulated second), and at 9.81 shoots not yet anchored "
-         "fold to the ground under shape matching at 2 iterations. At 1 shoots peeled off convex and overhanging "
-         "supports (the bunny: 5% of it covered, the rest on the ground); 0.5 keeps them on (18%) with a visible sag "
-         "where a support ends", {}},
-        {"stiffness", ParamType::Real, 0.8, 0, 1, "", "shape matching: fraction of the way to the goal per iteration", {}},
-        {"iterations", ParamType::Int, std::int64_t{2}, 1, 100, "", "shape-matching iterations per step", {}},
-        {"damping", ParamType::Real, 0.05, 0, 1, "", "fraction of linear and angular velocity removed per step", {}},
-        {"friction", ParamType::Real, 0.6, 0, 1, "", "tangential velocity removed at a contact", {}},
-        {"elasticity", ParamType::Real, 0.1, 0, 1, "", "normal velocity reflected at a contact", {}},
-        {"anchor_pull", ParamType::Real, 0.5, 0, 1, "", "phi: x += phi (anchor - x) per step", {}},
-        {"anchor_release", ParamType::Real, 0.03, 0, 100, "m", "an anchor lets go when its particle is this far from it",
-         {}},
-        {"break_sensitivity", ParamType::Real, 0.0, 0, 1e6, "",
-         "a joint breaks when its gap exceeds particle_length / this; 0: never", {}},
-        {"wind", ParamType::Vec3, glm::dvec3(1.0, 0.0, 0.0), -1e3, 1e3, "", "wind direction", {}},
-        {"wind_strength", ParamType::Real, 0.0, 0, 1e4, "m/s^2", "wind acceleration a_e", {}},
-        {"wind_gusts", ParamType::Real, 0.5, 0, 10, "",
-         "gust amplitude relative to the strength (smooth counter-based noise per shoot)", {}},
-        {"gust_period", ParamType::Real, 1.5, 1e-3, 1e3, "s", "time between gust peaks", {}},
-        {"prune", ParamType::String, std::string(), -INFINITY, INFINITY, "",
-         "cuts during the run, 'x,y,z,radius@step; ...': at that step the particles whose head is within radius of the "
-         "point (radius 0: the nearest one) and all they grew are removed", {}},
+        param::real("dt", 0.025).range(1e-4, 1).unit("s").doc("time step (the paper: 25 ms)"),
+        param::real("gravity", 0.5).range(0, 1000).unit("m/s^2")
+            .doc("a_g, downwards. Growth runs in time-lapse (0.2 m per simulated second), and at 9.81 shoots not yet "
+                 "anchored fold to the ground under shape matching at 2 iterations. At 1 shoots peeled off convex "
+                 "and overhanging supports (the bunny: 5% of it covered, the rest on the ground); 0.5 keeps them on "
+                 "(18%) with a visible sag where a support ends"),
+        param::real("stiffness", 0.8).range(0, 1).doc("shape matching: fraction of the way to the goal per iteration"),
+        param::integer("iterations", 2).range(1, 100).doc("shape-matching iterations per step"),
+        param::real("damping", 0.05).range(0, 1).doc("fraction of linear and angular velocity removed per step"),
+        param::real("friction", 0.6).range(0, 1).doc("tangential velocity removed at a contact"),
+        param::real("elasticity", 0.1).range(0, 1).doc("normal velocity reflected at a contact"),
+        param::real("anchor_pull", 0.5).range(0, 1).doc("phi: x += phi (anchor - x) per step"),
+        param::real("anchor_release", 0.03).range(0, 100).unit("m")
+            .doc("an anchor lets go when its particle is this far from it"),
+        param::real("break_sensitivity", 0.0).range(0, 1e6)
+            .doc("a joint breaks when its gap exceeds particle_length / this; 0: never"),
+        param::vec3("wind", glm::dvec3(1.0, 0.0, 0.0)).range(-1e3, 1e3).doc("wind direction"),
+        param::real("wind_strength", 0.0).range(0, 1e4).unit("m/s^2").doc("wind acceleration a_e"),
+        param::real("wind_gusts", 0.5).range(0, 10)
+            .doc("gust amplitude relative to the strength (smooth counter-based noise per shoot)"),
+        param::real("gust_period", 1.5).range(1e-3, 1e3).unit("s").doc("time between gust peaks"),
+        param::text("prune")
+            .doc("cuts during the run, 'x,y,z,radius@step; ...': at that step the particles whose head is within "
+                 "radius of the point (radius 0: the nearest one) and all they grew are removed"),
     },
-    {}};
+    .test_params = {"max_particles=2000"},
+};
 
 constexpr std::uint64_t kNoiseStream = 0x4ad71c00ull << 32;
 constexpr std::uint64_t kBranchStream = 0x4ad7b400ull << 32;
@@ -161,7 +166,7 @@ class HadrichAlgorithm final : public GrowthAlgorithm {
   const AlgorithmInfo& describe() const override { return kInfo; }
   void start(const Scene& scene, const SceneQuery& query, const Params& params, std::uint64_t seed) override {
     if (!query.has_sdf()) throw InputError("hadrich: the scene query has no distance field (collision needs one)");
-    sim_ = std::make_unique<hadrich::Simulator>(scene, query, hadrich::make_config(params), seed);
+    sim_ = std::make_unique<hadrich::Simulator>(scene, query, hadrich::make_setup(params), seed);
   }
   bool step() override { return sim_->step(); }
   const Plant& plant() const override { return sim_ ? sim_->plant() : empty_; }
@@ -176,8 +181,7 @@ class HadrichAlgorithm final : public GrowthAlgorithm {
 
 }  // namespace
 
-const AlgorithmInfo& hadrich_info() { return kInfo; }
-std::unique_ptr<GrowthAlgorithm> make_hadrich() { return std::make_unique<HadrichAlgorithm>(); }
+GROWBENCH_REGISTER_ALGORITHM(hadrich, HadrichAlgorithm, kInfo, hadrich::Config)
 
 namespace hadrich {
 
@@ -222,54 +226,55 @@ std::vector<Cut> parse_cuts(const std::string& text) {
   return cuts;
 }
 
-Config make_config(const Params& p) {
-  Config c;
+Setup make_setup(const Params& p) {
   auto f = [&](const char* k) { return static_cast<float>(p.real(k)); };
   auto i = [&](const char* k) { return static_cast<int>(p.integer(k)); };
-  c.particle_length = f("particle_length");
-  c.max_particles = static_cast<std::size_t>(p.integer("max_particles"));
-  c.growth_speed = f("growth_speed") * f("growth_factor");
-  c.shade_growth = f("shade_growth");
-  c.tip_radius = f("tip_radius");
-  c.max_radius = std::max(f("max_radius"), c.tip_radius);
-  c.thickening = f("thickening");
-  c.radius_falloff = f("radius_falloff");
-  c.adaptation = f("adaptation");
-  c.attraction_range = f("attraction_range");
-  c.approach_angle = f("approach_angle") * kDeg;
-  c.phototropism = f("phototropism");
-  c.light_rays = i("light_rays");
-  c.light_spread = f("light_spread") * kDeg;
-  c.direction_noise = f("direction_noise") * kDeg;
-  c.zone_rate = f("zone_rate");
-  c.max_laterals = i("max_laterals");
-  c.shoot_density = f("shoot_density");
-  c.branch_variance = f("branch_variance");
-  c.max_order = i("max_order");
-  c.leaf_density = f("leaf_density");
-  c.leaf_step = i("leaf_step");
-  c.phyllotaxis = f("phyllotaxis") * kDeg;
-  c.leaf_size = f("leaf_size");
-  c.leaf_light = f("leaf_light");
-  c.dt = f("dt");
-  c.gravity = f("gravity");
-  c.stiffness = f("stiffness");
-  c.iterations = i("iterations");
-  c.damping = f("damping");
-  c.friction = f("friction");
-  c.elasticity = f("elasticity");
-  c.anchor_pull = f("anchor_pull");
-  c.anchor_release = f("anchor_release");
-  c.break_sensitivity = f("break_sensitivity");
   const glm::vec3 w(p.vec3("wind"));
   if (glm::length(w) < 1e-12f && p.real("wind_strength") > 0.0)
     throw InputError("hadrich: parameter 'wind' is the zero vector but wind_strength > 0; expected a direction");
-  c.wind = glm::length(w) > 0.0f ? glm::normalize(w) : w;
-  c.wind_strength = f("wind_strength");
-  c.wind_gusts = f("wind_gusts");
-  c.gust_period = f("gust_period");
-  c.cuts = parse_cuts(p.text("prune"));
-  return c;
+  // Designated initializers: a member left out is a warning (-Wmissing-field-initializers), an error in CI.
+  const Config c = {
+      .particle_length = f("particle_length"),
+      .max_particles = static_cast<std::size_t>(p.integer("max_particles")),
+      .growth_speed = f("growth_speed") * f("growth_factor"),
+      .shade_growth = f("shade_growth"),
+      .tip_radius = f("tip_radius"),
+      .max_radius = std::max(f("max_radius"), f("tip_radius")),
+      .thickening = f("thickening"),
+      .radius_falloff = f("radius_falloff"),
+      .adaptation = f("adaptation"),
+      .attraction_range = f("attraction_range"),
+      .approach_angle = f("approach_angle") * kDeg,
+      .phototropism = f("phototropism"),
+      .light_rays = i("light_rays"),
+      .light_spread = f("light_spread") * kDeg,
+      .direction_noise = f("direction_noise") * kDeg,
+      .zone_rate = f("zone_rate"),
+      .max_laterals = i("max_laterals"),
+      .max_order = i("max_order"),
+      .leaf_step = i("leaf_step"),
+      .shoot_density = f("shoot_density"),
+      .branch_variance = f("branch_variance"),
+      .leaf_density = f("leaf_density"),
+      .phyllotaxis = f("phyllotaxis") * kDeg,
+      .leaf_size = f("leaf_size"),
+      .leaf_light = f("leaf_light"),
+      .dt = f("dt"),
+      .gravity = f("gravity"),
+      .stiffness = f("stiffness"),
+      .damping = f("damping"),
+      .iterations = i("iterations"),
+      .friction = f("friction"),
+      .elasticity = f("elasticity"),
+      .anchor_pull = f("anchor_pull"),
+      .anchor_release = f("anchor_release"),
+      .break_sensitivity = f("break_sensitivity"),
+      .wind = glm::length(w) > 0.0f ? glm::normalize(w) : w,
+      .wind_strength = f("wind_strength"),
+      .wind_gusts = f("wind_gusts"),
+      .gust_period = f("gust_period"),
+  };
+  return {c, parse_cuts(p.text("prune"))};
 }
 
 // ---- particles ----
@@ -289,8 +294,8 @@ std::size_t Particles::bytes_per_particle() {
 
 // ---- simulator ----
 
-Simulator::Simulator(const Scene& scene, const SceneQuery& query, const Config& config, std::uint64_t seed)
-    : scene_(scene), query_(query), cfg_(config), seed_(seed) {
+Simulator::Simulator(const Scene& scene, const SceneQuery& query, const Setup& setup, std::uint64_t seed)
+    : scene_(scene), query_(query), cfg_(setup.config), cuts_(setup.cuts), seed_(seed) {
   p_.reserve(cfg_.max_particles);
   seed_started_.assign(scene_.seeds.size(), 0);
   if (scene_.seeds.empty()) throw InputError(fmt::format("hadrich: scene '{}' has no seeds", scene_.name));
@@ -789,7 +794,7 @@ void Simulator::physics() {
 
 bool Simulator::step() {
   add_seeds();
-  for (const Cut& c : cfg_.cuts)
+  for (const Cut& c : cuts_)
     if (c.step == step_) prune(c.point, c.radius);
   if (!tips_.empty()) {
     grow_tips();

@@ -17,9 +17,6 @@
 
 namespace growbench {
 
-const AlgorithmInfo& hadrich_info();
-std::unique_ptr<GrowthAlgorithm> make_hadrich();
-
 namespace hadrich {
 
 constexpr int kMaxChildren = 4;  // one successor + at most 3 laterals (max_laterals <= 3)
@@ -34,31 +31,38 @@ struct Cut {
 // Parses "x,y,z,radius@step; ..." (the `prune` parameter). InputError naming the entry otherwise.
 std::vector<Cut> parse_cuts(const std::string& text);
 
+// The parameters in the units the simulation uses (angles in radians, the growth speed times its
+// factor). Every value comes from the parameter table (make_setup): no member has a default of its own.
 struct Config {
   // growth
-  float particle_length = 0.02f;
-  std::size_t max_particles = 10000;
-  float growth_speed = 0.2f, shade_growth = 0.25f;
-  float tip_radius = 0.002f, max_radius = 0.012f, thickening = 0.002f, radius_falloff = 0.7f;
+  float particle_length;
+  std::size_t max_particles;
+  float growth_speed, shade_growth;
+  float tip_radius, max_radius, thickening, radius_falloff;
   // tropisms (rates in 1/s, angles in radians)
-  float adaptation = 6.0f, attraction_range = 0.15f, approach_angle = 0.436f;
-  float phototropism = 1.5f;
-  int light_rays = 4;
-  float light_spread = 0.087f, direction_noise = 0.1f, zone_rate = 3.0f;
+  float adaptation, attraction_range, approach_angle;
+  float phototropism;
+  int light_rays;
+  float light_spread, direction_noise, zone_rate;
   // branching and leaves
-  int max_laterals = 1, max_order = 3, leaf_step = 1;
-  float shoot_density = 0.08f, branch_variance = 0.8f;
-  float leaf_density = 0.7f, phyllotaxis = 2.4f, leaf_size = 0.05f, leaf_light = 0.7f;
+  int max_laterals, max_order, leaf_step;
+  float shoot_density, branch_variance;
+  float leaf_density, phyllotaxis, leaf_size, leaf_light;
   // physics
-  float dt = 0.025f, gravity = 1.0f, stiffness = 0.8f, damping = 0.05f;
-  int iterations = 2;
-  float friction = 0.6f, elasticity = 0.1f, anchor_pull = 0.5f, anchor_release = 0.03f;
-  float break_sensitivity = 0.0f;
-  glm::vec3 wind{1.0f, 0.0f, 0.0f};
-  float wind_strength = 0.0f, wind_gusts = 0.5f, gust_period = 1.5f;
+  float dt, gravity, stiffness, damping;
+  int iterations;
+  float friction, elasticity, anchor_pull, anchor_release;
+  float break_sensitivity;
+  glm::vec3 wind;
+  float wind_strength, wind_gusts, gust_period;
+};
+// What the simulation reads from the parameters: the values, and the cuts the `prune` parameter asks for.
+struct Setup {
+  Config config;
   std::vector<Cut> cuts;
 };
-Config make_config(const Params& params);
+// InputError naming the parameter for a value that cannot work (a bad `prune` entry, wind without a direction).
+Setup make_setup(const Params& params);
 
 // The particle pool: a structure of arrays preallocated to max_particles, activated in order (a slot
 // is never reused, so a parent always has a lower index than its children). A particle is an
@@ -105,7 +109,7 @@ struct Leaf {
 // particle's slots, and new particles are created serially in index order.
 class Simulator {
  public:
-  Simulator(const Scene& scene, const SceneQuery& query, const Config& config, std::uint64_t seed);
+  Simulator(const Scene& scene, const SceneQuery& query, const Setup& setup, std::uint64_t seed);
   bool step();
   // Removes the particles whose head is within `radius` of `point` (radius 0: the nearest particle)
   // and their subtrees; returns how many were removed.
@@ -147,6 +151,7 @@ class Simulator {
   const Scene& scene_;
   const SceneQuery& query_;
   Config cfg_;
+  std::vector<Cut> cuts_;
   std::uint64_t seed_;
   Particles p_;
   std::vector<Leaf> leaves_;

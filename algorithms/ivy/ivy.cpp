@@ -37,63 +37,59 @@ namespace {
 
 // ---- parameter table (what `growbench list` prints) ----
 const AlgorithmInfo kInfo = {
-    "ivy",
-    "Luft's ivy generator (and Blender IvyGen): roots creep along surfaces by primary, random, adhesion and "
-    "gravity terms, mirror off what they hit, branch, and carry leaves facing away from the surface",
-    {
-        {"preset", ParamType::Choice, std::string("luft"), -INFINITY, INFINITY, "",
-         "luft: Luft's defaults, sizes relative to R (the scene's bounding-sphere radius); blender: Blender IvyGen "
-         "0.1.5 (absolute metres, max_root_length 1, one ray collision without death, closest-point adhesion, "
-         "one smoothing pass, its leaves)",
-         {"luft", "blender"}},
-        {"units", ParamType::Choice, std::string("relative"), -INFINITY, INFINITY, "",
-         "relative: ivy_size, max_float_length, max_adhesion_distance and the length limits are multiples of R, "
-         "leaf_size and branch_size multiples of R * ivy_size (Luft); absolute: all of them in metres (Blender)",
-         {"relative", "absolute"}},
-        {"ivy_size", ParamType::Real, 0.005, 1e-6, 100, "", "length scale of one growth step", {}},
-        {"primary_weight", ParamType::Real, 0.5, 0, 100, "", "weight of the previous direction", {}},
-        {"random_weight", ParamType::Real, 0.2, 0, 100, "",
-         "weight of a random direction (uniform in a cube, plus 0.2 up)", {}},
-        {"adhesion_weight", ParamType::Real, 0.1, 0, 100, "",
-         "weight of the pull to the nearest surface (the three weights are normalised by their sum)", {}},
-        {"gravity_weight", ParamType::Real, 1.0, 0, 100, "",
-         "gravity: ivy_size * this * (floating length / max_float_length)^0.7 downwards", {}},
-        {"branching_probability", ParamType::Real, 0.95, 0, 1, "",
-         "a node starts a new root when rand * w > this (w peaks mid-root); Blender's panel shows 1 - this", {}},
-        {"leaf_probability", ParamType::Real, 0.7, 0, 10, "",
-         "a leaf grows when rand * w > this (w grows toward the tip and on the ground); Blender's panel shows 1 - this",
-         {}},
-        {"leaf_size", ParamType::Real, 1.5, 0, 100, "", "leaf half-size (relative: times R * ivy_size)", {}},
-        {"branch_size", ParamType::Real, 0.15, 0, 100, "", "branch radius scale (relative: times R * ivy_size)", {}},
-        {"max_float_length", ParamType::Real, 0.1, 1e-6, 1e4, "",
-         "a root dies once it has floated (not touched a surface) this far", {}},
-        {"max_adhesion_distance", ParamType::Real, 0.1, 1e-6, 1e4, "", "surfaces farther than this do not attract", {}},
-        {"max_root_length", ParamType::Real, 3.0, 0, 1e6, "",
-         "stop when a root is this long (Blender's maxIvyLength; Luft's GUI has none, the user stops growth: roots "
-         "that never leave a surface never die); 0: no limit", {}},
-        {"max_total_length", ParamType::Real, 0.0, 0, 1e9, "", "stop when all roots together are this long; 0: no limit",
-         {}},
-        {"adhesion", ParamType::Choice, std::string("luft"), -INFINITY, INFINITY, "",
-         "luft: face interiors only, front sides only (Luft); closest: true closest point incl. edges and vertices "
-         "(Blender's BVH)",
-         {"luft", "closest"}},
-        {"collision", ParamType::Choice, std::string("luft"), -INFINITY, INFINITY, "",
-         "luft: mirror across every entered face, repeat, the root dies after more than 5 passes; blender: one ray, "
-         "mirror across the first face if entering, never dies",
-         {"luft", "blender"}},
-        {"max_depth", ParamType::Int, std::int64_t{3}, 0, 100, "", "roots this deep (ancestor count) can still branch", {}},
-        {"branches_per_step", ParamType::Int, std::int64_t{1}, 1, 1000000, "",
-         "new roots per iteration at most (Luft: 1)", {}},
-        {"smoothing_passes", ParamType::Int, std::int64_t{5}, 0, 100, "",
-         "passes of the 11-tap [1 2 4 7 9 10 9 7 4 2 1]/56 filter over each root's adhesion vectors", {}},
-        {"leaves", ParamType::Choice, std::string("luft"), -INFINITY, INFINITY, "",
-         "luft: leaf_passes passes over each root's nodes, young and adult leaves; blender: leaf_passes tries along "
-         "each segment; none",
-         {"luft", "blender", "none"}},
-        {"leaf_passes", ParamType::Int, std::int64_t{10}, 0, 1000, "", "leaf passes per root (luft) or tries per segment (blender)",
-         {}},
+    .name = "ivy",
+    .summary =
+        "Luft's ivy generator (and Blender IvyGen): roots creep along surfaces by primary, random, adhesion and "
+        "gravity terms, mirror off what they hit, branch, and carry leaves facing away from the surface",
+    .params = {
+        param::choice("preset", "luft", {"luft", "blender"})
+            .doc("luft: Luft's defaults, sizes relative to R (the scene's bounding-sphere radius); blender: Blender "
+                 "IvyGen 0.1.5 (absolute metres, max_root_length 1, one ray collision without death, closest-point "
+                 "adhesion, one smoothing pass, its leaves)"),
+        param::choice("units", "relative", {"relative", "absolute"})
+            .doc("relative: ivy_size, max_float_length, max_adhesion_distance and the length limits are multiples of "
+                 "R, leaf_size and branch_size multiples of R * ivy_size (Luft); absolute: all of them in metres "
+                 "(Blender)"),
+        param::real("ivy_size", 0.005).range(1e-6, 100).doc("length scale of one growth step"),
+        param::real("primary_weight", 0.5).range(0, 100).doc("weight of the previous direction"),
+        param::real("random_weight", 0.2).range(0, 100)
+            .doc("weight of a random direction (uniform in a cube, plus 0.2 up)"),
+        param::real("adhesion_weight", 0.1).range(0, 100)
+            .doc("weight of the pull to the nearest surface (the three weights are normalised by their sum)"),
+        param::real("gravity_weight", 1.0).range(0, 100)
+            .doc("gravity: ivy_size * this * (floating length / max_float_length)^0.7 downwards"),
+        param::real("branching_probability", 0.95).range(0, 1)
+            .doc("a node starts a new root when rand * w > this (w peaks mid-root); Blender's panel shows 1 - this"),
+        param::real("leaf_probability", 0.7).range(0, 10)
+            .doc("a leaf grows when rand * w > this (w grows toward the tip and on the ground); Blender's panel "
+                 "shows 1 - this"),
+        param::real("leaf_size", 1.5).range(0, 100).doc("leaf half-size (relative: times R * ivy_size)"),
+        param::real("branch_size", 0.15).range(0, 100).doc("branch radius scale (relative: times R * ivy_size)"),
+        param::real("max_float_length", 0.1).range(1e-6, 1e4)
+            .doc("a root dies once it has floated (not touched a surface) this far"),
+        param::real("max_adhesion_distance", 0.1).range(1e-6, 1e4).doc("surfaces farther than this do not attract"),
+        param::real("max_root_length", 3.0).range(0, 1e6)
+            .doc("stop when a root is this long (Blender's maxIvyLength; Luft's GUI has none, the user stops growth: "
+                 "roots that never leave a surface never die); 0: no limit"),
+        param::real("max_total_length", 0.0).range(0, 1e9)
+            .doc("stop when all roots together are this long; 0: no limit"),
+        param::choice("adhesion", "luft", {"luft", "closest"})
+            .doc("luft: face interiors only, front sides only (Luft); closest: true closest point incl. edges and "
+                 "vertices (Blender's BVH)"),
+        param::choice("collision", "luft", {"luft", "blender"})
+            .doc("luft: mirror across every entered face, repeat, the root dies after more than 5 passes; blender: "
+                 "one ray, mirror across the first face if entering, never dies"),
+        param::integer("max_depth", 3).range(0, 100).doc("roots this deep (ancestor count) can still branch"),
+        param::integer("branches_per_step", 1).range(1, 1000000).doc("new roots per iteration at most (Luft: 1)"),
+        param::integer("smoothing_passes", 5).range(0, 100)
+            .doc("passes of the 11-tap [1 2 4 7 9 10 9 7 4 2 1]/56 filter over each root's adhesion vectors"),
+        param::choice("leaves", "luft", {"luft", "blender", "none"})
+            .doc("luft: leaf_passes passes over each root's nodes, young and adult leaves; blender: leaf_passes "
+                 "tries along each segment; none"),
+        param::integer("leaf_passes", 10).range(0, 1000)
+            .doc("leaf passes per root (luft) or tries per segment (blender)"),
     },
-    {
+    .presets = {
         {"luft", {}},
         {"blender",
          {{"units", std::string("absolute")},
@@ -109,7 +105,9 @@ const AlgorithmInfo kInfo = {
           {"collision", std::string("blender")},
           {"smoothing_passes", std::int64_t{1}},
           {"leaves", std::string("blender")}}},
-    }};
+    },
+    .test_params = {"max_root_length=1"},
+};
 
 constexpr glm::vec3 kUp{0.0f, 1.0f, 0.0f};
 constexpr std::uint64_t kGrowStream = 0x1f7a11ull << 32;
@@ -303,8 +301,7 @@ class IvyAlgorithm final : public GrowthAlgorithm {
 
 }  // namespace
 
-const AlgorithmInfo& ivy_info() { return kInfo; }
-std::unique_ptr<GrowthAlgorithm> make_ivy() { return std::make_unique<IvyAlgorithm>(); }
+GROWBENCH_REGISTER_ALGORITHM(ivy, IvyAlgorithm, kInfo, ivy::Config)
 
 namespace ivy {
 
@@ -335,38 +332,41 @@ float bounding_sphere_radius(const Scene& scene) {
 }
 
 Config make_config(const Params& p, const Scene& scene) {
-  Config c;
-  c.radius = bounding_sphere_radius(scene);
-  if (!(c.radius > 0.0f))
+  const float radius = bounding_sphere_radius(scene);
+  if (!(radius > 0.0f))
     throw InputError(fmt::format("ivy: scene '{}' has no climbable surface to size R by", scene.name));
   const bool relative = p.text("units") == "relative";
-  const float R = relative ? c.radius : 1.0f;
-  c.step = static_cast<float>(p.real("ivy_size")) * R;
+  const float R = relative ? radius : 1.0f;
+  const float step = static_cast<float>(p.real("ivy_size")) * R;
   const double sum = p.real("primary_weight") + p.real("random_weight") + p.real("adhesion_weight");
   if (!(sum > 0.0))
     throw InputError("ivy: primary_weight, random_weight and adhesion_weight are all 0; at least one must be > 0");
-  c.primary = static_cast<float>(p.real("primary_weight") / sum);
-  c.random = static_cast<float>(p.real("random_weight") / sum);
-  c.adhesion = static_cast<float>(p.real("adhesion_weight") / sum);
-  c.gravity = static_cast<float>(p.real("gravity_weight"));
-  c.branching = static_cast<float>(p.real("branching_probability"));
-  c.leaf_probability = static_cast<float>(p.real("leaf_probability"));
-  c.leaf_size = static_cast<float>(p.real("leaf_size")) * (relative ? c.step : 1.0f);
-  c.branch_size = static_cast<float>(p.real("branch_size")) * (relative ? c.step : 1.0f);
-  c.max_float = static_cast<float>(p.real("max_float_length")) * R;
-  c.max_adhesion = static_cast<float>(p.real("max_adhesion_distance")) * R;
-  c.max_root_length = p.real("max_root_length") * R;
-  c.max_total_length = p.real("max_total_length") * R;
-  c.adhesion_mode = p.text("adhesion") == "luft" ? AdhesionMode::Luft : AdhesionMode::Closest;
-  c.collision_mode = p.text("collision") == "luft" ? CollisionMode::Luft : CollisionMode::Blender;
   const std::string& leaves = p.text("leaves");
-  c.leaf_mode = leaves == "luft" ? LeafMode::Luft : leaves == "blender" ? LeafMode::Blender : LeafMode::None;
-  c.max_depth = static_cast<int>(p.integer("max_depth"));
-  c.branches_per_step = static_cast<int>(p.integer("branches_per_step"));
-  c.smoothing_passes = static_cast<int>(p.integer("smoothing_passes"));
-  c.leaf_passes = static_cast<int>(p.integer("leaf_passes"));
-  c.margin = 1e-5f * c.radius;
-  return c;
+  // Designated initializers: a member left out is a warning (-Wmissing-field-initializers), an error in CI.
+  return {
+      .radius = radius,
+      .step = step,
+      .primary = static_cast<float>(p.real("primary_weight") / sum),
+      .random = static_cast<float>(p.real("random_weight") / sum),
+      .adhesion = static_cast<float>(p.real("adhesion_weight") / sum),
+      .gravity = static_cast<float>(p.real("gravity_weight")),
+      .branching = static_cast<float>(p.real("branching_probability")),
+      .leaf_probability = static_cast<float>(p.real("leaf_probability")),
+      .leaf_size = static_cast<float>(p.real("leaf_size")) * (relative ? step : 1.0f),
+      .branch_size = static_cast<float>(p.real("branch_size")) * (relative ? step : 1.0f),
+      .max_float = static_cast<float>(p.real("max_float_length")) * R,
+      .max_adhesion = static_cast<float>(p.real("max_adhesion_distance")) * R,
+      .max_root_length = p.real("max_root_length") * R,
+      .max_total_length = p.real("max_total_length") * R,
+      .adhesion_mode = p.text("adhesion") == "luft" ? AdhesionMode::Luft : AdhesionMode::Closest,
+      .collision_mode = p.text("collision") == "luft" ? CollisionMode::Luft : CollisionMode::Blender,
+      .leaf_mode = leaves == "luft" ? LeafMode::Luft : leaves == "blender" ? LeafMode::Blender : LeafMode::None,
+      .max_depth = static_cast<int>(p.integer("max_depth")),
+      .branches_per_step = static_cast<int>(p.integer("branches_per_step")),
+      .smoothing_passes = static_cast<int>(p.integer("smoothing_passes")),
+      .leaf_passes = static_cast<int>(p.integer("leaf_passes")),
+      .margin = 1e-5f * radius,
+  };
 }
 
 std::span<const std::uint32_t> Candidates::sorted_unique() {

@@ -12,9 +12,6 @@
 
 namespace growbench {
 
-const AlgorithmInfo& ivy_info();
-std::unique_ptr<GrowthAlgorithm> make_ivy();
-
 namespace ivy {
 
 constexpr std::uint32_t kNoTriangle = 0xFFFFFFFFu;
@@ -23,28 +20,29 @@ enum class AdhesionMode : std::uint8_t { Luft, Closest };
 enum class CollisionMode : std::uint8_t { Luft, Blender };
 enum class LeafMode : std::uint8_t { Luft, Blender, None };
 
-// Parameters resolved to metres (units=relative multiplied through by R).
+// Parameters resolved to metres (units=relative multiplied through by R). Every value comes from the
+// parameter table and the scene (make_config): no member has a default of its own.
 struct Config {
-  float radius = 1.0f;            // R: the climbable meshes' bounding-sphere radius
-  float step = 0.01f;             // ivy size: length scale of one growth step
-  float primary = 0.5f, random = 0.2f, adhesion = 0.1f;  // normalised to sum 1
-  float gravity = 1.0f;
-  float branching = 0.95f;        // a node branches when rand * w > this
-  float leaf_probability = 0.7f;  // a leaf grows when rand * w > this
-  float leaf_size = 0.01f;        // half the side of a leaf quad
-  float branch_size = 0.001f;     // radius scale
-  float max_float = 0.2f;
-  float max_adhesion = 0.2f;
-  double max_root_length = 0.0;   // 0: unlimited
-  double max_total_length = 0.0;  // 0: unlimited
-  AdhesionMode adhesion_mode = AdhesionMode::Luft;
-  CollisionMode collision_mode = CollisionMode::Luft;
-  LeafMode leaf_mode = LeafMode::Luft;
-  int max_depth = 3;
-  int branches_per_step = 1;
-  int smoothing_passes = 5;
-  int leaf_passes = 10;
-  float margin = 1e-5f;           // slack added to query radii (1e-5 R)
+  float radius;            // R: the climbable meshes' bounding-sphere radius
+  float step;              // ivy size: length scale of one growth step
+  float primary, random, adhesion;  // normalised to sum 1
+  float gravity;
+  float branching;         // a node branches when rand * w > this
+  float leaf_probability;  // a leaf grows when rand * w > this
+  float leaf_size;         // half the side of a leaf quad
+  float branch_size;       // radius scale
+  float max_float;
+  float max_adhesion;
+  double max_root_length;   // 0: unlimited
+  double max_total_length;  // 0: unlimited
+  AdhesionMode adhesion_mode;
+  CollisionMode collision_mode;
+  LeafMode leaf_mode;
+  int max_depth;
+  int branches_per_step;
+  int smoothing_passes;
+  int leaf_passes;
+  float margin;  // slack added to query radii (1e-5 R)
 };
 
 // The max distance from the vertex centroid of the climbable meshes (all meshes when none is

@@ -58,7 +58,6 @@ std::vector<std::size_t> symbol_counts(const LString& s) {
 }
 
 Deriver::Deriver(const Grammar& grammar, DeriveSettings settings) : g_(grammar), s_(std::move(settings)) {
-  s_.env.resize(kMaxSlots, 0.0);
   for (int c = 0; c < 128; ++c) {
     const auto& list = g_.rules_for[c];
     if (list.empty()) continue;
@@ -77,7 +76,7 @@ Deriver::Deriver(const Grammar& grammar, DeriveSettings settings) : g_(grammar),
 void Deriver::premise(LString& out) const {
   std::vector<std::uint16_t> syms;
   std::vector<float> pars;
-  std::vector<double> env = s_.env;
+  std::array<double, kMaxSlots> env = s_.env;
   env[kVarGeneration] = 0.0;
   for (std::size_t m = 0; m < g_.premise.size(); ++m) {
     const auto& mod = g_.premise[m];

@@ -19,6 +19,7 @@
 // A symbol with no applicable rule is copied.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -34,15 +35,17 @@ struct TurtleVars {
   float x = 0, y = 0, z = 0, arc = 0, length = 0, width = 0, u = 0, v = 0;
 };
 
+// How to rewrite. The values come from the parameter table (make_setup in lsystem.cpp): no member has a
+// default of its own.
 struct DeriveSettings {
-  const ExprHost* host = nullptr;
-  std::uint64_t seed = 0;
-  std::uint64_t stream = 0;  // e.g. the plant (scene seed) index
-  ProbabilityMode probability = ProbabilityMode::Sequential;
-  bool brackets_transparent = false;  // context includes siblings, or [ ] in the ignore list
-  std::size_t max_symbols = 50'000'000;
-  std::size_t max_params = 100'000'000;
-  std::vector<double> env;  // kMaxSlots values: a b c d T and user variables filled in
+  const ExprHost* host;
+  std::uint64_t seed;
+  std::uint64_t stream;  // e.g. the plant (scene seed) index
+  ProbabilityMode probability;
+  bool brackets_transparent;  // context includes siblings, or [ ] in the ignore list
+  std::size_t max_symbols;
+  std::size_t max_params;
+  std::array<double, kMaxSlots> env;  // a b c d T and user variables filled in, the rest 0
 };
 
 class Deriver {

@@ -36,61 +36,63 @@ namespace {
 
 // ---- parameter table (what `growbench list` prints) ----
 const AlgorithmInfo kInfo = {
-    "lsystem",
-    "L-system, Houdini dialect: parametric, stochastic, context-sensitive rules, 3D turtle, J/K/M organs, in(), wrap",
-    {
-        {"grammar", ParamType::String, std::string(""), -INFINITY, INFINITY, "",
-         "a .lsys grammar file (premise, rules and values) or an example name (koch-island, bush, ...)", {}},
-        {"premise", ParamType::String, std::string("FFFA"), -INFINITY, INFINITY, "", "the string at generation 0", {}},
-        {"rules", ParamType::String, std::string("A = !\"[&FFFA]////[&FFFA]////[&FFFA]"), -INFINITY, INFINITY, "",
-         "rules, one per line: [left<] sym [>right] [:cond] = replacement [:prob]", {}},
-        {"rules_file", ParamType::String, std::string(""), -INFINITY, INFINITY, "",
-         "read the rules from this file (one per line, # comments) instead", {}},
-        {"generations", ParamType::Real, 5.0, 0, 200, "", "rewrites; a fraction adds a partly grown last generation", {}},
-        {"step_size", ParamType::Real, 0.1, 0, 1e4, "m", "default length of F, f, G (and of J/K/M organs)", {}},
-        {"step_scale", ParamType::Real, 0.8, 0, 1e4, "", "factor of \" (and divisor of _)", {}},
-        {"angle", ParamType::Real, 28.0, -360, 360, "deg", "default angle of + - & ^ \\ /; also the variable a", {}},
-        {"angle_scale", ParamType::Real, 0.9, 0, 1e4, "", "factor of ; (and divisor of @)", {}},
-        {"thickness", ParamType::Real, 0.02, 0, 1e3, "m", "initial width (node radius = width / 2)", {}},
-        {"thickness_scale", ParamType::Real, 0.7, 0, 1e4, "", "factor of ! (and divisor of ?)", {}},
-        {"gravity", ParamType::Real, 0.2, -100, 100, "", "tropism of T toward -Y (radians per unit sin); also T", {}},
-        {"random_scale", ParamType::Real, 0.0, 0, 1, "", "every move length is scaled by 1 + random_scale * uniform(-1, 1)", {}},
-        {"u_increment", ParamType::Real, 0.1, -1e4, 1e4, "", "default increment of ' (colour index U)", {}},
-        {"v_increment", ParamType::Real, 0.1, -1e4, 1e4, "", "default increment of # (colour index V)", {}},
-        {"b", ParamType::Real, 0.0, -1e12, 1e12, "", "expression variable b", {}},
-        {"c", ParamType::Real, 0.0, -1e12, 1e12, "", "expression variable c", {}},
-        {"d", ParamType::Real, 0.0, -1e12, 1e12, "", "expression variable d", {}},
-        {"variables", ParamType::String, std::string(""), -INFINITY, INFINITY, "",
-         "user variables, single letters: 'k=0.5, q=2'", {}},
-        {"channels", ParamType::String, std::string(""), -INFINITY, INFINITY, "", "values of chan(0), chan(1), ...: '1, 0.5'", {}},
-        {"context_ignore", ParamType::String, std::string(""), -INFINITY, INFINITY, "",
-         "symbols skipped when matching contexts, e.g. '+-F'; with '[' or ']' brackets become transparent", {}},
-        {"context_siblings", ParamType::Bool, false, -INFINITY, INFINITY, "",
-         "contexts read across branch brackets (pre-Houdini 10 behaviour) instead of skipping sub-branches", {}},
-        {"probability", ParamType::Choice, std::string("sequential"), -INFINITY, INFINITY, "",
-         "sequential: each applicable rule fires with its own chance, in order (Houdini); normalized: one of the "
-         "applicable probabilistic rules by weight (ABOP)",
-         {"sequential", "normalized"}},
-        {"convention", ParamType::Choice, std::string("houdini"), -INFINITY, INFINITY, "",
-         "houdini: + turns right; abop: + turns left (The Algorithmic Beauty of Plants)", {"houdini", "abop"}},
-        {"continuous_length", ParamType::Bool, true, -INFINITY, INFINITY, "", "fractional generation scales new lengths", {}},
-        {"continuous_angles", ParamType::Bool, true, -INFINITY, INFINITY, "", "fractional generation scales new angles", {}},
-        {"continuous_width", ParamType::Bool, true, -INFINITY, INFINITY, "", "fractional generation scales new widths", {}},
-        {"start", ParamType::Choice, std::string("seeds"), -INFINITY, INFINITY, "",
-         "seeds: one plant per scene seed (along its direction); origin: one plant at start_position, +Y",
-         {"seeds", "origin"}},
-        {"start_position", ParamType::Vec3, glm::dvec3(0.0), -1e6, 1e6, "m", "where the turtle starts when start=origin", {}},
-        {"surface", ParamType::Choice, std::string("free"), -INFINITY, INFINITY, "",
-         "free: the turtle moves in space; wrap: every move is mapped onto the nearest scene surface", {"free", "wrap"}},
-        {"wrap_offset", ParamType::Real, 0.01, 0, 10, "m", "distance kept from the surface when wrapping", {}},
-        {"in_test", ParamType::Choice, std::string("auto"), -INFINITY, INFINITY, "",
-         "what in(x,y,z) tests: the scene envelope, the scene's solids, or auto (envelope if any, else solids)",
-         {"auto", "envelope", "solids"}},
-        {"pic_image", ParamType::String, std::string(""), -INFINITY, INFINITY, "", "image read by pic(u, v, plane) (PNG, JPEG, ...)", {}},
-        {"max_symbols", ParamType::Int, std::int64_t{50'000'000}, 1, 2e9, "",
-         "a generation that would exceed this many symbols stops the run with an error", {}},
+    .name = "lsystem",
+    .summary =
+        "L-system, Houdini dialect: parametric, stochastic, context-sensitive rules, 3D turtle, J/K/M organs, "
+        "in(), wrap",
+    .params = {
+        param::text("grammar")
+            .doc("a .lsys grammar file (premise, rules and values) or an example name (koch-island, bush, ...)"),
+        param::text("premise", "FFFA").doc("the string at generation 0"),
+        param::text("rules", "A = !\"[&FFFA]////[&FFFA]////[&FFFA]")
+            .doc("rules, one per line: [left<] sym [>right] [:cond] = replacement [:prob]"),
+        param::text("rules_file").doc("read the rules from this file (one per line, # comments) instead"),
+        param::real("generations", 5.0).range(0, 200).doc("rewrites; a fraction adds a partly grown last generation"),
+        param::real("step_size", 0.1).range(0, 1e4).unit("m").doc("default length of F, f, G (and of J/K/M organs)"),
+        param::real("step_scale", 0.8).range(0, 1e4).doc("factor of \" (and divisor of _)"),
+        param::real("angle", 28.0).range(-360, 360).unit("deg")
+            .doc("default angle of + - & ^ \\ /; also the variable a"),
+        param::real("angle_scale", 0.9).range(0, 1e4).doc("factor of ; (and divisor of @)"),
+        param::real("thickness", 0.02).range(0, 1e3).unit("m").doc("initial width (node radius = width / 2)"),
+        param::real("thickness_scale", 0.7).range(0, 1e4).doc("factor of ! (and divisor of ?)"),
+        param::real("gravity", 0.2).range(-100, 100).doc("tropism of T toward -Y (radians per unit sin); also T"),
+        param::real("random_scale", 0.0).range(0, 1)
+            .doc("every move length is scaled by 1 + random_scale * uniform(-1, 1)"),
+        param::real("u_increment", 0.1).range(-1e4, 1e4).doc("default increment of ' (colour index U)"),
+        param::real("v_increment", 0.1).range(-1e4, 1e4).doc("default increment of # (colour index V)"),
+        param::real("b", 0.0).range(-1e12, 1e12).doc("expression variable b"),
+        param::real("c", 0.0).range(-1e12, 1e12).doc("expression variable c"),
+        param::real("d", 0.0).range(-1e12, 1e12).doc("expression variable d"),
+        param::text("variables").doc("user variables, single letters: 'k=0.5, q=2'"),
+        param::text("channels").doc("values of chan(0), chan(1), ...: '1, 0.5'"),
+        param::text("context_ignore")
+            .doc("symbols skipped when matching contexts, e.g. '+-F'; with '[' or ']' brackets become transparent"),
+        param::boolean("context_siblings", false)
+            .doc("contexts read across branch brackets (pre-Houdini 10 behaviour) instead of skipping sub-branches"),
+        param::choice("probability", "sequential", {"sequential", "normalized"})
+            .doc("sequential: each applicable rule fires with its own chance, in order (Houdini); normalized: one of "
+                 "the applicable probabilistic rules by weight (ABOP)"),
+        param::choice("convention", "houdini", {"houdini", "abop"})
+            .doc("houdini: + turns right; abop: + turns left (The Algorithmic Beauty of Plants)"),
+        param::boolean("continuous_length", true).doc("fractional generation scales new lengths"),
+        param::boolean("continuous_angles", true).doc("fractional generation scales new angles"),
+        param::boolean("continuous_width", true).doc("fractional generation scales new widths"),
+        param::choice("start", "seeds", {"seeds", "origin"})
+            .doc("seeds: one plant per scene seed (along its direction); origin: one plant at start_position, +Y"),
+        param::vec3("start_position", glm::dvec3(0.0)).range(-1e6, 1e6).unit("m")
+            .doc("where the turtle starts when start=origin"),
+        param::choice("surface", "free", {"free", "wrap"})
+            .doc("free: the turtle moves in space; wrap: every move is mapped onto the nearest scene surface"),
+        param::real("wrap_offset", 0.01).range(0, 10).unit("m").doc("distance kept from the surface when wrapping"),
+        param::choice("in_test", "auto", {"auto", "envelope", "solids"})
+            .doc("what in(x,y,z) tests: the scene envelope, the scene's solids, or auto (envelope if any, else "
+                 "solids)"),
+        param::text("pic_image").doc("image read by pic(u, v, plane) (PNG, JPEG, ...)"),
+        param::integer("max_symbols", 50'000'000).range(1, 2e9)
+            .doc("a generation that would exceed this many symbols stops the run with an error"),
     },
-    {}};
+    .test_params = {"surface=wrap"},  // a free tree passes through solids
+};
 
 const std::vector<std::string>& setting_names() {
   static const std::vector<std::string> names = [] {
@@ -245,48 +247,60 @@ Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* quer
     stbi_image_free(px);
   }
 
-  auto& d = s.derive;
-  d.host = s.host.get();
-  d.seed = seed;
-  d.probability = p.text("probability") == "normalized" ? lsys::ProbabilityMode::Normalized : lsys::ProbabilityMode::Sequential;
-  d.brackets_transparent = p.boolean("context_siblings") || s.grammar.ignore.test('[') || s.grammar.ignore.test(']');
-  d.max_symbols = static_cast<std::size_t>(p.integer("max_symbols"));
-  d.max_params = d.max_symbols * 2;
-  d.env.assign(lsys::kMaxSlots, 0.0);
-  d.env[lsys::kVarA] = p.real("angle");
-  d.env[lsys::kVarB] = p.real("b");
-  d.env[lsys::kVarC] = p.real("c");
-  d.env[lsys::kVarD] = p.real("d");
+  // Designated initializers: a member left out is a warning (-Wmissing-field-initializers), an error in CI.
+  const auto max_symbols = static_cast<std::size_t>(p.integer("max_symbols"));
+  s.derive = {
+      .host = s.host.get(),
+      .seed = seed,
+      .stream = 0,  // set for each plant before it is rewritten
+      .probability = p.text("probability") == "normalized" ? lsys::ProbabilityMode::Normalized
+                                                           : lsys::ProbabilityMode::Sequential,
+      .brackets_transparent =
+          p.boolean("context_siblings") || s.grammar.ignore.test('[') || s.grammar.ignore.test(']'),
+      .max_symbols = max_symbols,
+      .max_params = max_symbols * 2,
+      .env = {},
+  };
+  auto& env = s.derive.env;
+  env[lsys::kVarA] = p.real("angle");
+  env[lsys::kVarB] = p.real("b");
+  env[lsys::kVarC] = p.real("c");
+  env[lsys::kVarD] = p.real("d");
   for (const auto& [name, value] : vars) {
-    if (name == "b") d.env[lsys::kVarB] = value;
-    if (name == "c") d.env[lsys::kVarC] = value;
-    if (name == "d") d.env[lsys::kVarD] = value;
+    if (name == "b") env[lsys::kVarB] = value;
+    if (name == "c") env[lsys::kVarC] = value;
+    if (name == "d") env[lsys::kVarD] = value;
   }
-  d.env[lsys::kVarGravity] = p.real("gravity");
-  d.env[lsys::kVarLength] = p.real("step_size");
-  d.env[lsys::kVarWidth] = p.real("thickness");
-  for (std::size_t k = 0; k < user_values.size(); ++k) d.env[lsys::kUserVar0 + k] = user_values[k];
+  env[lsys::kVarGravity] = p.real("gravity");
+  env[lsys::kVarLength] = p.real("step_size");
+  env[lsys::kVarWidth] = p.real("thickness");
+  for (std::size_t k = 0; k < user_values.size(); ++k) env[lsys::kUserVar0 + k] = user_values[k];
 
-  auto& t = s.turtle;
-  t.step = p.real("step_size");
-  t.step_scale = p.real("step_scale");
-  t.angle = p.real("angle");
-  t.angle_scale = p.real("angle_scale");
-  t.thickness = p.real("thickness");
-  t.thickness_scale = p.real("thickness_scale");
-  t.gravity = p.real("gravity");
-  t.random_scale = p.real("random_scale");
-  t.uv_increment = {p.real("u_increment"), p.real("v_increment")};
-  t.convention = p.text("convention") == "abop" ? lsys::Convention::Abop : lsys::Convention::Houdini;
-  t.continuous_length = p.boolean("continuous_length");
-  t.continuous_angles = p.boolean("continuous_angles");
-  t.continuous_width = p.boolean("continuous_width");
-  t.seed = seed;
-  t.wrap_offset = p.real("wrap_offset");
-  if (p.text("surface") == "wrap") {
-    if (!query) throw InputError("surface=wrap needs a scene with surfaces");
-    t.wrap = query;
-  }
+  if (p.text("surface") == "wrap" && !query) throw InputError("surface=wrap needs a scene with surfaces");
+  s.turtle = {
+      .step = p.real("step_size"),
+      .step_scale = p.real("step_scale"),
+      .angle = p.real("angle"),
+      .angle_scale = p.real("angle_scale"),
+      .thickness = p.real("thickness"),
+      .thickness_scale = p.real("thickness_scale"),
+      .gravity = p.real("gravity"),
+      .random_scale = p.real("random_scale"),
+      .uv_increment = {p.real("u_increment"), p.real("v_increment")},
+      .convention = p.text("convention") == "abop" ? lsys::Convention::Abop : lsys::Convention::Houdini,
+      // The plant's own, set for each plant when it is drawn; these draw one plant at the origin, +Y.
+      .fraction = 1.0,
+      .continuous_length = p.boolean("continuous_length"),
+      .continuous_angles = p.boolean("continuous_angles"),
+      .continuous_width = p.boolean("continuous_width"),
+      .seed = seed,
+      .stream = 0,
+      .origin = glm::dvec3(0.0),
+      .heading = glm::dvec3(0.0, 1.0, 0.0),
+      .wrap = p.text("surface") == "wrap" ? query : nullptr,
+      .wrap_offset = p.real("wrap_offset"),
+      .birth_step = 0,
+  };
   const double generations = p.real("generations");
   const int full = static_cast<int>(std::floor(generations + 1e-9));
   s.fraction = generations - full < 1e-6 ? 0.0 : generations - full;
@@ -411,8 +425,7 @@ class LSystem final : public GrowthAlgorithm {
 
 }  // namespace
 
-const AlgorithmInfo& lsystem_info() { return kInfo; }
-std::unique_ptr<GrowthAlgorithm> make_lsystem() { return std::make_unique<LSystem>(); }
+GROWBENCH_REGISTER_ALGORITHM(lsystem, LSystem, kInfo, lsys::TurtleSettings, lsys::DeriveSettings)
 
 std::vector<std::string> lsystem_examples() {
   std::vector<std::string> names;

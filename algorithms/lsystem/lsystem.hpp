@@ -10,9 +10,6 @@
 
 namespace growbench {
 
-const AlgorithmInfo& lsystem_info();
-std::unique_ptr<GrowthAlgorithm> make_lsystem();
-
 // What `growbench lsystem FILE --print` shows: the derived string (of the first plant) and its symbol
 // counts, without drawing (the turtle runs only if rules read its state).
 struct DerivedString {

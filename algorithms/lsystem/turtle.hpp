@@ -32,25 +32,27 @@ namespace growbench::lsys {
 
 enum class Convention { Houdini, Abop };
 
+// What the turtle draws with. The values come from the parameter table (make_setup in lsystem.cpp), the
+// per-plant ones from the plant being drawn: no member has a default of its own.
 struct TurtleSettings {
-  double step = 0.1;             // default F length (m)
-  double step_scale = 0.9;       // " and _
-  double angle = 30.0;           // default turn (degrees)
-  double angle_scale = 0.9;      // ; and @
-  double thickness = 0.01;       // default width (m)
-  double thickness_scale = 0.9;  // ! and ?
-  double gravity = 0.2;          // T: susceptibility (radians per unit |H x down|)
-  double random_scale = 0.0;     // lengths scaled by 1 + random_scale * uniform(-1, 1)
-  glm::dvec2 uv_increment{0.1, 0.1};
-  Convention convention = Convention::Houdini;
-  double fraction = 1.0;  // < 1: modules of the last generation are scaled by it (fractional generations)
-  bool continuous_length = true, continuous_angles = true, continuous_width = true;
-  std::uint64_t seed = 0, stream = 0;
-  glm::dvec3 origin{0.0};
-  glm::dvec3 heading{0.0, 1.0, 0.0};
-  const SceneQuery* wrap = nullptr;  // when set: every move is mapped onto the nearest surface
-  double wrap_offset = 0.005;
-  std::uint32_t birth_step = 0;
+  double step;             // default F length (m)
+  double step_scale;       // " and _
+  double angle;            // default turn (degrees)
+  double angle_scale;      // ; and @
+  double thickness;        // default width (m)
+  double thickness_scale;  // ! and ?
+  double gravity;          // T: susceptibility (radians per unit |H x down|)
+  double random_scale;     // lengths scaled by 1 + random_scale * uniform(-1, 1)
+  glm::dvec2 uv_increment;
+  Convention convention;
+  double fraction;  // < 1: modules of the last generation are scaled by it (fractional generations); else 1
+  bool continuous_length, continuous_angles, continuous_width;
+  std::uint64_t seed, stream;
+  glm::dvec3 origin;
+  glm::dvec3 heading;
+  const SceneQuery* wrap;  // when set: every move is mapped onto the nearest surface
+  double wrap_offset;
+  std::uint32_t birth_step;
 };
 
 struct TurtleResult {

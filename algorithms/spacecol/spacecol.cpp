@@ -30,45 +30,48 @@ namespace {
 
 // ---- parameter table (what `growbench list` prints) ----
 const AlgorithmInfo kInfo = {
-    "spacecol",
-    "Runions space colonization: attraction points pull nodes; open or closed venation; free, avoid or cling",
-    {
-        {"venation", ParamType::Choice, std::string("open"), -INFINITY, INFINITY, "",
-         "open: each point pulls its nearest node; closed: every node in its relative neighbourhood", {"open", "closed"}},
-        {"points", ParamType::Choice, std::string("auto"), -INFINITY, INFINITY, "",
-         "attraction points: in the scene envelope, on the surfaces (area-weighted), or from points_file; auto = "
-         "surface when surface=cling or the scene has no envelope, else envelope",
-         {"auto", "envelope", "surface", "file"}},
-        {"points_file", ParamType::String, std::string(""), -INFINITY, INFINITY, "",
-         "text file of attraction points, one 'x y z' (or x,y,z) per line, # comments (points=file)", {}},
-        {"point_count", ParamType::Int, std::int64_t{20000}, 1, 5e7, "", "number of attraction points sampled", {}},
-        {"surface_offset", ParamType::Real, 0.01, 0, 10, "m",
-         "surface-sampled points are lifted this far along the surface normal", {}},
-        {"influence", ParamType::Real, 0.25, 1e-4, 1e3, "m", "influence radius d_i: points farther from every node are ignored", {}},
-        {"kill", ParamType::Real, 0.05, 1e-5, 1e3, "m", "kill distance d_k: a point this close to a node is removed", {}},
-        {"step", ParamType::Real, 0.02, 1e-5, 1e2, "m", "step length D between a node and its child", {}},
-        {"tropism", ParamType::Vec3, glm::dvec3(0.0), -10, 10, "",
-         "added to each normalised growth direction (e.g. 0,0.2,0 bends growth upward)", {}},
-        {"noise", ParamType::Real, 0.0, 0, 10, "", "random unit vector times this is added to each growth direction", {}},
-        {"surface", ParamType::Choice, std::string("free"), -INFINITY, INFINITY, "",
-         "free: ignore solids; avoid: push nodes out of solids; cling: hold nodes at cling_distance from the "
-         "nearest surface (the Hyphae collision vector)",
-         {"free", "avoid", "cling"}},
-        {"cling_distance", ParamType::Real, 0.01, 0, 10, "m",
-         "distance kept from the surface (cling), minimum clearance (avoid)", {}},
-        {"split", ParamType::Real, 0.1, 0, 1, "",
-         "when the pulls on a node nearly cancel (|sum| < split * count), grow two children toward the two most "
-         "opposed points instead of stalling (0: such a node stalls)", {}},
-        {"seek", ParamType::Bool, true, -INFINITY, INFINITY, "",
-         "while no attraction point is within reach, roots grow along their seed direction", {}},
-        {"tip_radius", ParamType::Real, 0.002, 1e-6, 10, "m", "radius of branch tips (pipe model)", {}},
-        {"pipe_exponent", ParamType::Real, 2.5, 1, 4, "", "pipe model exponent n: r^n = sum of children's r^n", {}},
-        {"leaves", ParamType::Choice, std::string("tips"), -INFINITY, INFINITY, "",
-         "where leaves go: none, at branch tips, every leaf_interval nodes, or both", {"none", "tips", "interval", "both"}},
-        {"leaf_interval", ParamType::Int, std::int64_t{6}, 1, 1000, "", "a leaf every k nodes along a branch (leaves=interval/both)", {}},
-        {"leaf_size", ParamType::Real, 0.05, 0, 10, "m", "leaf blade length", {}},
+    .name = "spacecol",
+    .summary =
+        "Runions space colonization: attraction points pull nodes; open or closed venation; free, avoid or cling",
+    .params = {
+        param::choice("venation", "open", {"open", "closed"})
+            .doc("open: each point pulls its nearest node; closed: every node in its relative neighbourhood"),
+        param::choice("points", "auto", {"auto", "envelope", "surface", "file"})
+            .doc("attraction points: in the scene envelope, on the surfaces (area-weighted), or from points_file; "
+                 "auto = surface when surface=cling or the scene has no envelope, else envelope"),
+        param::text("points_file")
+            .doc("text file of attraction points, one 'x y z' (or x,y,z) per line, # comments (points=file)"),
+        param::integer("point_count", 20000).range(1, 5e7).doc("number of attraction points sampled"),
+        param::real("surface_offset", 0.01).range(0, 10).unit("m")
+            .doc("surface-sampled points are lifted this far along the surface normal"),
+        param::real("influence", 0.25).range(1e-4, 1e3).unit("m")
+            .doc("influence radius d_i: points farther from every node are ignored"),
+        param::real("kill", 0.05).range(1e-5, 1e3).unit("m")
+            .doc("kill distance d_k: a point this close to a node is removed"),
+        param::real("step", 0.02).range(1e-5, 1e2).unit("m").doc("step length D between a node and its child"),
+        param::vec3("tropism", glm::dvec3(0.0)).range(-10, 10)
+            .doc("added to each normalised growth direction (e.g. 0,0.2,0 bends growth upward)"),
+        param::real("noise", 0.0).range(0, 10).doc("random unit vector times this is added to each growth direction"),
+        param::choice("surface", "free", {"free", "avoid", "cling"})
+            .doc("free: ignore solids; avoid: push nodes out of solids; cling: hold nodes at cling_distance from the "
+                 "nearest surface (the Hyphae collision vector)"),
+        param::real("cling_distance", 0.01).range(0, 10).unit("m")
+            .doc("distance kept from the surface (cling), minimum clearance (avoid)"),
+        param::real("split", 0.1).range(0, 1)
+            .doc("when the pulls on a node nearly cancel (|sum| < split * count), grow two children toward the two "
+                 "most opposed points instead of stalling (0: such a node stalls)"),
+        param::boolean("seek", true)
+            .doc("while no attraction point is within reach, roots grow along their seed direction"),
+        param::real("tip_radius", 0.002).range(1e-6, 10).unit("m").doc("radius of branch tips (pipe model)"),
+        param::real("pipe_exponent", 2.5).range(1, 4).doc("pipe model exponent n: r^n = sum of children's r^n"),
+        param::choice("leaves", "tips", {"none", "tips", "interval", "both"})
+            .doc("where leaves go: none, at branch tips, every leaf_interval nodes, or both"),
+        param::integer("leaf_interval", 6).range(1, 1000)
+            .doc("a leaf every k nodes along a branch (leaves=interval/both)"),
+        param::real("leaf_size", 0.05).range(0, 10).unit("m").doc("leaf blade length"),
     },
-    {}};
+    .test_params = {"surface=avoid", "point_count=4000"},
+};
 
 using Cloud = Vec3Cloud;
 using PointTree = Vec3Tree;
@@ -102,7 +105,9 @@ glm::vec3 safe_normalize(const glm::vec3& v, const glm::vec3& fallback) {
   return len > 1e-20f ? v / len : fallback;
 }
 
-enum class Surface { Free, Avoid, Cling };
+using spacecol::Leaves;
+using spacecol::Points;
+using spacecol::Surface;
 constexpr std::int32_t kNone = -1;
 constexpr float kStallFraction = 0.05f;  // a child closer than this * step to a sibling means a stalled node
 
@@ -123,40 +128,27 @@ class SpaceColonization final : public GrowthAlgorithm {
     scene_ = &scene;
     query_ = &query;
     seed_ = seed;
-    closed_ = p.text("venation") == "closed";
-    influence_ = static_cast<float>(p.real("influence"));
-    kill_ = static_cast<float>(p.real("kill"));
-    step_len_ = static_cast<float>(p.real("step"));
-    tropism_ = glm::vec3(p.vec3("tropism"));
-    noise_ = static_cast<float>(p.real("noise"));
-    cling_ = static_cast<float>(p.real("cling_distance"));
-    seek_ = p.boolean("seek");
-    split_ = static_cast<float>(p.real("split"));
-    tip_radius_ = static_cast<float>(p.real("tip_radius"));
-    pipe_exponent_ = static_cast<float>(p.real("pipe_exponent"));
-    leaves_ = p.text("leaves");
-    leaf_interval_ = static_cast<int>(p.integer("leaf_interval"));
-    leaf_size_ = static_cast<float>(p.real("leaf_size"));
-    const std::string& s = p.text("surface");
-    surface_ = s == "cling" ? Surface::Cling : s == "avoid" ? Surface::Avoid : Surface::Free;
-    if (kill_ >= influence_)
-      throw InputError(fmt::format("algorithm 'spacecol': kill ({}) must be smaller than influence ({})", kill_, influence_));
-    if (step_len_ >= influence_)
-      throw InputError(fmt::format("algorithm 'spacecol': step ({}) must be smaller than influence ({})", step_len_, influence_));
-    if (surface_ != Surface::Free && !query.has_sdf())
+    cfg_ = spacecol::make_config(p);
+    if (cfg_.kill >= cfg_.influence)
+      throw InputError(fmt::format("algorithm 'spacecol': kill ({}) must be smaller than influence ({})", cfg_.kill,
+                                   cfg_.influence));
+    if (cfg_.step >= cfg_.influence)
+      throw InputError(fmt::format("algorithm 'spacecol': step ({}) must be smaller than influence ({})", cfg_.step,
+                                   cfg_.influence));
+    if (cfg_.surface != Surface::Free && !query.has_sdf())
       throw InputError("algorithm 'spacecol': surface=avoid/cling needs the scene's distance field");
 
-    sample_points(p);
+    sample_points(p.text("points_file"));
     closest_.assign(pts_.size(), kNone);
     closest_d2_.assign(pts_.size(), 0.0f);
     alive_.assign(pts_.size(), 1);
     where_.assign(pts_.size(), kFar);
     // tau: the near/far split. Small enough that near searches are cheap, large enough that most
     // covered points qualify (every live point is at least the kill distance from its nearest node).
-    tau_ = std::min(influence_, std::max(2.0f * kill_, kill_ + 2.0f * step_len_));
+    tau_ = std::min(cfg_.influence, std::max(2.0f * cfg_.kill, cfg_.kill + 2.0f * cfg_.step));
     build_trees();
     alive_count_ = pts_.size();
-    if (closed_) node_tree_ = std::make_unique<NodeTree>(3, node_cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    if (cfg_.closed) node_tree_ = std::make_unique<NodeTree>(3, node_cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(16));
     step_ = 0;
     add_due_roots();
   }
@@ -164,9 +156,9 @@ class SpaceColonization final : public GrowthAlgorithm {
   bool step() override {
     ++step_;
     std::vector<std::int32_t> new_nodes;
-    if (closed_) grow_closed(new_nodes);
+    if (cfg_.closed) grow_closed(new_nodes);
     else grow_open(new_nodes);
-    if (new_nodes.empty() && seek_ && !ever_influenced_) seek(new_nodes);
+    if (new_nodes.empty() && cfg_.seek && !ever_influenced_) seek(new_nodes);
     if (!new_nodes.empty()) associate(new_nodes);
     const bool roots_pending = add_due_roots();
     compact_active();
@@ -175,7 +167,7 @@ class SpaceColonization final : public GrowthAlgorithm {
   }
 
   void finish() override {
-    assign_pipe_radii(plant_, tip_radius_, pipe_exponent_);
+    assign_pipe_radii(plant_, cfg_.tip_radius, cfg_.pipe_exponent);
     place_leaves();
   }
 
@@ -233,13 +225,14 @@ class SpaceColonization final : public GrowthAlgorithm {
                                    what, scene_->name));
   }
 
-  void sample_points(const Params& p) {
-    std::string mode = p.text("points");
-    if (mode == "auto") mode = (surface_ == Surface::Cling || !scene_->envelope) ? "surface" : "envelope";
-    const auto count = static_cast<std::size_t>(p.integer("point_count"));
+  void sample_points(const std::string& points_file) {
+    Points mode = cfg_.points;
+    if (mode == Points::Auto)
+      mode = (cfg_.surface == Surface::Cling || !scene_->envelope) ? Points::Surface : Points::Envelope;
+    const std::size_t count = cfg_.point_count;
     pts_.clear();
     pts_.reserve(count);
-    if (mode == "envelope") {
+    if (mode == Points::Envelope) {
       if (!scene_->envelope)
         throw InputError(fmt::format("algorithm 'spacecol': points=envelope but scene '{}' has no envelope", scene_->name));
       const Shape& env = *scene_->envelope;
@@ -255,14 +248,14 @@ class SpaceColonization final : public GrowthAlgorithm {
         return glm::vec3(std::numeric_limits<float>::quiet_NaN());
       }, "in the envelope");
       pts_.erase(std::remove_if(pts_.begin(), pts_.end(), [](const glm::vec3& v) { return std::isnan(v.x); }), pts_.end());
-    } else if (mode == "surface") {
-      const auto off = static_cast<float>(p.real("surface_offset"));
+    } else if (mode == Points::Surface) {
+      const float off = cfg_.surface_offset;
       sample_accepted(count, [&](std::size_t i) {
         const SurfaceSample s = query_->sample_surface(seed_, i);
         return s.position + off * s.normal;
       }, "on the surfaces");
     } else {
-      read_points_file(p.text("points_file"));
+      read_points_file(points_file);
     }
     morton_order();
   }
@@ -377,14 +370,14 @@ class SpaceColonization final : public GrowthAlgorithm {
 
   // Where a node grown from `from` along `dir` lands, after the surface mode has its say.
   glm::vec3 place(const glm::vec3& from, const glm::vec3& dir) const {
-    glm::vec3 c = from + step_len_ * dir;
-    if (surface_ == Surface::Free) return c;
+    glm::vec3 c = from + cfg_.step * dir;
+    if (cfg_.surface == Surface::Free) return c;
     // A few fixed-point iterations: the SDF gradient is that of a trilinear field, so one push lands close.
     for (int it = 0; it < 3; ++it) {
       const float d = query_->signed_distance(c);
-      if (surface_ == Surface::Avoid && d >= cling_) break;
-      if (std::abs(d - cling_) < 1e-3f * step_len_) break;
-      c += (cling_ - d) * query_->gradient(c);
+      if (cfg_.surface == Surface::Avoid && d >= cfg_.cling_distance) break;
+      if (std::abs(d - cfg_.cling_distance) < 1e-3f * cfg_.step) break;
+      c += (cfg_.cling_distance - d) * query_->gradient(c);
     }
     return c;
   }
@@ -392,12 +385,12 @@ class SpaceColonization final : public GrowthAlgorithm {
   // A node is stalled when its new child would land on the node itself (held back by a solid), on an
   // existing child (the same pull again) or back on its own parent (oscillating between two points).
   bool is_stalled_child(std::int32_t parent, const glm::vec3& pos) const {
-    const float lim2 = (kStallFraction * step_len_) * (kStallFraction * step_len_);
+    const float lim2 = (kStallFraction * cfg_.step) * (kStallFraction * cfg_.step);
     const glm::vec3 self = node_pos_[static_cast<std::size_t>(parent)] - pos;
     if (glm::dot(self, self) < lim2) return true;  // pushed back onto itself (growing into a solid)
     if (const std::int32_t gp = plant_.nodes[static_cast<std::size_t>(parent)].parent; gp != kNone) {
       const glm::vec3 d = node_pos_[static_cast<std::size_t>(gp)] - pos;
-      if (glm::dot(d, d) < 0.25f * step_len_ * step_len_) return true;
+      if (glm::dot(d, d) < 0.25f * cfg_.step * cfg_.step) return true;
     }
     for (std::int32_t c = first_child_[static_cast<std::size_t>(parent)]; c != kNone; c = next_sibling_[static_cast<std::size_t>(c)]) {
       const glm::vec3 d = node_pos_[static_cast<std::size_t>(c)] - pos;
@@ -406,13 +399,13 @@ class SpaceColonization final : public GrowthAlgorithm {
     return false;
   }
 
-  bool cancelling(const Pull& p) const { return split_ > 0.0f && glm::length(p.sum) < split_ * static_cast<float>(p.count); }
+  bool cancelling(const Pull& p) const { return cfg_.split > 0.0f && glm::length(p.sum) < cfg_.split * static_cast<float>(p.count); }
 
   glm::vec3 steer(glm::vec3 dir, std::size_t v, std::uint64_t salt) const {
-    dir = safe_normalize(dir + tropism_, dir);
-    if (noise_ > 0.0f) {
+    dir = safe_normalize(dir + cfg_.tropism, dir);
+    if (cfg_.noise > 0.0f) {
       Rng rng(seed_, 0x40000000ull + v, static_cast<std::uint64_t>(step_) * 4 + salt);
-      dir = safe_normalize(dir + noise_ * rng.unit_vector(), dir);
+      dir = safe_normalize(dir + cfg_.noise * rng.unit_vector(), dir);
     }
     return dir;
   }
@@ -428,7 +421,7 @@ class SpaceColonization final : public GrowthAlgorithm {
         const auto v = static_cast<std::size_t>(influenced[k]);
         const Pull& p = pull[k];
         // A node the field's push leaves inside a solid (one thinner than its voxels) does not grow.
-        auto outside = [&](const glm::vec3& c) { return surface_ != Surface::Free && query_->inside(c) ? none : c; };
+        auto outside = [&](const glm::vec3& c) { return cfg_.surface != Surface::Free && query_->inside(c) ? none : c; };
         if (cancelling(p) && p.min_dot < 0.0f) {
           target[k] = {outside(place(node_pos_[v], steer(p.first, v, 1))), outside(place(node_pos_[v], steer(p.opposite, v, 2)))};
           continue;
@@ -501,7 +494,7 @@ class SpaceColonization final : public GrowthAlgorithm {
 
   void grow_closed(std::vector<std::int32_t>& new_nodes) {
     // For each active point, its relative neighbourhood among the nodes within the influence radius.
-    const float r2 = influence_ * influence_, k2 = kill_ * kill_;
+    const float r2 = cfg_.influence * cfg_.influence, k2 = cfg_.kill * cfg_.kill;
     std::vector<std::vector<std::uint32_t>> rn(active_.size());
     std::vector<std::uint8_t> dies(active_.size(), 0);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, active_.size(), 64), [&](const auto& r) {
@@ -575,7 +568,7 @@ class SpaceColonization final : public GrowthAlgorithm {
   // below its crown).
   void seek(std::vector<std::int32_t>& new_nodes) {
     const Aabb b = scene_->bounds();
-    const int limit = static_cast<int>(std::ceil(2.0f * glm::length(b.size()) / step_len_)) + 1;
+    const int limit = static_cast<int>(std::ceil(2.0f * glm::length(b.size()) / cfg_.step)) + 1;
     if (seek_steps_++ > limit) return;
     for (auto& [tip, dir] : seek_tips_) {
       const std::int32_t n = add_node(place(node_pos_[static_cast<std::size_t>(tip)], dir), tip);
@@ -595,9 +588,9 @@ class SpaceColonization final : public GrowthAlgorithm {
 
   // Updates nearest nodes, activations and kills for points near the given (new) nodes.
   void associate(const std::vector<std::int32_t>& nodes) {
-    if (closed_) node_tree_->addPoints(static_cast<std::uint32_t>(node_pos_.size() - nodes.size()),
+    if (cfg_.closed) node_tree_->addPoints(static_cast<std::uint32_t>(node_pos_.size() - nodes.size()),
                                        static_cast<std::uint32_t>(node_pos_.size() - 1));
-    const float r2 = influence_ * influence_, k2 = kill_ * kill_;
+    const float r2 = cfg_.influence * cfg_.influence, k2 = cfg_.kill * cfg_.kill;
     std::vector<std::vector<std::pair<std::uint32_t, float>>> found(nodes.size());
     // Only points the new node is nearer to than their current nearest can change (every live point is
     // farther than the kill distance from its nearest node, so this also keeps every point to kill).
@@ -627,7 +620,7 @@ class SpaceColonization final : public GrowthAlgorithm {
       const std::int32_t v = nodes[k];
       for (const auto& [s, d2] : found[k]) {
         if (!alive_[s]) continue;
-        if (!closed_ && d2 < k2) {
+        if (!cfg_.closed && d2 < k2) {
           kill_point(s);
           continue;
         }
@@ -679,19 +672,20 @@ class SpaceColonization final : public GrowthAlgorithm {
 
   // ---------- leaves ----------
   void place_leaves() {
-    if (leaves_ == "none" || leaf_size_ <= 0.0f) return;
-    const bool tips = leaves_ == "tips" || leaves_ == "both", interval = leaves_ == "interval" || leaves_ == "both";
+    if (cfg_.leaves == Leaves::None || cfg_.leaf_size <= 0.0f) return;
+    const bool tips = cfg_.leaves == Leaves::Tips || cfg_.leaves == Leaves::Both;
+    const bool interval = cfg_.leaves == Leaves::Interval || cfg_.leaves == Leaves::Both;
     std::vector<int> depth(plant_.nodes.size(), 0);
     for (std::size_t i = 0; i < plant_.nodes.size(); ++i) {
       const auto& n = plant_.nodes[i];
       if (n.parent != kNone) depth[i] = depth[static_cast<std::size_t>(n.parent)] + 1;
       const bool tip = first_child_[i] == kNone && n.parent != kNone;
-      if (!((tips && tip) || (interval && n.parent != kNone && depth[i] % leaf_interval_ == 0))) continue;
+      if (!((tips && tip) || (interval && n.parent != kNone && depth[i] % cfg_.leaf_interval == 0))) continue;
       const glm::vec3 axis =
           safe_normalize(n.position - plant_.nodes[static_cast<std::size_t>(n.parent)].position, glm::vec3(0, 1, 0));
       Rng rng(seed_, 0x1EAFull, i);
       // Upper side faces away from the nearest surface when clinging, otherwise up (toward the sky).
-      glm::vec3 up = surface_ == Surface::Free ? glm::vec3(0, 1, 0) : query_->gradient(n.position);
+      glm::vec3 up = cfg_.surface == Surface::Free ? glm::vec3(0, 1, 0) : query_->gradient(n.position);
       // Blade: along the branch, tilted away from the axis by a random angle around it.
       glm::vec3 side = safe_normalize(glm::cross(axis, up), safe_normalize(glm::cross(axis, glm::vec3(1, 0, 0)), glm::vec3(0, 0, 1)));
       if (rng.uniform() < 0.5) side = -side;
@@ -701,7 +695,7 @@ class SpaceColonization final : public GrowthAlgorithm {
       Organ leaf;
       leaf.position = n.position;
       leaf.orientation = glm::quat_cast(glm::mat3(x, normal, blade));
-      leaf.size = leaf_size_ * static_cast<float>(rng.uniform(0.8, 1.2));
+      leaf.size = cfg_.leaf_size * static_cast<float>(rng.uniform(0.8, 1.2));
       leaf.kind = tip ? OrganKind::YoungLeaf : OrganKind::Leaf;
       leaf.node = static_cast<std::int32_t>(i);
       plant_.organs.push_back(leaf);
@@ -712,14 +706,8 @@ class SpaceColonization final : public GrowthAlgorithm {
   const Scene* scene_ = nullptr;
   const SceneQuery* query_ = nullptr;
   std::uint64_t seed_ = 0;
-  bool closed_ = false, seek_ = true, ever_influenced_ = false;
-  float split_ = 0;
-  float influence_ = 0, kill_ = 0, step_len_ = 0, noise_ = 0, cling_ = 0, tip_radius_ = 0, pipe_exponent_ = 2;
-  glm::vec3 tropism_{0.0f};
-  Surface surface_ = Surface::Free;
-  std::string leaves_;
-  int leaf_interval_ = 1;
-  float leaf_size_ = 0;
+  spacecol::Config cfg_{};  // set by start()
+  bool ever_influenced_ = false;
 
   std::vector<glm::vec3> pts_;
   // Live points split at the last rebuild into far (no node within tau) and near ones, each in its own
@@ -753,7 +741,43 @@ class SpaceColonization final : public GrowthAlgorithm {
 
 }  // namespace
 
-const AlgorithmInfo& spacecol_info() { return kInfo; }
-std::unique_ptr<GrowthAlgorithm> make_spacecol() { return std::make_unique<SpaceColonization>(); }
+namespace spacecol {
+
+Config make_config(const Params& p) {
+  const std::string& points = p.text("points");
+  const std::string& surface = p.text("surface");
+  const std::string& leaves = p.text("leaves");
+  // Designated initializers: a member left out is a warning (-Wmissing-field-initializers), an error in CI.
+  return {
+      .closed = p.text("venation") == "closed",
+      .points = points == "envelope" ? Points::Envelope
+                : points == "surface" ? Points::Surface
+                : points == "file"    ? Points::File
+                                      : Points::Auto,
+      .point_count = static_cast<std::size_t>(p.integer("point_count")),
+      .surface_offset = static_cast<float>(p.real("surface_offset")),
+      .influence = static_cast<float>(p.real("influence")),
+      .kill = static_cast<float>(p.real("kill")),
+      .step = static_cast<float>(p.real("step")),
+      .tropism = glm::vec3(p.vec3("tropism")),
+      .noise = static_cast<float>(p.real("noise")),
+      .surface = surface == "cling" ? Surface::Cling : surface == "avoid" ? Surface::Avoid : Surface::Free,
+      .cling_distance = static_cast<float>(p.real("cling_distance")),
+      .split = static_cast<float>(p.real("split")),
+      .seek = p.boolean("seek"),
+      .tip_radius = static_cast<float>(p.real("tip_radius")),
+      .pipe_exponent = static_cast<float>(p.real("pipe_exponent")),
+      .leaves = leaves == "none" ? Leaves::None
+                : leaves == "tips" ? Leaves::Tips
+                : leaves == "interval" ? Leaves::Interval
+                                       : Leaves::Both,
+      .leaf_interval = static_cast<int>(p.integer("leaf_interval")),
+      .leaf_size = static_cast<float>(p.real("leaf_size")),
+  };
+}
+
+}  // namespace spacecol
+
+GROWBENCH_REGISTER_ALGORITHM(spacecol, SpaceColonization, kInfo, spacecol::Config)
 
 }  // namespace growbench

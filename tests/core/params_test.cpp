@@ -1,5 +1,8 @@
 #include "core/params.hpp"
 
+#include <limits>
+#include <stdexcept>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -11,16 +14,45 @@ namespace {
 
 std::vector<ParamSpec> specs() {
   return {
-      {"step", ParamType::Real, 0.02, 1e-4, 1.0, "m", "step length", {}},
-      {"count", ParamType::Int, std::int64_t{10}, 1, 100, "", "a count", {}},
-      {"flag", ParamType::Bool, false, -INFINITY, INFINITY, "", "a flag", {}},
-      {"mode", ParamType::Choice, std::string("open"), -INFINITY, INFINITY, "", "mode", {"open", "closed"}},
-      {"dir", ParamType::Vec3, glm::dvec3(0, 1, 0), -10, 10, "", "direction", {}},
-      {"file", ParamType::String, std::string(""), -INFINITY, INFINITY, "", "a path", {}},
+      param::real("step", 0.02).range(1e-4, 1.0).unit("m").doc("step length"),
+      param::integer("count", 10).range(1, 100).doc("a count"),
+      param::boolean("flag", false).doc("a flag"),
+      param::choice("mode", "open", {"open", "closed"}).doc("mode"),
+      param::vec3("dir", glm::dvec3(0, 1, 0)).range(-10, 10).doc("direction"),
+      param::text("file").doc("a path"),
   };
 }
 
 using test::error_of;
+
+// A row states only what it has; the rest is the spec's own: no range, no unit, no doc.
+TEST(Params, RowsStateOnlyWhatTheyHave) {
+  const ParamSpec bare = param::real("x", 1.5);
+  EXPECT_EQ(bare.name, "x");
+  EXPECT_EQ(bare.type, ParamType::Real);
+  EXPECT_EQ(std::get<double>(bare.default_value), 1.5);
+  EXPECT_EQ(bare.min, -std::numeric_limits<double>::infinity());
+  EXPECT_EQ(bare.max, std::numeric_limits<double>::infinity());
+  EXPECT_EQ(bare.unit, "");
+  EXPECT_EQ(bare.doc, "");
+  EXPECT_TRUE(bare.choices.empty());
+  const ParamSpec full = param::integer("n", 3).range(1, 9).unit("m").doc("a count");
+  EXPECT_EQ(full.type, ParamType::Int);
+  EXPECT_EQ(std::get<std::int64_t>(full.default_value), 3);
+  EXPECT_EQ(full.min, 1);
+  EXPECT_EQ(full.max, 9);
+  EXPECT_EQ(full.unit, "m");
+  EXPECT_EQ(full.doc, "a count");
+  const ParamSpec text = param::text("path");
+  EXPECT_EQ(text.type, ParamType::String);
+  EXPECT_EQ(std::get<std::string>(text.default_value), "");
+  const ParamSpec mode = param::choice("mode", "b", {"a", "b"});
+  EXPECT_EQ(mode.type, ParamType::Choice);
+  EXPECT_EQ(std::get<std::string>(mode.default_value), "b");
+  EXPECT_EQ(mode.choices, (std::vector<std::string>{"a", "b"}));
+  // A default that is not a choice is a mistake in the table, caught where the table is built.
+  EXPECT_THROW((void)param::choice("mode", "c", {"a", "b"}), std::logic_error);
+}
 
 TEST(Params, DefaultsAndParsing) {
   Params p("algorithm 'x'", specs());

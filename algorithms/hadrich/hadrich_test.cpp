@@ -18,10 +18,10 @@ namespace {
 using hadrich::Particles;
 using hadrich::Simulator;
 
-hadrich::Config config(const std::vector<std::string>& sets) {
+hadrich::Setup setup(const std::vector<std::string>& sets) {
   Params p = default_params(find_algorithm("hadrich"));
   for (const auto& s : sets) p.set_assignment(s);
-  return hadrich::make_config(p);
+  return hadrich::make_setup(p);
 }
 
 // A lone wall in the plane z = 0 (front face at z = 0.05), a seed `gap` in front of it, sun overhead.
@@ -58,7 +58,7 @@ TEST(Hadrich, PruneEntriesParseAndBadOnesAreNamed) {
   EXPECT_NE(test::error_of([] { hadrich::parse_cuts("1,2,3,-1@4"); }).find("negative radius"), std::string::npos);
   EXPECT_NE(test::error_of([] { hadrich::parse_cuts("1,2,3,1@-4"); }).find("step '-4'"), std::string::npos);
   // Through the parameter table, the error names the parameter.
-  EXPECT_NE(test::error_of([] { config({"prune=1,2,3@4"}); }).find("parameter 'prune'"), std::string::npos);
+  EXPECT_NE(test::error_of([] { setup({"prune=1,2,3@4"}); }).find("parameter 'prune'"), std::string::npos);
 }
 
 // A shoot started 8 cm in front of a wall, growing straight up (the light is overhead, so
@@ -66,7 +66,7 @@ TEST(Hadrich, PruneEntriesParseAndBadOnesAreNamed) {
 TEST(Hadrich, AdaptationPullsAShootOntoAWallAndKeepsItThere) {
   const Scene s = wall_scene(0.08f);
   SceneQuery q(s);
-  Simulator sim(s, q, config({"max_laterals=0", "max_particles=120", "direction_noise=0", "light_rays=0"}), 1);
+  Simulator sim(s, q, setup({"max_laterals=0", "max_particles=120", "direction_noise=0", "light_rays=0"}), 1);
   for (int i = 0; i < 600 && sim.step(); ++i) {
   }
   const auto gaps = main_shoot_gaps(sim);
@@ -76,7 +76,7 @@ TEST(Hadrich, AdaptationPullsAShootOntoAWallAndKeepsItThere) {
   for (std::size_t k = gaps.size() / 2; k < gaps.size(); ++k) EXPECT_LT(gaps[k], 0.015f) << "particle " << k;
   for (const float g : gaps) EXPECT_GT(g, 0.0f);
   // The same shoot with adaptation off stays where it started.
-  Simulator free(s, q, config({"max_laterals=0", "max_particles=120", "direction_noise=0", "light_rays=0", "adaptation=0"}), 1);
+  Simulator free(s, q, setup({"max_laterals=0", "max_particles=120", "direction_noise=0", "light_rays=0", "adaptation=0"}), 1);
   for (int i = 0; i < 600 && free.step(); ++i) {
   }
   const auto free_gaps = main_shoot_gaps(free);
@@ -95,7 +95,7 @@ TEST(Hadrich, PhototropismTurnsTowardTheLight) {
   auto tip_direction = [&](const std::vector<std::string>& sets) {
     auto sets2 = sets;
     for (const char* x : {"max_laterals=0", "max_particles=60", "direction_noise=0", "gravity=0"}) sets2.emplace_back(x);
-    Simulator sim(s, q, config(sets2), 1);
+    Simulator sim(s, q, setup(sets2), 1);
     for (int i = 0; i < 400 && sim.step(); ++i) {
     }
     return sim.forward(sim.particles().size() - 1);
@@ -117,7 +117,7 @@ TEST(Hadrich, GrowthSlowsInTheShade) {
   s.seeds.push_back({{3.0f, 0.0f, 0.0f}, {0, 1, 0}, 0});
   s.light.direction = {0.0f, 1.0f, 0.0f};
   SceneQuery q(s);
-  Simulator sim(s, q, config({"max_laterals=0", "direction_noise=0", "phototropism=0", "gravity=0", "shade_growth=0.25"}), 1);
+  Simulator sim(s, q, setup({"max_laterals=0", "direction_noise=0", "phototropism=0", "gravity=0", "shade_growth=0.25"}), 1);
   for (int i = 0; i < 100; ++i) sim.step();
   const Particles& p = sim.particles();
   float shaded = 0.0f, sunny = 0.0f;
@@ -152,7 +152,7 @@ TEST(Hadrich, NoNodeInsideClosedSolids) {
 TEST(Hadrich, PruningRemovesExactlyTheSubtree) {
   const Scene s = load_scene("wall");
   SceneQuery q(s);
-  Simulator sim(s, q, config({"max_particles=6000"}), 3);
+  Simulator sim(s, q, setup({"max_particles=6000"}), 3);
   for (int i = 0; i < 250; ++i) ASSERT_TRUE(sim.step());
   const Particles& p = sim.particles();
   // A particle with a lateral among its descendants, a quarter of the way into the pool.
@@ -196,7 +196,7 @@ TEST(Hadrich, PruningRemovesExactlyTheSubtree) {
 TEST(Hadrich, PruneParameterCutsAtItsStep) {
   const Scene s = load_scene("wall", {"seeds=1"});
   SceneQuery q(s);
-  Simulator probe(s, q, config({"max_particles=2000"}), 1);
+  Simulator probe(s, q, setup({"max_particles=2000"}), 1);
   for (int i = 0; i < 150; ++i) probe.step();
   const std::size_t before = probe.node_count();
   std::vector<glm::vec3> heads;
@@ -204,7 +204,7 @@ TEST(Hadrich, PruneParameterCutsAtItsStep) {
   const std::size_t target = heads.size() / 2;
   const glm::vec3 at = heads[target];
   for (const float radius : {0.0f, 0.1f}) {
-    Simulator sim(s, q, config({"max_particles=2000", fmt::format("prune={},{},{},{}@150", at.x, at.y, at.z, radius)}), 1);
+    Simulator sim(s, q, setup({"max_particles=2000", fmt::format("prune={},{},{},{}@150", at.x, at.y, at.z, radius)}), 1);
     for (int i = 0; i < 150; ++i) sim.step();
     EXPECT_EQ(sim.node_count(), before);
     sim.step();
@@ -230,7 +230,7 @@ TEST(Hadrich, BreakingUnderLoadAndNeverWithSensitivityZero) {
   SceneQuery q(s);
   auto broken = [&](const char* sensitivity) {
     Simulator sim(s, q,
-                  config({"max_particles=150", "max_laterals=0", "gravity=0", "wind_strength=400", "wind=1,0,0",
+                  setup({"max_particles=150", "max_laterals=0", "gravity=0", "wind_strength=400", "wind=1,0,0",
                           sensitivity}),
                   1);
     for (int i = 0; i < 800; ++i) sim.step();
@@ -251,7 +251,7 @@ TEST(Hadrich, BreakingUnderLoadAndNeverWithSensitivityZero) {
 TEST(Hadrich, StableOverTenThousandSteps) {
   const Scene s = load_scene("corner", {"seeds=1"});
   SceneQuery q(s);
-  Simulator sim(s, q, config({"max_particles=400", "wind_strength=3", "wind_gusts=1"}), 2);
+  Simulator sim(s, q, setup({"max_particles=400", "wind_strength=3", "wind_gusts=1"}), 2);
   float worst = 0.0f;
   const Aabb box = s.bounds();
   for (int i = 0; i < 10000; ++i) {

@@ -25,13 +25,14 @@ Grammar grammar(const std::string& premise, const std::string& rules) {
 }
 
 DeriveSettings settings(const NoHost& host) {
-  DeriveSettings s;
-  s.host = &host;
-  s.seed = 1;
-  s.max_symbols = 200'000'000;
-  s.max_params = 400'000'000;
-  s.env.assign(kMaxSlots, 0.0);
-  return s;
+  return {.host = &host,
+          .seed = 1,
+          .stream = 0,
+          .probability = ProbabilityMode::Sequential,
+          .brackets_transparent = false,
+          .max_symbols = 200'000'000,
+          .max_params = 400'000'000,
+          .env = {}};
 }
 
 // Derives `generations - 1` generations, then times the last one.
@@ -86,8 +87,27 @@ void BM_LsysTurtle(benchmark::State& state) {
     d.rewrite(a, b, k, {});
     std::swap(a, b);
   }
-  TurtleSettings ts;
-  ts.angle = 25.7;
+  const TurtleSettings ts = {.step = 0.1,
+                             .step_scale = 0.9,
+                             .angle = 25.7,
+                             .angle_scale = 0.9,
+                             .thickness = 0.01,
+                             .thickness_scale = 0.9,
+                             .gravity = 0.2,
+                             .random_scale = 0.0,
+                             .uv_increment = {0.1, 0.1},
+                             .convention = Convention::Houdini,
+                             .fraction = 1.0,
+                             .continuous_length = true,
+                             .continuous_angles = true,
+                             .continuous_width = true,
+                             .seed = 0,
+                             .stream = 0,
+                             .origin = glm::dvec3(0.0),
+                             .heading = glm::dvec3(0.0, 1.0, 0.0),
+                             .wrap = nullptr,
+                             .wrap_offset = 0.0,
+                             .birth_step = 0};
   std::size_t nodes = 0;
   Plant reused;
   for (auto _ : state) {

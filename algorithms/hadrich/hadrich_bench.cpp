@@ -45,7 +45,7 @@ Grown& grown(std::size_t particles, int which, std::size_t threads) {
     }
     Params p = default_params(find_algorithm("hadrich"));
     p.set_assignment(fmt::format("max_particles={}", 2 * particles));
-    g.sim = std::make_unique<hadrich::Simulator>(g.scene, *g.query, hadrich::make_config(p), 1);
+    g.sim = std::make_unique<hadrich::Simulator>(g.scene, *g.query, hadrich::make_setup(p), 1);
     while (g.sim->particles().size() < particles && g.sim->step()) {
     }
   }
