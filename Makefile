@@ -9,7 +9,7 @@ JOBS ?= $(shell nproc)
 # Repetitions per cell in `make demo` (a number, or "suite" for the standard suite's own).
 DEMO_REPETITIONS ?= 1
 
-.PHONY: all deps configure build cli test demo demo-full bench gate baseline format clean
+.PHONY: all deps configure build cli test demo demo-full bench gate baseline readme-params format clean
 
 all: build
 
@@ -49,6 +49,11 @@ baseline: build
 	rm -rf $(GATE)
 	$(GROWBENCH) suite bench/suites/quick.json --instructions --out $(GATE) -q > $(BUILD)/gate.log
 	$(GROWBENCH) baseline update $(GATE)/results.json --baseline reports/baselines/quick.json
+
+# Fill the parameter tables in algorithms/*/README.md from `growbench list --markdown NAME` (commit them;
+# the ctest readme.params fails while a committed table differs from the binary's).
+readme-params: cli
+	/usr/bin/python3 scripts/readme-params $(GROWBENCH)
 
 bench: build
 	$(BUILD)/bench/growbench_bench

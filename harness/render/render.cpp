@@ -122,22 +122,9 @@ glm::vec3 any_perpendicular(const glm::vec3& d) {
   return glm::normalize(glm::cross(d, a));
 }
 
-
-}  // namespace
-
-std::uint64_t write_pov(const std::string& path, const Scene& scene, const Plant& plant, const RenderOptions& o) {
-  fmt::memory_buffer b;
-  auto out = std::back_inserter(b);
+// The file's first line, the global settings (radiosity in paper quality), the materials and the sky.
+void write_settings(Out out, const Scene& scene, const Plant& plant, const RenderOptions& o, float diag) {
   const bool paper = o.quality == RenderQuality::Paper;
-  const int w = render_width(o), h = render_height(o);
-  const float aspect = static_cast<float>(w) / static_cast<float>(h);
-
-  Aabb bounds = scene.bounds();
-  for (const auto& n : plant.nodes) bounds.extend(n.position);
-  if (bounds.empty()) bounds.extend(glm::vec3(0.0f));
-  const glm::vec3 centre = bounds.center();
-  const float diag = std::max(glm::length(bounds.size()), 1.0f);
-
   fmt::format_to(out,
                  "// growbench render: scene '{}', {} nodes, {} organs, quality {}\n"
                  "#version 3.7;\n"
@@ -162,17 +149,22 @@ std::uint64_t write_pov(const std::string& path, const Scene& scene, const Plant
   fmt::format_to(out,
                  "sky_sphere {{ pigment {{ gradient y color_map {{ [0.0 srgb <0.93,0.94,0.95>] [0.5 srgb <0.93,0.94,0.95>]\n"
                  "  [1.0 srgb <0.50,0.66,0.86>] }} scale 2 translate -1 }} }}\n");
+}
 
-  // Camera: the scene's, with its vertical field of view kept at the image's aspect.
-  const float vfov = glm::radians(scene.camera.fov_deg);
+// The scene's camera, with its vertical field of view kept at the image's aspect.
+void write_camera(Out out, const Camera& camera, float aspect) {
+  const float vfov = glm::radians(camera.fov_deg);
   const float hfov = 2.0f * std::atan(std::tan(0.5f * vfov) * aspect);
   fmt::format_to(out, "camera {{ perspective location ");
-  vec(out, pov(scene.camera.position));
+  vec(out, pov(camera.position));
   fmt::format_to(out, " look_at ");
-  vec(out, pov(scene.camera.look_at));
+  vec(out, pov(camera.look_at));
   fmt::format_to(out, " right x*{:.6g} up y angle {:.6g} }}\n", aspect, glm::degrees(hfov));
+}
 
-  // The scene light: the sun as a parallel light from far along its direction, or the point light.
+// The scene light: the sun as a parallel light from far along its direction, or the point light; in the
+// preview also a dim shadowless light at the camera.
+void write_lights(Out out, const Scene& scene, const glm::vec3& centre, float diag, bool paper) {
   const bool sun = scene.light.kind == Light::Kind::Sun;
   const glm::vec3 towards = sun ? glm::normalize(scene.light.direction) : glm::normalize(scene.light.position - centre);
   const glm::vec3 lpos = sun ? centre + towards * (20.0f * diag) : scene.light.position;
@@ -199,107 +191,137 @@ std::uint64_t write_pov(const std::string& path, const Scene& scene, const Plant
     vec(out, pov(scene.camera.position));
     fmt::format_to(out, " color srgb 0.35 shadowless }}\n");
   }
+}
 
-  // Ground: a plane under everything (the scene's own ground mesh, when it has one, sits on it).
-  fmt::format_to(out, "plane {{ y, {:.6g} texture {{ GB_Ground }} }}\n", bounds.min.y - 1e-3f);
-
-  // Scene meshes.
+void write_scene_meshes(Out out, const Scene& scene) {
   for (const auto& m : scene.meshes) {
     if (m.triangles.empty()) continue;
     fmt::format_to(out, "// scene mesh '{}': {} triangles\n", m.name, m.triangles.size());
     write_mesh2(out, m.vertices, smooth_normals(m), m.triangles, 0, static_cast<std::uint32_t>(m.triangles.size()));
     fmt::format_to(out, "  texture {{ {} }}\n}}\n", m.climbable ? "GB_Surface" : "GB_Ground");
   }
+}
 
-  if (o.draw_plant) {
-    // Branches.
-    if (o.branches == "mesh") {
-      const OutputMesh tubes = mesh_plant(Plant{plant.nodes, {}, {}, {}, {}}, o.mesher);
-      if (!tubes.triangles.empty()) {
-        fmt::format_to(out, "// branches: {} nodes as one mesh2\n", plant.nodes.size());
-        write_mesh2(out, tubes.positions, tubes.normals, tubes.triangles, 0,
-                    static_cast<std::uint32_t>(tubes.triangles.size()));
-        fmt::format_to(out, "  texture {{ GB_Bark }}\n}}\n");
-      }
-    } else if (o.branches == "cones") {
-      std::vector<std::uint8_t> has_child(plant.nodes.size(), 0);
-      for (const auto& n : plant.nodes)
-        if (n.parent != kNoParent) has_child[static_cast<std::size_t>(n.parent)] = 1;
-      group(out, "branches: cones with a sphere at each joint", "GB_Bark", [&](Out o2) {
-        std::size_t count = 0;
-        for (std::size_t i = 0; i < plant.nodes.size(); ++i) {
-          const PlantNode& n = plant.nodes[i];
-          const float r = std::max(n.radius, kMinRadius);
-          if (n.parent != kNoParent) {
-            const PlantNode& p = plant.nodes[static_cast<std::size_t>(n.parent)];
-            if (glm::length(n.position - p.position) > 1e-5f) {
-              fmt::format_to(o2, "  cone {{ ");
-              vec(o2, pov(p.position));
-              fmt::format_to(o2, ",{:.5g},", std::max(p.radius, kMinRadius));
-              vec(o2, pov(n.position));
-              fmt::format_to(o2, ",{:.5g} }}\n", r);
-              ++count;
-            }
-          }
-          // Joints and tips are rounded; a root without children is a lone point and is skipped.
-          if (n.parent != kNoParent || has_child[i]) {
-            fmt::format_to(o2, "  sphere {{ ");
-            vec(o2, pov(n.position));
-            fmt::format_to(o2, ",{:.5g} }}\n", r);
-            ++count;
-          }
+// Branches as cones between each node and its parent, with a sphere at each joint and tip.
+void write_cones(Out out, const Plant& plant) {
+  std::vector<std::uint8_t> has_child(plant.nodes.size(), 0);
+  for (const auto& n : plant.nodes)
+    if (n.parent != kNoParent) has_child[static_cast<std::size_t>(n.parent)] = 1;
+  group(out, "branches: cones with a sphere at each joint", "GB_Bark", [&](Out o2) {
+    std::size_t count = 0;
+    for (std::size_t i = 0; i < plant.nodes.size(); ++i) {
+      const PlantNode& n = plant.nodes[i];
+      const float r = std::max(n.radius, kMinRadius);
+      if (n.parent != kNoParent) {
+        const PlantNode& p = plant.nodes[static_cast<std::size_t>(n.parent)];
+        if (glm::length(n.position - p.position) > 1e-5f) {
+          fmt::format_to(o2, "  cone {{ ");
+          vec(o2, pov(p.position));
+          fmt::format_to(o2, ",{:.5g},", std::max(p.radius, kMinRadius));
+          vec(o2, pov(n.position));
+          fmt::format_to(o2, ",{:.5g} }}\n", r);
+          ++count;
         }
-        return count;
-      });
-    } else {
-      throw InputError(fmt::format("render branches '{}': expected cones or mesh", o.branches));
-    }
-
-    // Leaves and flowers: one declared mesh, instanced with matrices (column i of the instance's
-    // linear map is row i of POV-Ray's matrix; both sides converted to POV-Ray's handedness).
-    if (!plant.organs.empty()) {
-      TriangleMesh shape = organ_shape(o.mesher);
-      fmt::format_to(out, "#declare GB_OrganShape =\n");
-      write_mesh2(out, shape.vertices, {}, shape.triangles, 0, static_cast<std::uint32_t>(shape.triangles.size()));
-      fmt::format_to(out, "}}\n");
-      const glm::mat3 flip(glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, 0, -1));
-      auto organs = [&](std::initializer_list<OrganKind> kinds, const char* comment, const char* texture) {
-        group(out, comment, texture, [&](Out o2) {
-          std::size_t count = 0;
-          for (const auto& organ : plant.organs) {
-            if (std::find(kinds.begin(), kinds.end(), organ.kind) == kinds.end() || !(organ.size > 0.0f)) continue;
-            const glm::mat3 a = flip * glm::mat3_cast(organ.orientation) * flip * organ.size;
-            const glm::vec3 t = pov(organ.position);
-            fmt::format_to(o2, "  object {{ GB_OrganShape matrix <{:.5g},{:.5g},{:.5g}, {:.5g},{:.5g},{:.5g}, "
-                               "{:.5g},{:.5g},{:.5g}, {:.6g},{:.6g},{:.6g}> }}\n",
-                           a[0].x, a[0].y, a[0].z, a[1].x, a[1].y, a[1].z, a[2].x, a[2].y, a[2].z, t.x, t.y, t.z);
-            ++count;
-          }
-          return count;
-        });
-      };
-      organs({OrganKind::Leaf}, "leaves", "GB_Leaf");
-      organs({OrganKind::YoungLeaf}, "young leaves", "GB_YoungLeaf");
-      organs({OrganKind::Flower, OrganKind::Bud}, "flowers and buds", "GB_Flower");
-    }
-
-    // L-system polygons: one mesh2 of fans.
-    std::vector<glm::vec3> pv;
-    std::vector<glm::uvec3> pt;
-    for (const auto& poly : plant.polygons) {
-      if (poly.vertices.size() < 3) continue;
-      const auto base = static_cast<std::uint32_t>(pv.size());
-      pv.insert(pv.end(), poly.vertices.begin(), poly.vertices.end());
-      for (std::uint32_t i = 1; i + 1 < poly.vertices.size(); ++i) {
-        const glm::vec3 e = glm::cross(poly.vertices[i] - poly.vertices[0], poly.vertices[i + 1] - poly.vertices[0]);
-        if (glm::length(e) > 1e-12f) pt.emplace_back(base, base + i, base + i + 1);  // POV-Ray warns on degenerate ones
+      }
+      // Joints and tips are rounded; a root without children is a lone point and is skipped.
+      if (n.parent != kNoParent || has_child[i]) {
+        fmt::format_to(o2, "  sphere {{ ");
+        vec(o2, pov(n.position));
+        fmt::format_to(o2, ",{:.5g} }}\n", r);
+        ++count;
       }
     }
-    if (!pt.empty()) {
-      fmt::format_to(out, "// polygons: {}\n", plant.polygons.size());
-      write_mesh2(out, pv, {}, pt, 0, static_cast<std::uint32_t>(pt.size()));
-      fmt::format_to(out, "  texture {{ GB_Leaf }}\n}}\n");
+    return count;
+  });
+}
+
+// Branches as RenderOptions::branches asks: cone chains, or the mesher's tubes as one mesh2.
+void write_branches(Out out, const Plant& plant, const RenderOptions& o) {
+  if (o.branches == "mesh") {
+    const OutputMesh tubes = mesh_plant(Plant{plant.nodes, {}, {}, {}, {}}, o.mesher);
+    if (!tubes.triangles.empty()) {
+      fmt::format_to(out, "// branches: {} nodes as one mesh2\n", plant.nodes.size());
+      write_mesh2(out, tubes.positions, tubes.normals, tubes.triangles, 0, static_cast<std::uint32_t>(tubes.triangles.size()));
+      fmt::format_to(out, "  texture {{ GB_Bark }}\n}}\n");
     }
+  } else if (o.branches == "cones") {
+    write_cones(out, plant);
+  } else {
+    throw InputError(fmt::format("render branches '{}': expected cones or mesh", o.branches));
+  }
+}
+
+// Leaves and flowers: one declared mesh, instanced with matrices (column i of the instance's linear map
+// is row i of POV-Ray's matrix; both sides converted to POV-Ray's handedness).
+void write_organs(Out out, const Plant& plant, const MesherOptions& mesher) {
+  if (plant.organs.empty()) return;
+  TriangleMesh shape = organ_shape(mesher);
+  fmt::format_to(out, "#declare GB_OrganShape =\n");
+  write_mesh2(out, shape.vertices, {}, shape.triangles, 0, static_cast<std::uint32_t>(shape.triangles.size()));
+  fmt::format_to(out, "}}\n");
+  const glm::mat3 flip(glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, 0, -1));
+  auto organs = [&](std::initializer_list<OrganKind> kinds, const char* comment, const char* texture) {
+    group(out, comment, texture, [&](Out o2) {
+      std::size_t count = 0;
+      for (const auto& organ : plant.organs) {
+        if (std::find(kinds.begin(), kinds.end(), organ.kind) == kinds.end() || !(organ.size > 0.0f)) continue;
+        const glm::mat3 a = flip * glm::mat3_cast(organ.orientation) * flip * organ.size;
+        const glm::vec3 t = pov(organ.position);
+        fmt::format_to(o2, "  object {{ GB_OrganShape matrix <{:.5g},{:.5g},{:.5g}, {:.5g},{:.5g},{:.5g}, "
+                           "{:.5g},{:.5g},{:.5g}, {:.6g},{:.6g},{:.6g}> }}\n",
+                       a[0].x, a[0].y, a[0].z, a[1].x, a[1].y, a[1].z, a[2].x, a[2].y, a[2].z, t.x, t.y, t.z);
+        ++count;
+      }
+      return count;
+    });
+  };
+  organs({OrganKind::Leaf}, "leaves", "GB_Leaf");
+  organs({OrganKind::YoungLeaf}, "young leaves", "GB_YoungLeaf");
+  organs({OrganKind::Flower, OrganKind::Bud}, "flowers and buds", "GB_Flower");
+}
+
+// L-system polygons: one mesh2 of fans.
+void write_polygons(Out out, const Plant& plant) {
+  std::vector<glm::vec3> pv;
+  std::vector<glm::uvec3> pt;
+  for (const auto& poly : plant.polygons) {
+    if (poly.vertices.size() < 3) continue;
+    const auto base = static_cast<std::uint32_t>(pv.size());
+    pv.insert(pv.end(), poly.vertices.begin(), poly.vertices.end());
+    for (std::uint32_t i = 1; i + 1 < poly.vertices.size(); ++i) {
+      const glm::vec3 e = glm::cross(poly.vertices[i] - poly.vertices[0], poly.vertices[i + 1] - poly.vertices[0]);
+      if (glm::length(e) > 1e-12f) pt.emplace_back(base, base + i, base + i + 1);  // POV-Ray warns on degenerate ones
+    }
+  }
+  if (pt.empty()) return;
+  fmt::format_to(out, "// polygons: {}\n", plant.polygons.size());
+  write_mesh2(out, pv, {}, pt, 0, static_cast<std::uint32_t>(pt.size()));
+  fmt::format_to(out, "  texture {{ GB_Leaf }}\n}}\n");
+}
+
+}  // namespace
+
+std::uint64_t write_pov(const std::string& path, const Scene& scene, const Plant& plant, const RenderOptions& o) {
+  fmt::memory_buffer b;
+  auto out = std::back_inserter(b);
+  const int w = render_width(o), h = render_height(o);
+  const float aspect = static_cast<float>(w) / static_cast<float>(h);
+
+  Aabb bounds = scene.bounds();
+  for (const auto& n : plant.nodes) bounds.extend(n.position);
+  if (bounds.empty()) bounds.extend(glm::vec3(0.0f));
+  const float diag = std::max(glm::length(bounds.size()), 1.0f);
+
+  write_settings(out, scene, plant, o, diag);
+  write_camera(out, scene.camera, aspect);
+  write_lights(out, scene, bounds.center(), diag, o.quality == RenderQuality::Paper);
+  // Ground: a plane under everything (the scene's own ground mesh, when it has one, sits on it).
+  fmt::format_to(out, "plane {{ y, {:.6g} texture {{ GB_Ground }} }}\n", bounds.min.y - 1e-3f);
+  write_scene_meshes(out, scene);
+  if (o.draw_plant) {
+    write_branches(out, plant, o);
+    write_organs(out, plant, o.mesher);
+    write_polygons(out, plant);
   }
   fs::create_directories(fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path());
   return write_file_atomic(path, b.data(), b.size());
@@ -330,6 +352,45 @@ std::string povray_version() {
   return out;
 }
 
+namespace {
+
+// POV-Ray's command line, the file names relative to the directory it runs in.
+std::vector<std::string> povray_args(const std::string& bin, const fs::path& pov_abs, const fs::path& png_abs,
+                                     const RenderResult& r, const RenderOptions& o) {
+  const fs::path dir = png_abs.parent_path();
+  std::vector<std::string> args = {bin,
+                                   "+I" + pov_abs.lexically_relative(dir).string(),
+                                   "+O" + png_abs.filename().string(),
+                                   fmt::format("+W{}", r.width),
+                                   fmt::format("+H{}", r.height),
+                                   "+FN",
+                                   "-D",  // no display window (and no ASCII-art preview in the log)
+                                   "-V",
+                                   "-P",
+                                   fmt::format("+WT{}", std::max(1, o.threads))};
+  if (o.quality == RenderQuality::Paper) {
+    args.insert(args.end(), {"+A0.1", "+AM2", "+R3"});
+  } else {
+    args.push_back("-A");
+  }
+  return args;
+}
+
+// The log's warning lines into `warnings`; returns its error lines.
+std::vector<std::string> scan_log(const std::string& log, std::vector<std::string>& warnings) {
+  std::vector<std::string> errors;
+  std::stringstream ss(log);
+  for (std::string line; std::getline(ss, line);) {
+    // "Parse Warning: ...", "Possible Parse Error: ...", "Parse Error: ..." (the banner's "Warning Stream
+    // to console" lines have no colon after the word).
+    if (line.find("Warning:") != std::string::npos) warnings.push_back(line);
+    if (line.find("Error:") != std::string::npos || line.find("error:") != std::string::npos) errors.push_back(line);
+  }
+  return errors;
+}
+
+}  // namespace
+
 RenderResult run_povray(const std::string& pov_path, const std::string& png_path, const RenderOptions& o) {
   RenderResult r;
   r.pov = pov_path;
@@ -346,29 +407,14 @@ RenderResult run_povray(const std::string& pov_path, const std::string& png_path
   // POV-Ray runs in the output directory with relative file names: Debian's povray.conf restricts
   // reading and writing to the working directory and below.
   const fs::path png_abs = fs::absolute(png_path), pov_abs = fs::absolute(pov_path);
-  const fs::path dir = png_abs.parent_path();
   std::error_code ec;
   fs::remove(png_abs, ec);
   fs::remove(r.log, ec);
-  std::vector<std::string> args = {bin,
-                                   "+I" + pov_abs.lexically_relative(dir).string(),
-                                   "+O" + png_abs.filename().string(),
-                                   fmt::format("+W{}", r.width),
-                                   fmt::format("+H{}", r.height),
-                                   "+FN",
-                                   "-D",  // no display window (and no ASCII-art preview in the log)
-                                   "-V",
-                                   "-P",
-                                   fmt::format("+WT{}", std::max(1, o.threads))};
-  if (o.quality == RenderQuality::Paper) {
-    args.insert(args.end(), {"+A0.1", "+AM2", "+R3"});
-  } else {
-    args.push_back("-A");
-  }
+  const std::vector<std::string> args = povray_args(bin, pov_abs, png_abs, r, o);
   const auto t0 = std::chrono::steady_clock::now();
   ChildResult cr;
   try {
-    cr = run_program(args, dir.string(), {o.timeout_s, 0}, fs::absolute(r.log).string());
+    cr = run_program(args, png_abs.parent_path().string(), {o.timeout_s, 0}, fs::absolute(r.log).string());
   } catch (const std::exception& e) {
     r.status = "failed";
     r.message = e.what();
@@ -376,17 +422,7 @@ RenderResult run_povray(const std::string& pov_path, const std::string& png_path
   }
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.cpu_s = cr.user_s + cr.system_s;
-  const std::string log = fs::exists(r.log) ? read_text_file(r.log) : std::string();
-  std::vector<std::string> errors;
-  {
-    std::stringstream ss(log);
-    for (std::string line; std::getline(ss, line);) {
-      // "Parse Warning: ...", "Possible Parse Error: ...", "Parse Error: ..." (the banner's "Warning Stream
-      // to console" lines have no colon after the word).
-      if (line.find("Warning:") != std::string::npos) r.warnings.push_back(line);
-      if (line.find("Error:") != std::string::npos || line.find("error:") != std::string::npos) errors.push_back(line);
-    }
-  }
+  const std::vector<std::string> errors = scan_log(fs::exists(r.log) ? read_text_file(r.log) : std::string(), r.warnings);
   if (cr.timed_out) {
     r.status = "timeout";
     r.message = fmt::format("POV-Ray was stopped after {:.0f} s", o.timeout_s);
@@ -425,11 +461,11 @@ RenderResult render_plant(const Scene& scene, const Plant& plant, const std::str
   return r;
 }
 
-void write_grid(const std::string& png_path, const std::string& title, const std::vector<std::string>& row_labels,
-                const std::vector<std::string>& col_labels, const std::vector<std::vector<std::string>>& cells,
-                const std::vector<std::vector<std::string>>& notes, int cell_width) {
-  const int rows = static_cast<int>(row_labels.size()), cols = static_cast<int>(col_labels.size());
-  // The cell aspect follows the first image found (4:3 when there is none).
+namespace {
+
+// The cells' height over width: the first image's read, trying on while it reads 4:3 (the default, when
+// there is no image).
+double image_aspect(const std::vector<std::vector<std::string>>& cells) {
   double aspect = 0.75;
   for (const auto& row : cells)
     for (const auto& c : row)
@@ -439,6 +475,76 @@ void write_grid(const std::string& png_path, const std::string& title, const std
           aspect = static_cast<double>(cairo_image_surface_get_height(s)) / cairo_image_surface_get_width(s);
         cairo_surface_destroy(s);
       }
+  return aspect;
+}
+
+// `s` centred on (x, y), shrunk to fit within max_w.
+void centred_text(cairo_t* c, const std::string& s, double x, double y, double size, double max_w) {
+  cairo_set_font_size(c, size);
+  cairo_text_extents_t e;
+  cairo_text_extents(c, s.c_str(), &e);
+  if (e.width > max_w && e.width > 0) {
+    cairo_set_font_size(c, size * max_w / e.width);
+    cairo_text_extents(c, s.c_str(), &e);
+  }
+  cairo_move_to(c, x - e.width / 2 - e.x_bearing, y - e.height / 2 - e.y_bearing);
+  cairo_show_text(c, s.c_str());
+}
+
+// The PNG `file` scaled into the w x h cell at (x0, y0); false when it cannot be read.
+bool draw_image(cairo_t* c, const std::string& file, double x0, double y0, int w, int h) {
+  if (file.empty() || !fs::exists(file)) return false;
+  cairo_surface_t* img = cairo_image_surface_create_from_png(file.c_str());
+  const bool ok = cairo_surface_status(img) == CAIRO_STATUS_SUCCESS;
+  if (ok) {
+    const double sx = w / static_cast<double>(cairo_image_surface_get_width(img));
+    const double sy = h / static_cast<double>(cairo_image_surface_get_height(img));
+    cairo_save(c);
+    cairo_translate(c, x0, y0);
+    cairo_scale(c, sx, sy);
+    cairo_set_source_surface(c, img, 0, 0);
+    cairo_pattern_set_filter(cairo_get_source(c), CAIRO_FILTER_GOOD);
+    cairo_paint(c);
+    cairo_restore(c);
+  }
+  cairo_surface_destroy(img);
+  return ok;
+}
+
+// A grey cell with `note` in it, where an image is missing.
+void draw_missing(cairo_t* c, const std::string& note, double x0, double y0, int w, int h) {
+  cairo_set_source_rgb(c, 0.85, 0.85, 0.85);
+  cairo_rectangle(c, x0, y0, w, h);
+  cairo_fill(c);
+  cairo_set_source_rgb(c, 0.35, 0.35, 0.35);
+  centred_text(c, note, x0 + w / 2.0, y0 + h / 2.0, 13, w - 12);
+}
+
+void write_png(cairo_surface_t* surface, const std::string& png_path) {
+  cairo_surface_flush(surface);
+  AtomicFile png(png_path);
+  const auto sink = [](void* f, const unsigned char* data, unsigned int n) {
+    static_cast<AtomicFile*>(f)->bytes(data, n);
+    return CAIRO_STATUS_SUCCESS;
+  };
+  if (cairo_surface_write_to_png_stream(surface, sink, &png) != CAIRO_STATUS_SUCCESS)
+    throw std::runtime_error(fmt::format("{}: cannot write the grid image", png_path));
+  png.finish();
+}
+
+// Element (i, j) of a ragged table, or "" beyond its rows and columns.
+std::string at(const std::vector<std::vector<std::string>>& table, int i, int j) {
+  const auto ui = static_cast<std::size_t>(i), uj = static_cast<std::size_t>(j);
+  return ui < table.size() && uj < table[ui].size() ? table[ui][uj] : std::string();
+}
+
+}  // namespace
+
+void write_grid(const std::string& png_path, const std::string& title, const std::vector<std::string>& row_labels,
+                const std::vector<std::string>& col_labels, const std::vector<std::vector<std::string>>& cells,
+                const std::vector<std::vector<std::string>>& notes, int cell_width) {
+  const int rows = static_cast<int>(row_labels.size()), cols = static_cast<int>(col_labels.size());
+  const double aspect = image_aspect(cells);
   const int cw = cell_width, ch = static_cast<int>(std::lround(cell_width * aspect));
   const int pad = 6, label_w = 170, header_h = 30, title_h = title.empty() ? 0 : 40;
   const int W = label_w + cols * (cw + pad) + pad, H = title_h + header_h + rows * (ch + pad) + pad;
@@ -449,68 +555,23 @@ void write_grid(const std::string& png_path, const std::string& title, const std
   cairo_set_source_rgb(c, 1, 1, 1);
   cairo_paint(c);
   cairo_select_font_face(c, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
-  auto text = [&](const std::string& s, double x, double y, double size, double max_w) {
-    cairo_set_font_size(c, size);
-    cairo_text_extents_t e;
-    cairo_text_extents(c, s.c_str(), &e);
-    if (e.width > max_w && e.width > 0) {
-      cairo_set_font_size(c, size * max_w / e.width);
-      cairo_text_extents(c, s.c_str(), &e);
-    }
-    cairo_move_to(c, x - e.width / 2 - e.x_bearing, y - e.height / 2 - e.y_bearing);
-    cairo_show_text(c, s.c_str());
-  };
   cairo_set_source_rgb(c, 0.1, 0.1, 0.1);
-  if (!title.empty()) text(title, W / 2.0, title_h / 2.0 + 4, 20, W - 20);
+  if (!title.empty()) centred_text(c, title, W / 2.0, title_h / 2.0 + 4, 20, W - 20);
   for (int j = 0; j < cols; ++j)
-    text(col_labels[static_cast<std::size_t>(j)], label_w + pad + j * (cw + pad) + cw / 2.0, title_h + header_h / 2.0, 15, cw - 8);
+    centred_text(c, col_labels[static_cast<std::size_t>(j)], label_w + pad + j * (cw + pad) + cw / 2.0,
+                 title_h + header_h / 2.0, 15, cw - 8);
   for (int i = 0; i < rows; ++i) {
     const double y0 = title_h + header_h + i * (ch + pad);
     cairo_set_source_rgb(c, 0.1, 0.1, 0.1);
-    text(row_labels[static_cast<std::size_t>(i)], label_w / 2.0, y0 + ch / 2.0, 15, label_w - 12);
+    centred_text(c, row_labels[static_cast<std::size_t>(i)], label_w / 2.0, y0 + ch / 2.0, 15, label_w - 12);
     for (int j = 0; j < cols; ++j) {
       const double x0 = label_w + pad + j * (cw + pad);
-      const std::string& file = static_cast<std::size_t>(i) < cells.size() && static_cast<std::size_t>(j) < cells[i].size()
-                                    ? cells[i][j]
-                                    : std::string();
-      bool drawn = false;
-      if (!file.empty() && fs::exists(file)) {
-        cairo_surface_t* img = cairo_image_surface_create_from_png(file.c_str());
-        if (cairo_surface_status(img) == CAIRO_STATUS_SUCCESS) {
-          const double sx = cw / static_cast<double>(cairo_image_surface_get_width(img));
-          const double sy = ch / static_cast<double>(cairo_image_surface_get_height(img));
-          cairo_save(c);
-          cairo_translate(c, x0, y0);
-          cairo_scale(c, sx, sy);
-          cairo_set_source_surface(c, img, 0, 0);
-          cairo_pattern_set_filter(cairo_get_source(c), CAIRO_FILTER_GOOD);
-          cairo_paint(c);
-          cairo_restore(c);
-          drawn = true;
-        }
-        cairo_surface_destroy(img);
-      }
-      if (!drawn) {
-        cairo_set_source_rgb(c, 0.85, 0.85, 0.85);
-        cairo_rectangle(c, x0, y0, cw, ch);
-        cairo_fill(c);
-        cairo_set_source_rgb(c, 0.35, 0.35, 0.35);
-        std::string note = "no render";
-        if (static_cast<std::size_t>(i) < notes.size() && static_cast<std::size_t>(j) < notes[i].size() && !notes[i][j].empty())
-          note = notes[i][j];
-        text(note, x0 + cw / 2.0, y0 + ch / 2.0, 13, cw - 12);
-      }
+      if (draw_image(c, at(cells, i, j), x0, y0, cw, ch)) continue;
+      const std::string note = at(notes, i, j);
+      draw_missing(c, note.empty() ? "no render" : note, x0, y0, cw, ch);
     }
   }
-  cairo_surface_flush(surface.get());
-  AtomicFile png(png_path);
-  const auto sink = [](void* f, const unsigned char* data, unsigned int n) {
-    static_cast<AtomicFile*>(f)->bytes(data, n);
-    return CAIRO_STATUS_SUCCESS;
-  };
-  if (cairo_surface_write_to_png_stream(surface.get(), sink, &png) != CAIRO_STATUS_SUCCESS)
-    throw std::runtime_error(fmt::format("{}: cannot write the grid image", png_path));
-  png.finish();
+  write_png(surface.get(), png_path);
 }
 
 }  // namespace growbench

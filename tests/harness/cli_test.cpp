@@ -34,6 +34,24 @@ TEST(Cli, HelpAndLists) {
   EXPECT_NE(r.out.find("unknown mesh 'bunny' (did you mean 'stanford-bunny'?)"), std::string::npos) << r.out;
 }
 
+TEST(Cli, ListOneAlgorithmAsTextOrMarkdown) {
+  auto r = growbench("list spacecol");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_EQ(r.out.rfind("spacecol\n", 0), 0u) << r.out;
+  EXPECT_EQ(r.out.find("lsystem"), std::string::npos) << r.out;
+  r = growbench("list --markdown ivy");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_EQ(r.out.rfind("| name | type | default | allowed | unit | doc |\n|---|---|---|---|---|---|\n", 0), 0u) << r.out;
+  EXPECT_NE(r.out.find("| `preset` | choice | `luft` | `luft`, `blender` |"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("- `blender`: `units=absolute`"), std::string::npos) << r.out;
+  // A pipe in a doc would end its cell.
+  r = growbench("list --markdown spacecol");
+  EXPECT_NE(r.out.find("(\\|sum\\| < split * count)"), std::string::npos) << r.out;
+  r = growbench("list --markdown spacel");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("did you mean 'spacecol'"), std::string::npos) << r.out;
+}
+
 TEST(Cli, LsystemPrintsTheDerivedStringAndGrowsExamplesFromFiles) {
   auto r = growbench("lsystem koch-island --generations 1 --print");
   EXPECT_EQ(r.status, 0) << r.out;

@@ -1,0 +1,79 @@
+// growbench list: the algorithms and their parameter tables, as text or (--markdown) as the Markdown
+// the algorithms' READMEs carry.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "algorithms/algorithm.hpp"
+#include "harness/cli/command.hpp"
+#include "harness/cli/param_table.hpp"
+
+namespace growbench::cli {
+
+namespace {
+
+struct ListArgs {
+  std::string name;
+  bool markdown = false;
+};
+
+void print_text(const AlgorithmInfo& info) {
+  fmt::print("{}\n  {}\n", info.name, info.summary);
+  print_param_table(info.params);
+  for (const auto& preset : info.presets) {
+    std::vector<std::string> kv;
+    for (const auto& [k, v] : preset.values) kv.push_back(fmt::format("{}={}", k, format_value(v)));
+    fmt::print("    preset={}: {}\n", preset.name,
+               kv.empty() ? "the defaults above" : fmt::format("{}", fmt::join(kv, " ")));
+  }
+}
+
+// The table, then the presets as a list (each one's values are defaults too).
+std::string markdown_of(const AlgorithmInfo& info) {
+  std::string out = param_table_markdown(info.params);
+  if (!info.presets.empty()) out += "\nPresets (`preset=NAME` sets these defaults; a value set explicitly wins):\n\n";
+  for (const auto& preset : info.presets) {
+    std::vector<std::string> kv;
+    for (const auto& [k, v] : preset.values) kv.push_back(markdown_code(fmt::format("{}={}", k, format_value(v))));
+    out += fmt::format("- {}: {}\n", markdown_code(preset.name),
+                       kv.empty() ? "the defaults above" : fmt::format("{}", fmt::join(kv, " ")));
+  }
+  return out;
+}
+
+int list_algorithms(const ListArgs& a) {
+  if (!a.name.empty()) {
+    const AlgorithmInfo& info = find_algorithm(a.name).info();
+    if (a.markdown)
+      fmt::print("{}", markdown_of(info));
+    else
+      print_text(info);
+    return 0;
+  }
+  bool first = true;
+  for (const auto& e : algorithm_registry()) {
+    if (a.markdown)
+      fmt::print("{}## {}\n\n{}\n\n{}", first ? "" : "\n", e.info().name, e.info().summary, markdown_of(e.info()));
+    else
+      print_text(e.info());
+    first = false;
+  }
+  return 0;
+}
+
+}  // namespace
+
+Command add_list(CLI::App& app) {
+  auto* cmd = app.add_subcommand("list", "List the algorithms and their parameter tables");
+  auto a = std::make_shared<ListArgs>();
+  cmd->add_option("name", a->name, "only this algorithm");
+  cmd->add_flag("--markdown", a->markdown,
+                "the parameter tables as Markdown (name, type, default, allowed, unit, doc), as the algorithms' "
+                "READMEs carry them (scripts/readme-params)");
+  return {cmd, [a] { return list_algorithms(*a); }};
+}
+
+}  // namespace growbench::cli

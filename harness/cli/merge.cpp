@@ -1,0 +1,56 @@
+// growbench merge: join the results of a suite's shards into one results file.
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "harness/cli/command.hpp"
+#include "harness/gate/compare.hpp"
+#include "harness/record/files.hpp"
+#include "harness/suite/suite.hpp"
+
+namespace growbench::cli {
+
+namespace {
+
+struct MergeArgs {
+  std::vector<std::string> inputs;
+  std::string out;
+  bool mixed = false;
+};
+
+int merge_shards(const MergeArgs& a) {
+  std::vector<nlohmann::json> shards;
+  for (const auto& f : a.inputs) shards.push_back(read_results_file(f));
+  const auto merged = merge_results(shards, a.inputs, a.mixed);
+  const auto parent = std::filesystem::path(a.out).parent_path();
+  if (!parent.empty()) std::filesystem::create_directories(parent);
+  const std::string text = merged.dump(1) + "\n";
+  write_file_atomic(a.out, text.data(), text.size());
+  if (merged["context"].value("mixed_machines", false))
+    fmt::print(
+        stderr,
+        "growbench: warning: the shards ran on different machines or builds; their timings are not comparable\n");
+  fmt::print("merged {} shards, {} cells, into {}\n", shards.size(), merged["trials"].size(), a.out);
+  return 0;
+}
+
+}  // namespace
+
+Command add_merge(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "merge", "Join the results of a suite's shards (--shard I/N) into one results file, in the unsharded order");
+  auto a = std::make_shared<MergeArgs>();
+  cmd->add_option("shards", a->inputs, "results.json of every shard")->required();
+  cmd->add_option("-o,--out", a->out, "the merged results.json")->required();
+  cmd->add_flag("--mixed-machines", a->mixed,
+                "merge shards that ran on different CPU models or builds (their timings are not comparable; the "
+                "merged context is marked mixed_machines)");
+  return {cmd, [a] { return merge_shards(*a); }};
+}
+
+}  // namespace growbench::cli

@@ -1,0 +1,92 @@
+#include "harness/cli/param_table.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <string>
+#include <string_view>
+
+#include <fmt/format.h>
+
+namespace growbench::cli {
+
+namespace {
+
+bool is_word(char c) {
+  return std::isalnum(static_cast<unsigned char>(c)) != 0;
+}
+bool is_space(char c) {
+  return std::isspace(static_cast<unsigned char>(c)) != 0;
+}
+
+// Doc text as literal Markdown in a table cell. Only what could end the cell or start code, emphasis, a
+// link or HTML is escaped, so the raw README stays readable: `|`, backticks and backslashes always; `*`
+// and `_` unless spaces on both sides (or, for `_`, letters) keep them from emphasising; `]` before
+// `(`, `[` or `:`; `<` before a letter, `/`, `!` or `?`.
+std::string markdown_text(const std::string& text) {
+  std::string out;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    const char prev = i > 0 ? text[i - 1] : ' ', next = i + 1 < text.size() ? text[i + 1] : ' ';
+    bool escape = c == '|' || c == '`' || c == '\\';
+    if (c == '*' || c == '_')
+      escape = !(is_space(prev) && is_space(next)) && !(c == '_' && is_word(prev) && is_word(next));
+    if (c == ']') escape = next == '(' || next == '[' || next == ':';
+    if (c == '<') escape = std::isalpha(static_cast<unsigned char>(next)) || next == '/' || next == '!' || next == '?';
+    if (escape) out += '\\';
+    out += c == '\n' ? ' ' : c;
+  }
+  return out;
+}
+
+}  // namespace
+
+void print_param_table(const std::vector<ParamSpec>& specs) {
+  std::size_t w = 4;
+  for (const auto& s : specs) w = std::max(w, s.name.size());
+  for (const auto& s : specs) {
+    std::string range;
+    if (s.type == ParamType::Choice)
+      range = fmt::format("{{{}}}", fmt::join(s.choices, "|"));
+    else if (std::isfinite(s.min) || std::isfinite(s.max))
+      range = fmt::format("[{:g}, {:g}]", s.min, s.max);
+    fmt::print("    {:<{}}  {:<6}  default {:<10} {:<18} {:<3}  {}\n", s.name, w, to_string(s.type),
+               format_value(s.default_value).empty() ? "\"\"" : format_value(s.default_value), range, s.unit, s.doc);
+  }
+}
+
+std::string markdown_code(const std::string& text) {
+  // A code span is fenced by a backtick run longer than any inside it; in a table cell a pipe needs a
+  // backslash even there, and a newline would end the row.
+  std::size_t longest = 0, run = 0;
+  for (const char c : text) {
+    run = c == '`' ? run + 1 : 0;
+    longest = std::max(longest, run);
+  }
+  std::string body;
+  for (const char c : text) body += c == '|' ? std::string("\\|") : c == '\n' ? std::string(" ") : std::string(1, c);
+  const std::string fence(longest + 1, '`');
+  const bool pad = !body.empty() && (body.front() == '`' || body.back() == '`');
+  return fence + (pad ? " " : "") + body + (pad ? " " : "") + fence;
+}
+
+std::string param_table_markdown(const std::vector<ParamSpec>& specs) {
+  std::string out = "| name | type | default | allowed | unit | doc |\n|---|---|---|---|---|---|\n";
+  for (const auto& s : specs) {
+    std::string allowed;
+    if (s.type == ParamType::Choice) {
+      std::vector<std::string> choices;
+      for (const auto& c : s.choices) choices.push_back(markdown_code(c));
+      allowed = fmt::format("{}", fmt::join(choices, ", "));
+    } else if (std::isfinite(s.min) || std::isfinite(s.max)) {
+      allowed = fmt::format("[{:g}, {:g}]", s.min, s.max);
+    }
+    const std::string value = format_value(s.default_value);
+    out += fmt::format("| {} | {} | {} | {} | {} | {} |\n", markdown_code(s.name), to_string(s.type),
+                       markdown_code(value.empty() ? "\"\"" : value), allowed, markdown_text(s.unit),
+                       markdown_text(s.doc));
+  }
+  return out;
+}
+
+}  // namespace growbench::cli

@@ -1,0 +1,56 @@
+// growbench render: render a suite's results directory or a run directory with POV-Ray.
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "harness/cli/command.hpp"
+#include "harness/render/render_results.hpp"
+
+namespace growbench::cli {
+
+namespace {
+
+struct RenderArgs {
+  std::string dir, quality = "preview";
+  RenderDirOptions options;
+};
+
+int render_dir(RenderArgs& a) {
+  a.options.render.quality = parse_render_quality(a.quality);
+  const auto r = render_directory(a.dir, a.options);
+  fmt::print("rendered {} images ({} failed, {} POV-Ray warnings) in {:.1f} s with {} POV-Ray processes at once\n",
+             r["renders"].get<int>(), r["failed"].get<int>(), r["warnings"].get<int>(), r["wall_s"].get<double>(),
+             r["jobs"].get<int>());
+  if (r.contains("grid"))
+    fmt::print("grid: {}\n", (std::filesystem::path(a.dir) / r["grid"].get<std::string>()).string());
+  return r["failed"].get<int>() > 0 ? 1 : 0;
+}
+
+}  // namespace
+
+Command add_render(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "render", "Render a suite's results directory (every trial, then grid.png) or a `run` directory with POV-Ray");
+  auto a = std::make_shared<RenderArgs>();
+  RenderOptions& ro = a->options.render;
+  cmd->add_option("dir", a->dir, "a directory with results.json (suite) or record.json (run)")->required();
+  cmd->add_option("--quality", a->quality,
+                  "preview (480x360, no anti-aliasing) or paper (1600x1200, "
+                  "anti-aliased, soft shadows, radiosity)")
+      ->default_val("preview");
+  cmd->add_option("-j,--jobs", a->options.jobs, "POV-Ray processes at once (0: one per core)")->default_val(0);
+  cmd->add_option("--width", ro.width, "image width (0: the quality's)")->default_val(0);
+  cmd->add_option("--height", ro.height, "image height (0: the quality's)")->default_val(0);
+  cmd->add_option("--branches", ro.branches,
+                  "branches as cones (cone and sphere chains) or mesh "
+                  "(the mesher's tubes as mesh2)")
+      ->default_val("cones")
+      ->check(CLI::IsMember({"cones", "mesh"}));
+  cmd->add_flag("-q,--quiet", a->options.quiet, "no progress lines");
+  return {cmd, [a] { return render_dir(*a); }};
+}
+
+}  // namespace growbench::cli

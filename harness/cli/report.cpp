@@ -1,0 +1,35 @@
+// growbench report: figures, tables and index.html from a results file alone.
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "harness/cli/command.hpp"
+#include "harness/report/report.hpp"
+
+namespace growbench::cli {
+
+namespace {
+
+struct ReportArgs {
+  std::string results, out;
+};
+
+int report(ReportArgs& a) {
+  if (a.out.empty()) a.out = (std::filesystem::path(a.results).parent_path() / "report").string();
+  return run_report(a.results, a.out, {});
+}
+
+}  // namespace
+
+Command add_report(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "report", "Figures (PNG, PDF), LaTeX and Markdown tables and index.html from a results file alone");
+  auto a = std::make_shared<ReportArgs>();
+  cmd->add_option("results", a->results, "results.json written by `growbench suite`")->required();
+  cmd->add_option("-o,--out", a->out, "report directory (default: report/ beside the results file)");
+  return {cmd, [a] { return report(*a); }};
+}
+
+}  // namespace growbench::cli

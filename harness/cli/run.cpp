@@ -1,0 +1,150 @@
+// growbench run: grow one plant, measure it, write its meshes and record, and optionally render it.
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "core/params.hpp"
+#include "harness/cli/command.hpp"
+#include "harness/record/files.hpp"
+#include "harness/render/render_results.hpp"
+#include "harness/run/trial.hpp"
+
+namespace growbench::cli {
+
+namespace {
+
+struct RunArgs {
+  TrialSpec spec;
+  std::vector<std::string> seed_at;
+  std::string out_dir;
+  bool quiet = false;
+  std::string render;
+};
+
+glm::vec3 parse_point(const std::string& text) {
+  Params p("--seed-at", {{"at", ParamType::Vec3, glm::dvec3(0.0), -1e9, 1e9, "m", "", {}}});
+  p.set("at", text);
+  return glm::vec3(p.vec3("at"));
+}
+
+// out/ALGORITHM-SCENE, the scene named by a mesh's or a scene file's stem.
+std::string default_out_dir(const TrialSpec& spec) {
+  std::string name = spec.scene;
+  if (name.rfind("mesh:", 0) == 0)
+    name = std::filesystem::path(name.substr(5)).stem().string();
+  else if (name.size() > 5 && name.substr(name.size() - 5) == ".json")
+    name = std::filesystem::path(name).stem().string();
+  return fmt::format("out/{}-{}", spec.algorithm, name);
+}
+
+void print_record(const nlohmann::json& rec, const TrialSpec& spec, const std::string& out_dir) {
+  const auto& ph = rec["phases"];
+  fmt::print("{} on {} (seed {}, {} threads): {} steps ({}), {} nodes, {} leaves, {:.2f} m of branches\n",
+             rec["algorithm"].get<std::string>(), rec["scene"]["name"].get<std::string>(), spec.seed,
+             rec["threads"].get<int>(), rec["steps"].get<int>(), rec["stopped_by"].get<std::string>(),
+             rec["counts"]["nodes"].get<std::size_t>(), rec["counts"]["leaves"].get<std::size_t>(),
+             rec["total_length_m"].get<double>());
+  fmt::print(
+      "  time: scene {:.3f} s, query {:.3f} s, growth {:.3f} s, meshing {:.3f} s, export {:.3f} s; peak RSS {:.1f} "
+      "MiB\n",
+      ph["scene_load"]["wall_s"].get<double>(), ph["query_build"]["wall_s"].get<double>(),
+      ph["growth"]["wall_s"].get<double>(), ph["meshing"]["wall_s"].get<double>(), ph["export"]["wall_s"].get<double>(),
+      rec["peak_rss_bytes"].get<double>() / (1024.0 * 1024.0));
+  fmt::print("  wrote {}/plant.obj, plant.ply, plant.glb, skeleton.obj, record.json (geometry hash {})\n", out_dir,
+             rec["geometry_hash"].get<std::string>());
+  if (rec.contains("frames"))
+    fmt::print("  kept {} frames in {}/frames (capture took {:.3f} s, not counted in growth)\n",
+               rec["frames"]["count"].get<int>(), out_dir, ph["growth"]["frame_capture_wall_s"].get<double>());
+}
+
+// Renders the run directory and reports what the record says of it: 1 when the render failed.
+int render_run(const std::string& out_dir, RenderQuality quality, bool quiet) {
+  RenderDirOptions ro;
+  ro.render.quality = quality;
+  ro.quiet = quiet;
+  const auto r = render_directory(out_dir, ro);
+  const auto updated = read_json_file((std::filesystem::path(out_dir) / "record.json").string());
+  const auto& rr = updated["render"];
+  if (rr["status"] == "ok")
+    fmt::print("  rendered {}/render.png ({}x{}, {}) in {:.2f} s of POV-Ray{}\n", out_dir, rr["width"].get<int>(),
+               rr["height"].get<int>(), to_string(quality), rr["wall_s"].get<double>(),
+               updated.contains("animation")
+                   ? fmt::format(", {} frames: {}", updated["animation"]["frames"].get<int>(),
+                                 updated["animation"].value("file", updated["animation"]["status"].get<std::string>()))
+                   : "");
+  else
+    fmt::print(stderr, "growbench: render failed: {}\n", rr.value("message", rr["status"].get<std::string>()));
+  return r["failed"].get<int>() > 0 ? 1 : 0;
+}
+
+int run_one(RunArgs& a) {
+  TrialSpec& spec = a.spec;
+  for (const auto& s : a.seed_at) spec.seed_at.push_back(parse_point(s));
+  if (a.out_dir.empty()) a.out_dir = default_out_dir(spec);
+  spec.out_dir = a.out_dir;
+  std::optional<RenderQuality> quality;
+  if (!a.render.empty()) quality = parse_render_quality(a.render, "--render");
+  const bool tty = isatty(STDERR_FILENO) != 0;
+  auto last = std::chrono::steady_clock::now();
+  auto progress = [&](const Progress& p) {
+    if (a.quiet) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last < std::chrono::seconds(1)) return;
+    last = now;
+    fmt::print(stderr, "{}growing: step {}, {} nodes, {:.1f} s{}", tty ? "\r" : "", p.step, p.nodes, p.growth_seconds,
+               tty ? "   " : "\n");
+  };
+  const nlohmann::json rec = run_trial(spec, progress);
+  if (!a.quiet && isatty(STDERR_FILENO)) fmt::print(stderr, "\r{:60}\r", "");
+  print_record(rec, spec, a.out_dir);
+  return quality ? render_run(a.out_dir, *quality, a.quiet) : 0;
+}
+
+}  // namespace
+
+Command add_run(CLI::App& app) {
+  auto* run = app.add_subcommand("run", "Grow one plant: one algorithm on one scene, measured, written to --out");
+  auto a = std::make_shared<RunArgs>();
+  TrialSpec& spec = a->spec;
+  run->add_option("-a,--algorithm", spec.algorithm, "algorithm name (see `growbench list`)")->required();
+  run->add_option(
+         "-s,--scene", spec.scene,
+         "scene: a standard scene's name (see `growbench scenes`), a scene file *.json, mesh:PATH.obj, or mesh:NAME "
+         "for a bundled mesh (e.g. mesh:stanford-bunny)")
+      ->required();
+  run->add_option("--scene-param", spec.scene_params, "scene parameter key=value (repeatable)");
+  run->add_option("--seed", spec.seed, "random seed")->default_val(1);
+  run->add_option("--set", spec.params, "algorithm parameter key=value (repeatable)");
+  run->add_option("--seed-at", a->seed_at,
+                  "seed position X,Y,Z, snapped to the nearest surface (repeatable; replaces the scene's seeds)");
+  run->add_option("--max-steps", spec.max_steps, "step cap")->default_val(5000);
+  run->add_option("--time-limit", spec.time_limit_s, "stop growing after this many seconds (0: none)")->default_val(0);
+  run->add_option("-j,--threads", spec.threads, "worker threads (0: all cores)")->default_val(0);
+  run->add_option("--voxel-size", spec.voxel_size, "distance-field voxel size in metres (0: scene diagonal / 256)")
+      ->default_val(0);
+  run->add_option("--sides", spec.mesher.sides, "tube sides of the branch mesh (3..64)")
+      ->default_val(6)
+      ->check(CLI::Range(3, 64));
+  run->add_option("--leaf-obj", spec.mesher.leaf_obj,
+                  "a custom leaf for every leaf and flower: an OBJ with the blade along +Z from the stem at z = 0 and "
+                  "its upper side toward +Y (scaled to unit length; the organ's size sizes it)");
+  run->add_option("-o,--out", a->out_dir, "output directory (default: out/ALGORITHM-SCENE)");
+  run->add_flag("-q,--quiet", a->quiet, "no progress line");
+  run->add_option("--render", a->render, "render the plant with POV-Ray afterwards: preview or paper (render.png)");
+  run->add_option("--frames", spec.frame_every,
+                  "growth animation: keep the plant every K steps (frames/); with --render, render them and make "
+                  "animation.mp4 with ffmpeg")
+      ->default_val(0);
+  return {run, [a] { return run_one(*a); }};
+}
+
+}  // namespace growbench::cli

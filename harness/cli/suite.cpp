@@ -1,0 +1,110 @@
+// growbench suite: run a suite file's trials, each in its own process, and summarise the results.
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "core/errors.hpp"
+#include "harness/cli/command.hpp"
+#include "harness/gate/history.hpp"
+#include "harness/record/files.hpp"
+#include "harness/render/render_results.hpp"
+#include "harness/report/summary.hpp"
+#include "harness/suite/suite.hpp"
+
+namespace growbench::cli {
+
+namespace {
+
+struct SuiteArgs {
+  std::string file, out, shard;
+  bool resume = false, quiet = false;
+  int repetitions = 0;
+  bool instructions = false;
+  std::string render, history;
+};
+
+// --shard I/N into `o`.
+void parse_shard(const std::string& shard, SuiteRunOptions& o) {
+  const auto slash = shard.find('/');
+  try {
+    if (slash == std::string::npos) throw std::invalid_argument("no slash");
+    o.shard_index = std::stoi(shard.substr(0, slash));
+    o.shard_count = std::stoi(shard.substr(slash + 1));
+  } catch (const std::exception&) {
+    throw InputError(fmt::format("--shard '{}': expected I/N with 0 <= I < N", shard));
+  }
+  if (o.shard_count < 1 || o.shard_index < 0 || o.shard_index >= o.shard_count)
+    throw InputError(fmt::format("--shard '{}': expected I/N with 0 <= I < N", shard));
+}
+
+// Renders every trial of the results directory of `results_path`, then the grid.
+void render_suite(const std::string& results_path, RenderQuality quality, bool quiet) {
+  RenderDirOptions ro;
+  ro.render.quality = quality;
+  ro.quiet = quiet;
+  const auto r = render_directory(std::filesystem::path(results_path).parent_path().string(), ro);
+  fmt::print("rendered {} trials ({} failed) in {:.0f} s; grid: {}\n", r["renders"].get<int>(), r["failed"].get<int>(),
+             r["wall_s"].get<double>(),
+             (std::filesystem::path(results_path).parent_path() / r.value("grid", "")).string());
+}
+
+int run_suite_file(const SuiteArgs& a) {
+  // First, while this process is small: the launcher that forks the trials (harness/run/process.hpp).
+  std::unique_ptr<Launcher> launcher;
+  if (!a.instructions) launcher = start_trial_launcher();
+  Suite suite = load_suite(a.file);
+  if (a.repetitions > 0) suite.repetitions = a.repetitions;
+  SuiteRunOptions o;
+  o.launcher = launcher.get();
+  o.out_dir = a.out;
+  o.resume = a.resume;
+  o.quiet = a.quiet;
+  o.instructions = a.instructions;
+  if (!a.shard.empty()) parse_shard(a.shard, o);
+  if (o.instructions)
+    fmt::print("suite {}: {} cells, each once, single-threaded, under callgrind (instruction counts per phase)\n",
+               suite.name, suite.configs.size());
+  else
+    fmt::print("suite {}: {} cells x {} repetitions (+{} warm-up)\n", suite.name, suite.configs.size(),
+               suite.repetitions, suite.warmup);
+  std::optional<RenderQuality> quality;
+  if (!a.render.empty()) quality = parse_render_quality(a.render, "--render");
+  const std::string path = run_suite(suite, o);
+  fmt::print("{}", summarize_results(read_json_file(path)));
+  fmt::print("\nwrote {} and results.csv beside it\n", path);
+  if (!a.history.empty()) fmt::print("history: appended to {}\n", history_add(path, a.history));
+  if (quality) render_suite(path, *quality, a.quiet);
+  return 0;
+}
+
+}  // namespace
+
+Command add_suite(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "suite", "Run a suite: algorithms x scenes x seeds x sweeps x repetitions, each trial in its own process");
+  auto a = std::make_shared<SuiteArgs>();
+  cmd->add_option("file", a->file, "suite file (e.g. bench/suites/quick.json)")->required();
+  cmd->add_option("-o,--out", a->out, "results directory (default: out/suites/NAME)");
+  cmd->add_flag("--resume", a->resume, "continue an interrupted run in --out, skipping finished trials");
+  cmd->add_option("--shard", a->shard, "run only shard I of N (I/N, 0-based): a deterministic slice of the cells");
+  cmd->add_flag("-q,--quiet", a->quiet, "no progress lines");
+  cmd->add_option("--repetitions", a->repetitions,
+                  "repetitions per cell instead of the suite file's (recorded in results.json; a quicker look "
+                  "with wider intervals)")
+      ->check(CLI::Range(1, 1000));
+  cmd->add_flag("--instructions", a->instructions,
+                "run each trial once, single-threaded, under valgrind's callgrind, and record instructions per "
+                "phase (the deterministic regression gate: see `growbench compare`)");
+  cmd->add_option("--render", a->render,
+                  "render every trial with POV-Ray afterwards (preview or paper) and compose grid.png");
+  cmd->add_option("--history", a->history,
+                  "append the run to this history directory (MACHINE/SUITE/COMMIT.json; see growbench history)");
+  return {cmd, [a] { return run_suite_file(*a); }};
+}
+
+}  // namespace growbench::cli
