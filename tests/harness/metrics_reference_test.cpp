@@ -168,12 +168,12 @@ int reference_overlap(const dvec3 (&a)[3], const dvec3 (&b)[3]) {
 }
 
 // ------------------------------------------------------------ the plants
+// Each algorithm's own test parameters, with space colonization clinging rather than avoiding, so that
+// adhesion and coverage see nodes near the surface.
 std::vector<std::string> plant_params(const std::string& algorithm) {
-  if (algorithm == "spacecol") return {"surface=cling", "point_count=4000"};
-  if (algorithm == "lsystem") return {"surface=wrap"};
-  if (algorithm == "ivy") return {"max_root_length=1"};
-  if (algorithm == "hadrich") return {"max_particles=2000"};
-  return {};
+  std::vector<std::string> p = find_algorithm(algorithm).info().test_params;
+  if (algorithm == "spacecol") p.push_back("surface=cling");
+  return p;
 }
 
 // Up to n distinct indices in [0, size), spread by a fixed generator.
