@@ -612,6 +612,30 @@ void read(const Node& n, CellResults& v) {
   f.done();
 }
 
+json to_json(const MedianSummary& v) {
+  return {{"n", v.n}, {"median", v.median}, {"lo", v.lo}, {"hi", v.hi}, {"exact", v.exact}};
+}
+void read(const Node& n, MedianSummary& v) {
+  Fields f(n);
+  f.field("n", v.n);
+  f.field("median", v.median);
+  f.field("lo", v.lo);
+  f.field("hi", v.hi);
+  f.field("exact", v.exact);
+  f.done();
+}
+
+json to_json(const CellSummary& v) {
+  json j = json::object();
+  put(j, "growth_s", v.growth_s);
+  return j;
+}
+void read(const Node& n, CellSummary& v) {
+  Fields f(n);
+  f.field("growth_s", v.growth_s);
+  f.done();
+}
+
 json to_json(const JournalEntry& v) {
   return {{"id", v.id}, {"sample", to_json(v.sample)}, {"cell", v.cell ? to_json(*v.cell) : json(nullptr)}};
 }
@@ -637,7 +661,8 @@ json to_json(const SuiteCell& v) {
   put(j, "message", v.message);
   put(j, "nondeterministic", v.nondeterministic);
   put_fields(j, v.results);
-
+  put(j, "summary", v.summary);
+  put(j, "render", v.render);
   put(j, "animation", v.animation);
   return j;
 }
@@ -656,7 +681,8 @@ void read(const Node& n, SuiteCell& v) {
   f.field("nondeterministic", v.nondeterministic);
   f.field("samples", v.samples);
   read_fields(f, v.results);
-
+  f.field("summary", v.summary);
+  f.field("render", v.render);
   f.field("animation", v.animation);
   f.done();
 }
@@ -729,6 +755,26 @@ void read(const Node& n, RenderSummary& v) {
   f.done();
 }
 
+json to_json(const PooledSummary& v) {
+  return {{"label", v.label}, {"scene", v.scene}, {"sweep", v.sweep}, {"cells", v.cells}, {"growth_s", to_json(v.growth_s)}};
+}
+void read(const Node& n, PooledSummary& v) {
+  Fields f(n);
+  f.field("label", v.label);
+  f.field("scene", v.scene);
+  f.field("sweep", v.sweep);
+  f.field("cells", v.cells);
+  f.field("growth_s", v.growth_s);
+  f.done();
+}
+
+json to_json(const ResultsSummary& v) { return {{"growth_s_over_seeds", to_json_value(v.growth_s_over_seeds)}}; }
+void read(const Node& n, ResultsSummary& v) {
+  Fields f(n);
+  f.field("growth_s_over_seeds", v.growth_s_over_seeds);
+  f.done();
+}
+
 json to_json(const ResultsFile& v) {
   json j = {{"schema_version", v.schema_version},
             {"kind", v.kind},
@@ -741,6 +787,7 @@ json to_json(const ResultsFile& v) {
             {"trials", to_json_value(v.trials)}};
   put(j, "shards", v.shards);
   put(j, "renders", v.renders);
+  put(j, "summary", v.summary);
   return j;
 }
 void read(const Node& n, ResultsFile& v) {
@@ -756,6 +803,7 @@ void read(const Node& n, ResultsFile& v) {
   f.required("trials", v.trials);
   f.field("shards", v.shards);
   f.field("renders", v.renders);
+  f.field("summary", v.summary);
   f.done();
 }
 
@@ -913,12 +961,16 @@ GROWBENCH_RECORD_TYPE(TrialSpecRecord)
 GROWBENCH_RECORD_TYPE(AllocCount)
 GROWBENCH_RECORD_TYPE(SuiteSample)
 GROWBENCH_RECORD_TYPE(CellResults)
+GROWBENCH_RECORD_TYPE(MedianSummary)
+GROWBENCH_RECORD_TYPE(CellSummary)
 GROWBENCH_RECORD_TYPE(JournalEntry)
 GROWBENCH_RECORD_TYPE(SuiteCell)
 GROWBENCH_RECORD_TYPE(SuiteInfo)
 GROWBENCH_RECORD_TYPE(ShardInfo)
 GROWBENCH_RECORD_TYPE(ShardRecord)
 GROWBENCH_RECORD_TYPE(RenderSummary)
+GROWBENCH_RECORD_TYPE(PooledSummary)
+GROWBENCH_RECORD_TYPE(ResultsSummary)
 GROWBENCH_RECORD_TYPE(ResultsFile)
 GROWBENCH_RECORD_TYPE(BaselineContext)
 GROWBENCH_RECORD_TYPE(BaselineCell)

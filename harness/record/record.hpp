@@ -229,6 +229,18 @@ struct CellResults {
   std::optional<InstructionCounts> instructions;
 };
 
+// A median and its distribution-free 95% interval (median_interval in harness/stats/stats.hpp).
+struct MedianSummary {
+  std::uint64_t n = 0;  // samples
+  double median = 0.0, lo = 0.0, hi = 0.0;
+  bool exact = false;  // false: fewer than 6 samples, [lo, hi] is the full range
+};
+
+// Statistics of a cell's ok repetitions, computed by the suite so that reports do not compute them again.
+struct CellSummary {
+  std::optional<MedianSummary> growth_s;  // the growth phase's wall time
+};
+
 // A line of journal.jsonl: one finished repetition, durable before the next trial starts.
 struct JournalEntry {
   std::string id;
@@ -247,6 +259,7 @@ struct SuiteCell {
   std::optional<bool> nondeterministic;  // two repetitions grew different plants
   std::vector<SuiteSample> samples;
   CellResults results;  // written into the cell's own object
+  std::optional<CellSummary> summary;
   std::optional<RenderRecord> render;
   std::optional<AnimationRecord> animation;
 };
@@ -276,6 +289,19 @@ struct RenderSummary {
   std::optional<std::map<std::string, std::string>> grid_per_scene;  // scene -> image
 };
 
+// Growth time over the seeds of one algorithm entry (and sweep point) on one scene: the rows of the
+// report's table.
+struct PooledSummary {
+  std::string label, scene;
+  nlohmann::json sweep = nlohmann::json::object();
+  std::vector<std::string> cells;  // the ok cells pooled
+  MedianSummary growth_s;
+};
+
+struct ResultsSummary {
+  std::vector<PooledSummary> growth_s_over_seeds;
+};
+
 // results.json.
 struct ResultsFile {
   int schema_version = kSchemaVersion;
@@ -289,6 +315,7 @@ struct ResultsFile {
   std::vector<SuiteCell> trials;
   std::optional<std::vector<ShardRecord>> shards;  // merged files
   std::optional<RenderSummary> renders;
+  std::optional<ResultsSummary> summary;
 };
 
 // ---------------------------------------------------------------- the gate and the history
@@ -367,12 +394,16 @@ nlohmann::json to_json(const TrialSpecRecord& v);
 nlohmann::json to_json(const AllocCount& v);
 nlohmann::json to_json(const SuiteSample& v);
 nlohmann::json to_json(const CellResults& v);
+nlohmann::json to_json(const MedianSummary& v);
+nlohmann::json to_json(const CellSummary& v);
 nlohmann::json to_json(const JournalEntry& v);
 nlohmann::json to_json(const SuiteCell& v);
 nlohmann::json to_json(const SuiteInfo& v);
 nlohmann::json to_json(const ShardInfo& v);
 nlohmann::json to_json(const ShardRecord& v);
 nlohmann::json to_json(const RenderSummary& v);
+nlohmann::json to_json(const PooledSummary& v);
+nlohmann::json to_json(const ResultsSummary& v);
 nlohmann::json to_json(const ResultsFile& v);
 nlohmann::json to_json(const BaselineContext& v);
 nlohmann::json to_json(const BaselineCell& v);

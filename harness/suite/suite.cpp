@@ -29,6 +29,7 @@
 #include "harness/output/exporters.hpp"
 #include "harness/record/record.hpp"
 #include "harness/run/process.hpp"
+#include "harness/stats/stats.hpp"
 #include "scenes/scene_library.hpp"
 
 namespace growbench {
@@ -455,6 +456,24 @@ void take_fields(CellResults& to, const CellResults& from) {
   take(to.instructions, from.instructions);
 }
 
+// The growth phase's wall time of every ok repetition of a cell, in repetition order.
+std::vector<double> growth_times(const SuiteCell& t) {
+  std::vector<double> v;
+  for (const auto& s : t.samples)
+    if (s.status == "ok" && s.phases && s.phases->growth) v.push_back(s.phases->growth->wall_s);
+  return v;
+}
+
+MedianSummary median_summary(const std::vector<double>& v) {
+  MedianSummary m;
+  m.n = v.size();
+  m.median = median_of(v);
+  const auto [lo, hi] = median_interval(v, m.exact);
+  m.lo = lo;
+  m.hi = hi;
+  return m;
+}
+
 // Adds one finished repetition to its cell: the live run and the journal replay both come here.
 void apply_sample(SuiteCell& t, const SuiteSample& sample, const std::optional<CellResults>& cell) {
   if (sample.status == "ok" && cell) {
@@ -472,9 +491,41 @@ void apply_sample(SuiteCell& t, const SuiteSample& sample, const std::optional<C
   if (st != "ok")
     for (const auto& s : t.samples)
       if (s.status != "ok" && s.message) t.message = s.message;
+  // The growth time's median and interval, so that reports read them instead of computing them again.
+  const std::vector<double> growth = growth_times(t);
+  if (growth.empty()) t.summary.reset();
+  else t.summary = CellSummary{median_summary(growth)};
 }
 
-std::string results_text(const ResultsFile& results) { return json_text(to_json(results), 1); }
+// The growth time over the seeds of each algorithm entry (and sweep point) on each scene: every ok cell's
+// ok repetitions pooled, as the report's table shows them.
+ResultsSummary results_summary(const std::vector<SuiteCell>& trials) {
+  ResultsSummary out;
+  std::vector<std::vector<double>> times;
+  for (const auto& t : trials) {
+    const std::vector<double> growth = growth_times(t);
+    if (t.status != "ok" || growth.empty()) continue;
+    std::size_t g = 0;
+    while (g < out.growth_s_over_seeds.size() &&
+           !(out.growth_s_over_seeds[g].label == t.label && out.growth_s_over_seeds[g].scene == t.scene &&
+             out.growth_s_over_seeds[g].sweep == t.sweep))
+      ++g;
+    if (g == out.growth_s_over_seeds.size()) {
+      out.growth_s_over_seeds.push_back({t.label, t.scene, t.sweep, {}, {}});
+      times.emplace_back();
+    }
+    out.growth_s_over_seeds[g].cells.push_back(t.id);
+    times[g].insert(times[g].end(), growth.begin(), growth.end());
+  }
+  for (std::size_t g = 0; g < times.size(); ++g) out.growth_s_over_seeds[g].growth_s = median_summary(times[g]);
+  return out;
+}
+
+// results.json as written: its pooled summary brought up to date first.
+std::string results_text(ResultsFile& results) {
+  results.summary = results_summary(results.trials);
+  return json_text(to_json(results), 1);
+}
 
 }  // namespace
 
@@ -560,6 +611,7 @@ ResultsFile merge_results(const std::vector<ResultsFile>& shards, const std::vec
   }
   if (!differ.empty()) merged.context.mixed_machines = true;
   merged.renders.reset();  // per-shard render summaries do not describe the merged grid
+  merged.summary = results_summary(merged.trials);  // seeds of one entry and scene may have run in different shards
   return merged;
 }
 
