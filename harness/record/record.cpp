@@ -145,7 +145,8 @@ void read(const Node& n, std::map<std::string, T>& v) {
 
 template <class T, std::size_t N>
 void read(const Node& n, std::array<T, N>& v) {
-  if (!n.j.is_array() || n.j.size() != N) n.fail(fmt::format("expected an array of {}, {}", N, n.got()));
+  if (!n.j.is_array()) n.fail(fmt::format("expected an array of {}, {}", N, n.got()));
+  if (n.j.size() != N) n.fail(fmt::format("expected an array of {}, got {} items", N, n.j.size()));
   for (std::size_t i = 0; i < N; ++i) read(n.index(i), v[i]);
 }
 
