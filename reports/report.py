@@ -9,10 +9,15 @@ algorithms' code. Run with Debian's /usr/bin/python3, which sees python3-matplot
 Writes into OUT: fig-*.png and fig-*.pdf, table.tex (booktabs), table.md, renders/ (copies of the
 comparison grids), and index.html, which needs nothing from the network.
 
-Statistics, the same as `growbench summary`:
-- medians over repetitions, with a distribution-free 95% interval from order statistics (the pair
-  x_(l), x_(n+1-l) with binomial coverage >= 95%; below 6 repetitions no pair reaches it, so the full
-  range is shown and marked '~');
+The file is checked against harness/record/results.schema.json first (python3-jsonschema), the
+schema whose version the C++ writes: a renamed or mistyped field is an error naming the file and the
+JSON path.
+
+Statistics:
+- growth times: the medians and distribution-free 95% intervals the suite wrote into results.json
+  ("summary" of each cell, and "summary.growth_s_over_seeds" for the table's rows, whose seeds are
+  pooled), computed by the same C++ as `growbench summary` (harness/stats/stats.hpp); a results file
+  written before the suite wrote them shows medians without intervals;
 - scaling exponents: least squares of log(time) on log(nodes) over an algorithm's cells (their median
   times), with a 95% interval from Student's t on the slope's standard error.
 """
@@ -39,6 +44,9 @@ QUALITY = [("coverage", "surface coverage", "fraction"),
            ("leaf_light_exposure_scene", "leaf light exposure (scene shade only)", "fraction")]
 # The metrics' definitions and error bounds, rendered beside the report (docs/metrics.md).
 METRICS_DOC = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "docs", "metrics.md")
+# The results file's schema, declared beside the C++ record that writes it.
+SCHEMA_NAME = "harness/record/results.schema.json"
+SCHEMA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", *SCHEMA_NAME.split("/"))
 
 
 class ReportError(Exception):
@@ -53,22 +61,6 @@ def median(v):
     if n == 0:
         return float("nan")
     return s[n // 2] if n % 2 else 0.5 * (s[n // 2 - 1] + s[n // 2])
-
-
-def median_ci(v):
-    """(low, high, exact): a distribution-free 95% interval for the median (see the module doc)."""
-    s = sorted(v)
-    n = len(s)
-    if n == 0:
-        return float("nan"), float("nan"), False
-    best = None
-    for lo in range(1, n // 2 + 1):  # 1-based order statistics x_(lo), x_(n+1-lo)
-        cover = sum(math.comb(n, k) for k in range(lo, n - lo + 1)) / 2.0 ** n
-        if cover >= 0.95:
-            best = lo
-    if best is None:
-        return s[0], s[-1], False
-    return s[best - 1], s[n - best], True
 
 
 def t975(df):
@@ -99,6 +91,39 @@ def fit_exponent(xs, ys):
 
 # ---------------------------------------------------------------- reading results
 
+def load_schema():
+    with open(SCHEMA) as f:
+        return json.load(f)
+
+
+def schema_version(schema):
+    """The results schema_version this report reads: the one the schema (and so the C++) declares."""
+    return schema["$defs"]["results"]["properties"]["schema_version"]["const"]
+
+
+def json_path(parts):
+    """trials[3].samples[0].phases: a path as the C++ reader names it."""
+    out = ""
+    for p in parts:
+        out += f"[{p}]" if isinstance(p, int) else (f".{p}" if out else str(p))
+    return out or "the top level"
+
+
+def validate(doc, path, schema=None):
+    """ReportError naming the file and the JSON path of the first place `doc` departs from the schema."""
+    schema = schema or load_schema()
+    try:
+        import jsonschema
+    except ImportError:
+        raise ReportError("python3-jsonschema is not installed (scripts/install-deps installs it)")
+    version = schema_version(schema)
+    if doc.get("schema_version") != version:
+        raise ReportError(f"{path}: schema_version {doc.get('schema_version')!r}; this report reads {version} ({SCHEMA_NAME})")
+    error = jsonschema.exceptions.best_match(jsonschema.Draft202012Validator(schema).iter_errors(doc))
+    if error is not None:
+        raise ReportError(f"{path}: at {json_path(error.absolute_path)}: {error.message} (against {SCHEMA_NAME})")
+
+
 def load_results(path):
     try:
         with open(path) as f:
@@ -107,9 +132,15 @@ def load_results(path):
         raise ReportError(f"{path}: cannot open: {e.strerror}")
     except json.JSONDecodeError as e:
         raise ReportError(f"{path}: not valid JSON: line {e.lineno} column {e.colno}: {e.msg}")
-    if doc.get("kind") != "growbench-results" or "trials" not in doc:
+    if not isinstance(doc, dict) or doc.get("kind") != "growbench-results" or "trials" not in doc:
         raise ReportError(f"{path}: not a growbench results file (expected kind 'growbench-results' and trials)")
+    validate(doc, path)
     return doc
+
+
+def pooled_summaries(doc):
+    """The suite's growth-time summaries over seeds, by the set of cells each pools."""
+    return {frozenset(p["cells"]): p["growth_s"] for p in doc.get("summary", {}).get("growth_s_over_seeds", [])}
 
 
 def row_label(t):
@@ -145,6 +176,11 @@ class Cell:
         self.alloc_bytes = alloc.get("bytes", 0)
         self.alloc_count = alloc.get("count", 0)
         self.ok = self.status == "ok" and len(self.growth) > 0
+        # The suite's median and 95% interval of the growth time (None in files written before it did).
+        self.growth_summary = t.get("summary", {}).get("growth_s")
+
+    def growth_median(self):
+        return self.growth_summary["median"] if self.growth_summary else median(self.growth)
 
 
 def ordered(values):
@@ -180,11 +216,15 @@ def fmt_frac(x):
     return "-" if x is None else f"{x:.3f}"
 
 
-def time_with_ci(v):
-    if not v:
+def time_with_ci(summary, times):
+    """'median [lo, hi]' from a summary the suite wrote ('~': the full range, under 6 samples); without one, the
+    median of `times` alone."""
+    if summary:
+        lo, hi = summary["lo"], summary["hi"]
+        return f"{fmt_seconds(summary['median'])} [{'' if summary['exact'] else '~'}{fmt_seconds(lo)}, {fmt_seconds(hi)}]"
+    if not times:
         return "-"
-    lo, hi, exact = median_ci(v)
-    return f"{fmt_seconds(median(v))} [{'' if exact else '~'}{fmt_seconds(lo)}, {fmt_seconds(hi)}]"
+    return f"{fmt_seconds(median(times))} [no interval in this file]"
 
 
 # ---------------------------------------------------------------- tables
@@ -193,8 +233,10 @@ TABLE_HEAD = ["algorithm", "scene", "seeds", "growth time median [95% CI]", "pea
               "coverage", "attached", "penetration", "leaf overlap", "leaf light"]
 
 
-def table_rows(cells):
-    """One row per algorithm entry x scene (seeds pooled): repetition times of every seed together."""
+def table_rows(cells, pooled=None):
+    """One row per algorithm entry x scene (seeds pooled): repetition times of every seed together, with the
+    interval the suite computed over them (`pooled`: pooled_summaries of the results file)."""
+    pooled = pooled or {}
     rows = []
     for scene in ordered(c.scene for c in cells):
         for label in ordered(c.row for c in cells):
@@ -213,7 +255,8 @@ def table_rows(cells):
             nodes = median([c.nodes for c in good])
             m = lambda k: median([c.metrics[k] for c in good if k in c.metrics]) if any(k in c.metrics for c in good) else None
             seeds = f"{len(good)}" + (f" ({len(bad)} failed: {', '.join(sorted({c.status for c in bad}))})" if bad else "")
-            rows.append([label, scene, seeds, time_with_ci(times), fmt_bytes(rss), fmt_bytes(glb), f"{nodes:.0f}",
+            summary = pooled.get(frozenset(c.t.get("id") for c in good))
+            rows.append([label, scene, seeds, time_with_ci(summary, times), fmt_bytes(rss), fmt_bytes(glb), f"{nodes:.0f}",
                          fmt_frac(m("coverage")), fmt_frac(m("attached_fraction")), fmt_frac(m("penetration_samples")),
                          fmt_frac(m("leaf_overlap")), fmt_frac(m("leaf_light_exposure"))])
     return rows
@@ -279,10 +322,10 @@ def figures(cells, out, formats):
         if not pts:
             continue
         x = np.array([c.nodes for c in pts], dtype=float)
-        med = np.array([median(c.growth) for c in pts])
-        cis = [median_ci(c.growth) for c in pts]
-        lo = med - np.array([ci[0] for ci in cis])
-        hi = np.array([ci[1] for ci in cis]) - med
+        med = np.array([c.growth_median() for c in pts])
+        # Bars: the suite's interval of each median (none in files written before it wrote them).
+        lo = med - np.array([c.growth_summary["lo"] if c.growth_summary else m for c, m in zip(pts, med)])
+        hi = np.array([c.growth_summary["hi"] if c.growth_summary else m for c, m in zip(pts, med)]) - med
         fit = fit_exponent(x, med)
         name = label
         if fit:
@@ -358,7 +401,7 @@ def figures(cells, out, formats):
         a = axes[idx // ncol][idx % ncol]
         data, names = [], []
         for label in labels:
-            v = [median(c.growth) for c in good if c.scene == scene and c.label == label]
+            v = [c.growth_median() for c in good if c.scene == scene and c.label == label]
             if v:
                 data.append(v)
                 names.append(label)
@@ -567,7 +610,7 @@ def main(argv=None):
         print(f"report: {len(cells)} cells from {args.results}", file=sys.stderr)
         figs = figures(cells, args.out, formats)
 
-        rows = table_rows(cells)
+        rows = table_rows(cells, pooled_summaries(doc))
         caption = ("Median growth wall time over all repetitions of all seeds [distribution-free 95% interval; '~': "
                    "the full range, fewer than 6 samples], peak memory of the trial process, GLB file size, nodes, and "
                    "quality metrics (median over seeds).")
@@ -599,7 +642,7 @@ def main(argv=None):
         print(f"report: error: {e}", file=sys.stderr)
         return 2
     except ImportError as e:
-        print(f"report: error: {e}; install Debian's python3-matplotlib and python3-numpy (scripts/install-deps) "
+        print(f"report: error: {e}; install Debian's python3-matplotlib, python3-numpy and python3-jsonschema (scripts/install-deps) "
               f"and run with /usr/bin/python3", file=sys.stderr)
         return 2
     return 0

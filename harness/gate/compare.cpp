@@ -1,12 +1,12 @@
 #include "harness/gate/compare.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <map>
 
 #include <fmt/format.h>
 
 #include "core/errors.hpp"
+#include "harness/record/files.hpp"
 
 namespace growbench {
 using json = nlohmann::json;
@@ -33,8 +33,6 @@ void flatten(const json& j, const std::string& prefix, std::map<std::string, jso
     out[prefix] = j;
   }
 }
-
-const char* const kBehaviour[] = {"status", "geometry_hash", "counts", "metrics"};
 
 }  // namespace
 
@@ -92,127 +90,205 @@ std::string CompareResult::table() const {
   return out;
 }
 
-CompareResult compare_results(const json& base, const json& now, const CompareOptions& o) {
-  CompareResult r;
-  std::map<std::string, const json*> now_cells;
-  for (const auto& t : now.at("trials")) now_cells[t.value("id", "")] = &t;
-  std::map<std::string, bool> seen;
-  for (const auto& b : base.at("trials")) {
-    const std::string id = b.value("id", "");
-    seen[id] = true;
-    const auto it = now_cells.find(id);
-    if (it == now_cells.end()) {
-      r.missing_cells.push_back(id);
+namespace {
+
+// A cell as the gate sees it, from either kind of file: what a baseline keeps, and the repetitions when the
+// file is a results file.
+struct GateCell {
+  BaselineCell cell;
+  const std::vector<SuiteSample>* samples = nullptr;
+};
+
+std::vector<GateCell> gate_cells(const GateFile& f) {
+  std::vector<GateCell> out;
+  if (const auto* r = std::get_if<ResultsFile>(&f)) {
+    for (const auto& t : r->trials) out.push_back({baseline_cell_of(t), &t.samples});
+  } else {
+    for (const auto& c : std::get<Baseline>(f).trials) out.push_back({c, nullptr});
+  }
+  return out;
+}
+
+template <class T>
+std::optional<json> json_of(const std::optional<T>& v) {
+  if (!v) return std::nullopt;
+  if constexpr (requires { to_json(*v); }) return to_json(*v);
+  else return json(*v);
+}
+
+// The fields compared quantity by quantity ("counts.nodes"), each as JSON (absent: the cell has none).
+struct GatedField {
+  const char* name;
+  std::optional<json> (*get)(const BaselineCell&);
+};
+const GatedField kBehaviour[] = {
+    {"status", [](const BaselineCell& c) { return std::optional<json>(c.status); }},
+    {"geometry_hash", [](const BaselineCell& c) { return json_of(c.geometry_hash); }},
+    {"counts", [](const BaselineCell& c) { return json_of(c.counts); }},
+    {"metrics", [](const BaselineCell& c) { return json_of(c.metrics); }},
+};
+const GatedField kOutputBytes = {"output_bytes", [](const BaselineCell& c) { return json_of(c.output_bytes); }};
+const GatedField kAlloc = {"alloc", [](const BaselineCell& c) {
+                             if (!c.alloc) return std::optional<json>();
+                             json j = json::object();
+                             for (const auto& [phase, a] : *c.alloc) j[phase] = to_json(a);
+                             return std::optional<json>(j);
+                           }};
+
+// Every changed instruction count: a rise past the threshold fails; anything else is shown.
+void compare_instructions(const std::string& id, const InstructionCounts& base, const InstructionCounts& now,
+                          const CompareOptions& o, CompareResult& r) {
+  for (const auto& [phase, old_ir] : base) {
+    const auto it = now.find(phase);
+    if (it == now.end() || it->second == old_ir) continue;
+    const json v = old_ir, nv = it->second;
+    const double ratio = ratio_of(v, nv);
+    const double delta = static_cast<double>(it->second) - static_cast<double>(old_ir);
+    if (std::abs(ratio - 1.0) < 1e-3 && std::abs(delta) < o.instructions_floor) {
+      ++r.small_changes;  // heap-layout noise: counted, not listed
       continue;
     }
-    const json& n = *it->second;
+    const bool bad = ratio > 1.0 + o.instructions_threshold && delta > o.instructions_floor;
+    r.changes.push_back({id, "instructions." + phase, show(v), show(nv), ratio, bad,
+                         fmt::format("instructions {:+.2f}%{}", 100.0 * (ratio - 1.0),
+                                     bad ? fmt::format(" > +{:g}%", 100.0 * o.instructions_threshold)
+                                     : ratio > 1.0 + o.instructions_threshold ? " (below the floor)" : "")});
+  }
+}
+
+// The repetitions of both runs, per phase, wall and CPU: judged when both have at least 3.
+void compare_timings(const GateCell& b, const GateCell& n, const CompareOptions& o, CompareResult& r) {
+  auto samples = [](const GateCell& t, std::string_view phase, bool cpu) {
+    std::vector<double> v;
+    if (t.samples)
+      for (const auto& s : *t.samples)
+        if (const PhaseMeasures* p = s.status == "ok" && s.phases ? s.phases->find(phase) : nullptr)
+          v.push_back(cpu ? p->cpu_s : p->wall_s);
+    return v;
+  };
+  for (const char* phase : {"growth"})
+    for (const bool cpu : {false, true}) {
+      const auto a = samples(b, phase, cpu), c = samples(n, phase, cpu);
+      if (a.size() >= 3 && c.size() >= 3)
+        r.timings.push_back({b.cell.id, fmt::format("{}.{}", phase, cpu ? "cpu_s" : "wall_s"),
+                             judge_timings(a, c, o.timing_effect, o.timing_alpha)});
+    }
+}
+
+void compare_cell(const GateCell& gb, const GateCell& gn, const CompareOptions& o, CompareResult& r) {
+  const BaselineCell& b = gb.cell;
+  const BaselineCell& n = gn.cell;
+  const std::string& id = b.id;
+  auto compare_field = [&](const GatedField& field, const std::string& why, bool fails) {
+    std::map<std::string, json> fb, fn;
+    if (const auto v = field.get(b)) flatten(*v, field.name, fb);
+    if (const auto v = field.get(n)) flatten(*v, field.name, fn);
+    for (const auto& [k, v] : fb) {
+      const auto jt = fn.find(k);
+      const json nv = jt == fn.end() ? json(nullptr) : jt->second;
+      if (nv != v) r.changes.push_back({id, k, show(v), jt == fn.end() ? "(absent)" : show(nv), ratio_of(v, nv), fails, why});
+    }
+    for (const auto& [k, v] : fn)
+      if (!fb.count(k)) r.changes.push_back({id, k, "(absent)", show(v), 0.0, false, "new quantity"});
+  };
+  for (const auto& f : kBehaviour) compare_field(f, "behaviour", true);
+  compare_field(kOutputBytes, "output bytes", true);
+  // Allocation counts are deterministic for one thread; with more, libraries' parallel builders
+  // (OpenVDB's level sets) allocate a varying amount, so they are shown but cannot fail.
+  const bool single = b.threads.value_or(0) == 1 && n.threads.value_or(0) == 1;
+  const std::size_t before = r.changes.size();
+  compare_field(kAlloc, single ? "allocations" : "allocations (multithreaded: not gated)", single);
+  for (std::size_t k = before; k < r.changes.size(); ++k) {
+    Change& c = r.changes[k];
+    const bool bytes = c.quantity.size() > 6 && c.quantity.compare(c.quantity.size() - 6, 6, ".bytes") == 0;
+    if (c.fails && c.ratio > 0.0) {
+      const double delta = std::abs(std::stod(c.new_value) - std::stod(c.old_value));
+      const double slack = bytes ? o.alloc_bytes_slack : o.alloc_count_slack;
+      if (delta <= slack) {
+        c.fails = false;
+        c.why = fmt::format("{} within {:g} (paths differ by checkout)", bytes ? "allocated bytes" : "allocations", slack);
+      }
+    }
+  }
+  if (b.instructions && n.instructions) compare_instructions(id, *b.instructions, *n.instructions, o, r);
+  compare_timings(gb, gn, o, r);
+}
+
+// A results or baseline document read as JSON from `source`.
+GateFile gate_file_from_json(const json& j, const std::string& source) {
+  const std::string kind = j.is_object() ? j.value("kind", "") : "";
+  if (kind == kBaselineKind) return from_json<Baseline>(j, source);
+  if (kind == kResultsKind) return from_json<ResultsFile>(j, source);
+  throw InputError(fmt::format("{}: not a growbench results or baseline file (kind '{}')", source, kind));
+}
+
+}  // namespace
+
+CompareResult compare_results(const GateFile& base, const GateFile& now, const CompareOptions& o) {
+  CompareResult r;
+  const std::vector<GateCell> base_cells = gate_cells(base), now_list = gate_cells(now);
+  std::map<std::string, const GateCell*> now_cells;
+  for (const auto& t : now_list) now_cells[t.cell.id] = &t;
+  std::map<std::string, bool> seen;
+  for (const auto& b : base_cells) {
+    seen[b.cell.id] = true;
+    const auto it = now_cells.find(b.cell.id);
+    if (it == now_cells.end()) {
+      r.missing_cells.push_back(b.cell.id);
+      continue;
+    }
     ++r.cells_compared;
-    auto compare_field = [&](const char* field, const std::string& why, bool fails) {
-      std::map<std::string, json> fb, fn;
-      if (b.contains(field)) flatten(b[field], field, fb);
-      if (n.contains(field)) flatten(n[field], field, fn);
-      for (const auto& [k, v] : fb) {
-        const auto jt = fn.find(k);
-        const json nv = jt == fn.end() ? json(nullptr) : jt->second;
-        if (nv != v) r.changes.push_back({id, k, show(v), jt == fn.end() ? "(absent)" : show(nv), ratio_of(v, nv), fails, why});
-      }
-      for (const auto& [k, v] : fn)
-        if (!fb.count(k)) r.changes.push_back({id, k, "(absent)", show(v), 0.0, false, "new quantity"});
-    };
-    for (const char* f : kBehaviour) compare_field(f, "behaviour", true);
-    compare_field("output_bytes", "output bytes", true);
-    // Allocation counts are deterministic for one thread; with more, libraries' parallel builders
-    // (OpenVDB's level sets) allocate a varying amount, so they are shown but cannot fail.
-    const bool single = b.value("threads", 0) == 1 && n.value("threads", 0) == 1;
-    const std::size_t before = r.changes.size();
-    compare_field("alloc", single ? "allocations" : "allocations (multithreaded: not gated)", single);
-    for (std::size_t k = before; k < r.changes.size(); ++k) {
-      Change& c = r.changes[k];
-      const bool bytes = c.quantity.size() > 6 && c.quantity.compare(c.quantity.size() - 6, 6, ".bytes") == 0;
-      if (c.fails && c.ratio > 0.0) {
-        const double delta = std::abs(std::stod(c.new_value) - std::stod(c.old_value));
-        const double slack = bytes ? o.alloc_bytes_slack : o.alloc_count_slack;
-        if (delta <= slack) {
-          c.fails = false;
-          c.why = fmt::format("{} within {:g} (paths differ by checkout)", bytes ? "allocated bytes" : "allocations", slack);
-        }
-      }
-    }
-    // Instructions: a rise past the threshold fails; anything else is shown.
-    if (b.contains("instructions") && n.contains("instructions")) {
-      for (const auto& [phase, v] : b["instructions"].items()) {
-        if (!n["instructions"].contains(phase)) continue;
-        const json& nv = n["instructions"][phase];
-        if (nv == v) continue;
-        const double ratio = ratio_of(v, nv);
-        if (std::abs(ratio - 1.0) < 1e-3 && std::abs(nv.get<double>() - v.get<double>()) < o.instructions_floor) {
-          ++r.small_changes;  // heap-layout noise: counted, not listed
-          continue;
-        }
-        const bool bad = ratio > 1.0 + o.instructions_threshold &&
-                         nv.get<double>() - v.get<double>() > o.instructions_floor;
-        r.changes.push_back({id, "instructions." + phase, show(v), show(nv), ratio, bad,
-                             fmt::format("instructions {:+.2f}%{}", 100.0 * (ratio - 1.0),
-                                         bad ? fmt::format(" > +{:g}%", 100.0 * o.instructions_threshold)
-                                         : ratio > 1.0 + o.instructions_threshold ? " (below the floor)" : "")});
-      }
-    }
-    // Timings: the repetitions of both runs, per phase, wall and CPU.
-    auto samples = [](const json& t, const std::string& phase, const char* what) {
-      std::vector<double> v;
-      if (t.contains("samples"))
-        for (const auto& s : t["samples"])
-          if (s.value("status", "") == "ok" && s.contains("phases") && s["phases"].contains(phase))
-            v.push_back(s["phases"][phase][what].get<double>());
-      return v;
-    };
-    for (const char* phase : {"growth"})
-      for (const char* what : {"wall_s", "cpu_s"}) {
-        const auto a = samples(b, phase, what), c = samples(n, phase, what);
-        if (a.size() >= 3 && c.size() >= 3)
-          r.timings.push_back({id, fmt::format("{}.{}", phase, what), judge_timings(a, c, o.timing_effect, o.timing_alpha)});
-      }
+    compare_cell(b, *it->second, o, r);
   }
   for (const auto& [id, t] : now_cells)
     if (!seen.count(id)) r.new_cells.push_back(id);
   return r;
 }
 
-json baseline_of(const json& results) {
-  json b = {{"schema_version", 1}, {"kind", "growbench-baseline"}, {"mode", results.value("mode", "timing")}};
-  if (results.contains("suite")) b["suite"] = results["suite"];
-  if (results.contains("suite_hash")) b["suite_hash"] = results["suite_hash"];
-  if (results.contains("context")) {
-    const json& c = results["context"];
-    json ctx = json::object();
-    for (const char* k : {"growbench_commit", "dirty", "compiler", "cxx_flags", "build_type", "dependencies", "valgrind"})
-      if (c.contains(k)) ctx[k] = c[k];
-    b["context"] = ctx;
-  }
-  b["trials"] = json::array();
-  for (const auto& t : results.at("trials")) {
-    json cell = {{"id", t.value("id", "")}};
-    for (const char* k : {"label", "algorithm", "scene", "seed", "status", "threads", "geometry_hash", "counts", "metrics",
-                          "output_bytes", "alloc", "instructions"})
-      if (t.contains(k)) cell[k] = t[k];
-    b["trials"].push_back(cell);
-  }
+CompareResult compare_results(const json& base, const json& now, const CompareOptions& o) {
+  return compare_results(gate_file_from_json(base, "the base"), gate_file_from_json(now, "the new results"), o);
+}
+
+BaselineCell baseline_cell_of(const SuiteCell& t) {
+  BaselineCell c;
+  c.id = t.id;
+  c.label = t.label;
+  c.algorithm = t.algorithm;
+  c.scene = t.scene;
+  c.seed = t.seed;
+  c.status = t.status;
+  c.threads = t.results.threads;
+  c.geometry_hash = t.results.geometry_hash;
+  c.counts = t.results.counts;
+  c.metrics = t.results.metrics;
+  c.output_bytes = t.results.output_bytes;
+  c.alloc = t.results.alloc;
+  c.instructions = t.results.instructions;
+  return c;
+}
+
+Baseline baseline_of(const ResultsFile& results) {
+  Baseline b;
+  b.mode = results.mode;
+  b.suite = results.suite;
+  b.suite_hash = results.suite_hash;
+  const RunContext& c = results.context;
+  b.context = {c.growbench_commit, c.dirty, c.compiler, c.cxx_flags, c.build_type, c.dependencies};
+  for (const auto& t : results.trials) b.trials.push_back(baseline_cell_of(t));
   return b;
 }
 
+json baseline_of(const json& results) { return to_json(baseline_of(from_json<ResultsFile>(results, "the results"))); }
+
+GateFile read_gate_file(const std::string& path) { return gate_file_from_json(read_json_file(path), path); }
+
 json read_results_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(fmt::format("{}: cannot open", path));
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::exception& e) {
-    throw InputError(fmt::format("{}: not valid JSON: {}", path, e.what()));
+  const GateFile f = read_gate_file(path);
+  if (const auto* r = std::get_if<ResultsFile>(&f)) {
+    if (r->schema_version > kSchemaVersion) return to_json(read_results(path));  // refused there, with the reason
+    return to_json(*r);
   }
-  const std::string kind = j.value("kind", "");
-  if ((kind != "growbench-results" && kind != "growbench-baseline") || !j.contains("trials") || !j["trials"].is_array())
-    throw InputError(fmt::format("{}: not a growbench results or baseline file (kind '{}')", path, kind));
-  return j;
+  return to_json(std::get<Baseline>(f));
 }
 
 }  // namespace growbench

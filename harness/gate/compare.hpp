@@ -7,10 +7,12 @@
 #pragma once
 
 #include <string>
+#include <variant>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "harness/record/record.hpp"
 #include "harness/stats/stats.hpp"
 
 namespace growbench {
@@ -55,12 +57,22 @@ struct CompareResult {
   [[nodiscard]] std::string table() const;
 };
 
+// What the gate reads on either side: a results file, or a committed baseline.
+using GateFile = std::variant<ResultsFile, Baseline>;
+
+CompareResult compare_results(const GateFile& base, const GateFile& now, const CompareOptions& options = {});
+// The same on documents read as JSON (each read with from_json; InputError for what is neither).
 CompareResult compare_results(const nlohmann::json& base, const nlohmann::json& now, const CompareOptions& options = {});
 
 // The deterministic part of a results file (no timings, no paths): what a committed baseline holds.
+Baseline baseline_of(const ResultsFile& results);
+BaselineCell baseline_cell_of(const SuiteCell& cell);
 nlohmann::json baseline_of(const nlohmann::json& results);
 
-// Reads a results or baseline file; InputError naming the file when it is neither.
+// Reads a results or baseline file; InputError naming the file when it is neither, and naming the JSON path
+// of a field that does not fit.
+GateFile read_gate_file(const std::string& path);
+// The same as JSON (to_json of what read_gate_file read), for callers that still work on JSON.
 nlohmann::json read_results_file(const std::string& path);
 
 }  // namespace growbench

@@ -8,17 +8,17 @@
 
 #include <string>
 
-#include <nlohmann/json.hpp>
+#include "harness/record/record.hpp"
 
 namespace growbench {
 
 // A machine key from a results context: the CPU model and hardware threads as a file name.
-std::string history_machine(const nlohmann::json& context);
+std::string history_machine(const RunContext& context);
 
 // The per-cell summary of one run that a history keeps.
-nlohmann::json history_entry(const nlohmann::json& results);
+HistoryRun history_entry(const ResultsFile& results);
 
-// Appends the results file's run to DIR (machine "" : history_machine of its context). Returns the
+// Appends the results file's run (a results file, not a baseline) to DIR (machine "" : history_machine of its context). Returns the
 // file written. InputError when the results have no commit.
 std::string history_add(const std::string& results_path, const std::string& dir, const std::string& machine = "");
 

@@ -28,21 +28,6 @@ using json = nlohmann::json;
 
 namespace {
 
-json read_json(const fs::path& p) {
-  std::ifstream in(p);
-  if (!in) throw InputError(fmt::format("{}: cannot open", p.string()));
-  try {
-    return json::parse(in);
-  } catch (const json::exception& e) {
-    throw InputError(fmt::format("{}: not valid JSON: {}", p.string(), e.what()));
-  }
-}
-
-void write_json(const fs::path& p, const json& j, int indent) {
-  const std::string text = j.dump(indent) + "\n";
-  write_file_atomic(p.string(), text.data(), text.size());
-}
-
 struct Job {
   std::string key;          // trial id ("" for a run directory)
   fs::path snapshot, pov, png;
@@ -65,12 +50,14 @@ std::vector<fs::path> frame_snapshots(const fs::path& trial_dir) {
 }
 
 // ffmpeg: frames/step_*.png to animation.mp4 (H.264, even dimensions). Returns a record of the attempt.
-json make_animation(const fs::path& trial_dir, std::size_t frames) {
-  json a = {{"frames", frames}, {"frame_pattern", "frames/step_*.png"}};
+AnimationRecord make_animation(const fs::path& trial_dir, std::size_t frames) {
+  AnimationRecord a;
+  a.frames = frames;
+  a.frame_pattern = "frames/step_*.png";
   const std::string ffmpeg = find_program("ffmpeg");
   if (ffmpeg.empty()) {
-    a["status"] = "no_ffmpeg";
-    a["message"] = "ffmpeg is not installed: the numbered PNG frames are the animation";
+    a.status = "no_ffmpeg";
+    a.message = "ffmpeg is not installed: the numbered PNG frames are the animation";
     return a;
   }
   std::vector<std::string> args = {ffmpeg, "-y", "-loglevel", "error", "-framerate", "12", "-pattern_type", "glob",
@@ -78,67 +65,34 @@ json make_animation(const fs::path& trial_dir, std::size_t frames) {
                                    "yuv420p", "animation.mp4"};
   const ChildResult cr = run_program(args, trial_dir.string(), {600.0, 0}, (trial_dir / "animation.log").string());
   if (cr.exit_code == 0 && fs::exists(trial_dir / "animation.mp4")) {
-    a["status"] = "ok";
-    a["file"] = "animation.mp4";
-    a["bytes"] = fs::file_size(trial_dir / "animation.mp4");
+    a.status = "ok";
+    a.file = "animation.mp4";
+    a.bytes = fs::file_size(trial_dir / "animation.mp4");
   } else {
-    a["status"] = "failed";
-    a["message"] = fmt::format("ffmpeg failed (exit {}); see {}", cr.exit_code, (trial_dir / "animation.log").string());
+    a.status = "failed";
+    a.message = fmt::format("ffmpeg failed (exit {}); see {}", cr.exit_code, (trial_dir / "animation.log").string());
   }
   return a;
 }
 
-}  // namespace
-
-json render_directory(const std::string& dir_arg, const RenderDirOptions& o) {
-  const fs::path dir(dir_arg);
-  const bool suite = fs::exists(dir / "results.json");
-  if (!suite && !fs::exists(dir / "record.json"))
-    throw InputError(fmt::format("{}: neither a suite results directory (results.json) nor a run directory (record.json)",
-                                 dir_arg));
-  json doc = read_json(suite ? dir / "results.json" : dir / "record.json");
-
-  std::vector<Job> jobs;
-  std::map<std::string, std::size_t> trial_index;  // id -> index in doc["trials"]
-  auto add_trial = [&](const std::string& key, const fs::path& tdir, const std::string& scene_spec,
-                       const std::vector<std::string>& scene_params, const std::string& leaf_obj) {
-    if (!fs::exists(tdir / "plant.gbplant")) return false;
-    jobs.push_back({key, tdir / "plant.gbplant", tdir / "render.pov", tdir / "render.png", scene_spec, scene_params,
-                    leaf_obj, false, {}});
-    for (const auto& f : frame_snapshots(tdir)) {
-      fs::path png = f;
-      png.replace_extension(".png");
-      fs::path pov = f;
-      pov.replace_extension(".pov");
-      jobs.push_back({key, f, pov, png, scene_spec, scene_params, leaf_obj, true, {}});
-    }
-    return true;
-  };
-  std::size_t skipped = 0;
-  if (suite) {
-    if (!doc.contains("trials")) throw InputError(fmt::format("{}: no trials", (dir / "results.json").string()));
-    for (std::size_t i = 0; i < doc["trials"].size(); ++i) {
-      const json& t = doc["trials"][i];
-      const std::string id = t.value("id", "");
-      trial_index[id] = i;
-      const json& spec = t.contains("spec") ? t["spec"] : json::object();
-      if (!add_trial(id, dir / "trials" / id, spec.value("scene", t.value("scene_spec", "")),
-                     spec.value("scene_params", std::vector<std::string>{}), spec.value("leaf_obj", std::string{})))
-        ++skipped;
-    }
-  } else {
-    const json& sc = doc.at("scene");
-    if (!add_trial("", dir, sc.value("spec", ""), sc.value("params", std::vector<std::string>{}), doc.value("leaf_obj", std::string{})))
-      throw InputError(fmt::format("{}: no plant.gbplant to render (written by growbench run and suite trials)", dir_arg));
+// A trial's render and its frames' (when it kept a plant snapshot); false when it has none.
+bool add_trial(std::vector<Job>& jobs, const std::string& key, const fs::path& tdir, const std::string& scene_spec,
+               const std::vector<std::string>& scene_params, const std::string& leaf_obj) {
+  if (!fs::exists(tdir / "plant.gbplant")) return false;
+  jobs.push_back({key, tdir / "plant.gbplant", tdir / "render.pov", tdir / "render.png", scene_spec, scene_params, leaf_obj,
+                  false, {}});
+  for (const auto& f : frame_snapshots(tdir)) {
+    fs::path png = f;
+    png.replace_extension(".png");
+    fs::path pov = f;
+    pov.replace_extension(".pov");
+    jobs.push_back({key, f, pov, png, scene_spec, scene_params, leaf_obj, true, {}});
   }
+  return true;
+}
 
-  const int cores = std::max(1u, std::thread::hardware_concurrency());
-  const int workers = std::max(1, std::min<int>(o.jobs > 0 ? o.jobs : cores, static_cast<int>(jobs.size())));
-  RenderOptions ro = o.render;
-  ro.threads = std::max(1, cores / workers);
-  if (!jobs.empty() && find_povray().empty())
-    throw InputError("povray is not installed: run scripts/install-deps (Debian's povray package) and render again");
-
+// Renders every job with `workers` POV-Ray processes at once, each scene loaded and each leaf read once.
+void render_jobs(std::vector<Job>& jobs, int workers, const RenderOptions& ro, const RenderDirOptions& o) {
   std::mutex scene_mutex, print_mutex;
   std::map<std::string, std::shared_ptr<const Scene>> scenes;
   auto scene_for = [&](const Job& j) {
@@ -197,123 +151,201 @@ json render_directory(const std::string& dir_arg, const RenderDirOptions& o) {
   for (int i = 0; i < workers; ++i) pool.emplace_back(worker);
   for (auto& th : pool) th.join();
   if (tty) fmt::print(stderr, "\r{:<110}\r", "");
-  const double total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
 
-  // Records: paths relative to DIR, so the directory can move.
+// A render as its record keeps it, with paths relative to the results (or run) directory.
+RenderRecord render_record(const Job& j, const RenderOptions& ro, const fs::path& dir) {
   auto rel = [&](const fs::path& p) { return p.lexically_relative(dir).string(); };
-  std::size_t ok = 0, failed = 0, warnings = 0;
-  double povray_s = 0.0;
+  const RenderResult& r = j.result;
+  RenderRecord rr;
+  rr.status = r.status;
+  if (!r.message.empty()) rr.message = r.message;
+  rr.warnings = r.warnings;
+  rr.png = rel(j.png);
+  rr.pov = rel(j.pov);
+  rr.log = rel(fs::path(r.log));
+  rr.width = r.width;
+  rr.height = r.height;
+  rr.pov_bytes = r.pov_bytes;
+  rr.write_s = r.write_s;
+  rr.wall_s = r.wall_s;
+  rr.cpu_s = r.cpu_s;
+  rr.quality = to_string(ro.quality);
+  rr.branches = ro.branches;
+  rr.threads = ro.threads;
+  return rr;
+}
+
+// Where renders and animations are recorded: each trial of a suite's results, or the one run's record.
+struct RenderTargets {
+  ResultsFile* results = nullptr;  // a suite
+  TrialRecord* record = nullptr;   // a run
+  std::map<std::string, std::size_t> trial_index;  // id -> index in results->trials
+  void set(const std::string& key, RenderRecord r) {
+    if (results) results->trials[trial_index.at(key)].render = std::move(r);
+    else record->render = std::move(r);
+  }
+  void set(const std::string& key, AnimationRecord a) {
+    if (results) results->trials[trial_index.at(key)].animation = std::move(a);
+    else record->animation = std::move(a);
+  }
+};
+
+// Records every render, makes each trial's animation from its frames; the tally into `summary`.
+void record_renders(const std::vector<Job>& jobs, const RenderOptions& ro, const fs::path& dir, const RenderDirOptions& o,
+                    RenderTargets& targets, RenderSummary& summary) {
+  const bool suite = targets.results != nullptr;
   std::map<std::string, std::size_t> frames_of;
   std::map<std::string, std::vector<std::string>> frame_failures;
-  for (auto& j : jobs) {
-    j.result.ok() ? ++ok : ++failed;
-    warnings += j.result.warnings.size();
-    povray_s += j.result.wall_s;
+  for (const auto& j : jobs) {
+    j.result.ok() ? ++summary.ok : ++summary.failed;
+    summary.warnings += j.result.warnings.size();
+    summary.povray_s += j.result.wall_s;
     if (j.frame) {
       ++frames_of[j.key];
       if (!j.result.ok()) frame_failures[j.key].push_back(j.result.message);
       continue;
     }
-    json r = j.result.to_json();
-    r["png"] = rel(j.png);
-    r["pov"] = rel(j.pov);
-    r["log"] = rel(fs::path(j.result.log));
-    r["quality"] = to_string(ro.quality);
-    r["branches"] = ro.branches;
-    r["threads"] = ro.threads;
-    if (suite) doc["trials"][trial_index[j.key]]["render"] = r;
-    else doc["render"] = r;
+    targets.set(j.key, render_record(j, ro, dir));
   }
+  summary.renders = summary.ok + summary.failed;
   for (const auto& [key, n] : frames_of) {
     const fs::path tdir = suite ? dir / "trials" / key : dir;
-    json a = frame_failures.count(key) ? json{{"status", "failed"}, {"frames", n}, {"message", frame_failures[key].front()}}
-                                       : make_animation(tdir, n);
-    if (suite) {
-      if (a.contains("file")) a["file"] = rel(tdir / a["file"].get<std::string>());
-      doc["trials"][trial_index[key]]["animation"] = a;
+    AnimationRecord a;
+    if (frame_failures.count(key)) {
+      a.status = "failed";
+      a.frames = n;
+      a.message = frame_failures[key].front();
     } else {
-      doc["animation"] = a;
+      a = make_animation(tdir, n);
     }
-    if (!o.quiet) fmt::print(stderr, "animation {}: {} frames, {}\n", key.empty() ? dir_arg : key, n, a["status"].get<std::string>());
+    if (suite && a.file) a.file = (tdir / *a.file).lexically_relative(dir).string();
+    if (!o.quiet) fmt::print(stderr, "animation {}: {} frames, {}\n", key.empty() ? dir.string() : key, n, a.status);
+    targets.set(key, std::move(a));
+  }
+}
+
+// grid.png: one row per algorithm entry (and sweep value), one column per scene, the lowest seed's plant;
+// and grid-SCENE.png per scene. Failures to write them are recorded in `summary`, never fatal.
+void write_grids(const ResultsFile& doc, const fs::path& dir, const RenderOptions& ro, RenderSummary& summary) {
+  std::vector<std::string> rows, cols;
+  std::map<std::pair<std::string, std::string>, const SuiteCell*> pick;
+  for (const auto& t : doc.trials) {
+    std::string row = t.label.empty() ? t.algorithm : t.label;
+    if (t.sweep.is_object() && !t.sweep.empty()) {
+      std::vector<std::string> kv;
+      for (const auto& [k, v] : t.sweep.items()) kv.push_back(fmt::format("{}={}", k, v.is_string() ? v.get<std::string>() : v.dump()));
+      row += fmt::format(" {}", fmt::join(kv, " "));
+    }
+    const std::string& col = t.scene;
+    if (std::find(rows.begin(), rows.end(), row) == rows.end()) rows.push_back(row);
+    if (std::find(cols.begin(), cols.end(), col) == cols.end()) cols.push_back(col);
+    const SuiteCell*& p = pick[{row, col}];
+    if (!p || t.seed < p->seed) p = &t;
+  }
+  auto cell = [&](const std::string& r, const std::string& c, std::string& note) {
+    const auto it = pick.find({r, c});
+    if (it == pick.end()) {
+      note = "not in suite";
+      return std::string();
+    }
+    const SuiteCell& t = *it->second;
+    if (t.status != "ok") note = t.status;
+    else if (!t.render) note = "no snapshot";
+    else if (t.render->status != "ok") note = "render " + t.render->status;
+    else return (dir / t.render->png).string();
+    return std::string();
+  };
+  std::vector<std::vector<std::string>> cells(rows.size(), std::vector<std::string>(cols.size()));
+  std::vector<std::vector<std::string>> notes = cells;
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    for (std::size_t k = 0; k < cols.size(); ++k) cells[i][k] = cell(rows[i], cols[k], notes[i][k]);
+  const std::string title = fmt::format("growbench suite '{}': algorithm x scene (lowest seed), POV-Ray {}", doc.suite.name,
+                                        to_string(ro.quality));
+  try {
+    write_grid((dir / "grid.png").string(), title, rows, cols, cells, notes);
+    summary.grid = "grid.png";
+    std::map<std::string, std::string> per_scene;
+    for (std::size_t k = 0; k < cols.size(); ++k) {
+      std::vector<std::vector<std::string>> col_cells(1), col_notes(1);
+      for (std::size_t i = 0; i < rows.size(); ++i) {
+        col_cells[0].push_back(cells[i][k]);
+        col_notes[0].push_back(notes[i][k]);
+      }
+      const std::string name = "grid-" + safe_name(cols[k]) + ".png";
+      write_grid((dir / name).string(), fmt::format("{} (lowest seed)", cols[k]), {cols[k]}, rows, col_cells, col_notes);
+      per_scene[cols[k]] = name;
+    }
+    summary.grid_per_scene = per_scene;
+  } catch (const std::exception& e) {
+    summary.grid_error = e.what();
+    fmt::print(stderr, "growbench: {}\n", e.what());
+  }
+}
+
+}  // namespace
+
+RenderSummary render_directory_record(const std::string& dir_arg, const RenderDirOptions& o) {
+  const fs::path dir(dir_arg);
+  const bool suite = fs::exists(dir / "results.json");
+  if (!suite && !fs::exists(dir / "record.json"))
+    throw InputError(fmt::format("{}: neither a suite results directory (results.json) nor a run directory (record.json)",
+                                 dir_arg));
+  ResultsFile results;
+  TrialRecord record;
+  RenderTargets targets;
+  std::vector<Job> jobs;
+  std::size_t skipped = 0;
+  if (suite) {
+    results = read_results((dir / "results.json").string());
+    targets.results = &results;
+    for (std::size_t i = 0; i < results.trials.size(); ++i) {
+      const SuiteCell& t = results.trials[i];
+      targets.trial_index[t.id] = i;
+      if (!add_trial(jobs, t.id, dir / "trials" / t.id, t.spec.scene.empty() ? t.scene_spec : t.spec.scene,
+                     t.spec.scene_params, t.spec.leaf_obj.value_or("")))
+        ++skipped;
+    }
+  } else {
+    record = read_trial_record((dir / "record.json").string());
+    targets.record = &record;
+    if (!add_trial(jobs, "", dir, record.scene.spec, record.scene.params, record.leaf_obj.value_or("")))
+      throw InputError(fmt::format("{}: no plant.gbplant to render (written by growbench run and suite trials)", dir_arg));
   }
 
-  json summary = {{"quality", to_string(ro.quality)},
-                  {"branches", ro.branches},
-                  {"width", render_width(ro)},
-                  {"height", render_height(ro)},
-                  {"povray", povray_version()},
-                  {"jobs", workers},
-                  {"threads_per_render", ro.threads},
-                  {"renders", ok + failed},
-                  {"ok", ok},
-                  {"failed", failed},
-                  {"warnings", warnings},
-                  {"skipped_without_snapshot", skipped},
-                  {"povray_s", povray_s},
-                  {"wall_s", total_s}};
+  const int cores = std::max(1u, std::thread::hardware_concurrency());
+  const int workers = std::max(1, std::min<int>(o.jobs > 0 ? o.jobs : cores, static_cast<int>(jobs.size())));
+  RenderOptions ro = o.render;
+  ro.threads = std::max(1, cores / workers);
+  if (!jobs.empty() && find_povray().empty())
+    throw InputError("povray is not installed: run scripts/install-deps (Debian's povray package) and render again");
+  const auto t0 = std::chrono::steady_clock::now();
+  render_jobs(jobs, workers, ro, o);
+  const double total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
+  RenderSummary summary;
+  summary.quality = to_string(ro.quality);
+  summary.branches = ro.branches;
+  summary.width = render_width(ro);
+  summary.height = render_height(ro);
+  summary.povray = povray_version();
+  summary.jobs = workers;
+  summary.threads_per_render = ro.threads;
+  summary.skipped_without_snapshot = skipped;
+  summary.wall_s = total_s;
+  record_renders(jobs, ro, dir, o, targets, summary);
   if (suite) {
-    // Grid: one row per algorithm entry (and sweep value), one column per scene; the lowest seed's plant.
-    std::vector<std::string> rows, cols;
-    std::map<std::pair<std::string, std::string>, const json*> pick;
-    for (const auto& t : doc["trials"]) {
-      std::string row = t.value("label", t.value("algorithm", "?"));
-      if (t.contains("sweep") && t["sweep"].is_object() && !t["sweep"].empty()) {
-        std::vector<std::string> kv;
-        for (const auto& [k, v] : t["sweep"].items()) kv.push_back(fmt::format("{}={}", k, v.is_string() ? v.get<std::string>() : v.dump()));
-        row += fmt::format(" {}", fmt::join(kv, " "));
-      }
-      const std::string col = t.value("scene", "?");
-      if (std::find(rows.begin(), rows.end(), row) == rows.end()) rows.push_back(row);
-      if (std::find(cols.begin(), cols.end(), col) == cols.end()) cols.push_back(col);
-      const json*& p = pick[{row, col}];
-      if (!p || t.value("seed", 0ull) < p->value("seed", 0ull)) p = &t;
-    }
-    auto cell = [&](const std::string& r, const std::string& c, std::string& note) {
-      const auto it = pick.find({r, c});
-      if (it == pick.end()) {
-        note = "not in suite";
-        return std::string();
-      }
-      const json& t = *it->second;
-      if (t.value("status", "") != "ok") note = t.value("status", "not run");
-      else if (!t.contains("render")) note = "no snapshot";
-      else if (t["render"].value("status", "") != "ok") note = "render " + t["render"].value("status", "failed");
-      else return (dir / t["render"]["png"].get<std::string>()).string();
-      return std::string();
-    };
-    std::vector<std::vector<std::string>> cells(rows.size(), std::vector<std::string>(cols.size()));
-    std::vector<std::vector<std::string>> notes = cells;
-    for (std::size_t i = 0; i < rows.size(); ++i)
-      for (std::size_t k = 0; k < cols.size(); ++k) cells[i][k] = cell(rows[i], cols[k], notes[i][k]);
-    const std::string suite_name = doc.contains("suite") ? doc["suite"].value("name", "") : "";
-    const std::string title = fmt::format("growbench suite '{}': algorithm x scene (lowest seed), POV-Ray {}", suite_name,
-                                          to_string(ro.quality));
-    try {
-      write_grid((dir / "grid.png").string(), title, rows, cols, cells, notes);
-      summary["grid"] = "grid.png";
-      json per_scene = json::object();
-      for (std::size_t k = 0; k < cols.size(); ++k) {
-        std::vector<std::vector<std::string>> col_cells(1), col_notes(1);
-        for (std::size_t i = 0; i < rows.size(); ++i) {
-          col_cells[0].push_back(cells[i][k]);
-          col_notes[0].push_back(notes[i][k]);
-        }
-        const std::string name = "grid-" + safe_name(cols[k]) + ".png";
-        write_grid((dir / name).string(), fmt::format("{} (lowest seed)", cols[k]), {cols[k]}, rows, col_cells, col_notes);
-        per_scene[cols[k]] = name;
-      }
-      summary["grid_per_scene"] = per_scene;
-    } catch (const std::exception& e) {
-      summary["grid_error"] = e.what();
-      fmt::print(stderr, "growbench: {}\n", e.what());
-    }
-    doc["renders"] = summary;
-    write_json(dir / "results.json", doc, 1);
+    write_grids(results, dir, ro, summary);
+    results.renders = summary;
+    write_file_atomic((dir / "results.json").string(), json_text(to_json(results), 1));
   } else {
-    write_json(dir / "record.json", doc, 2);
+    write_file_atomic((dir / "record.json").string(), json_text(to_json(record), 2));
   }
   return summary;
+}
+
+json render_directory(const std::string& dir, const RenderDirOptions& options) {
+  return to_json(render_directory_record(dir, options));
 }
 
 }  // namespace growbench

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "harness/record/record.hpp"
 #include "harness/render/render.hpp"
 
 namespace growbench {
@@ -23,7 +24,9 @@ struct RenderDirOptions {
 // results.json under "renders" and each trial's "render") or record.json (one run: render.png, recorded
 // in record.json). Frames captured with --frames (frames/step_*.gbplant) become frames/step_*.png and,
 // when ffmpeg is installed, animation.mp4. A failed render is recorded, never fatal; results already
-// written are kept. Throws InputError when DIR is neither. Returns the "renders" summary.
-nlohmann::json render_directory(const std::string& dir, const RenderDirOptions& options);
+// written are kept. Throws InputError when DIR is neither (or its file does not read as one). Returns the
+// "renders" summary.
+RenderSummary render_directory_record(const std::string& dir, const RenderDirOptions& options);
+nlohmann::json render_directory(const std::string& dir, const RenderDirOptions& options);  // to_json of the above
 
 }  // namespace growbench

@@ -27,6 +27,7 @@
 #include "algorithms/algorithm.hpp"
 #include "core/errors.hpp"
 #include "harness/record/files.hpp"
+#include "harness/record/record.hpp"
 #include "harness/run/alloc_counter.hpp"
 #include "harness/output/exporters.hpp"
 #include "harness/output/metrics.hpp"
@@ -82,11 +83,11 @@ bool reset_peak_rss() {
   return fd >= 0 && pwrite(fd, "5", 1, 0) == 1;
 }
 
+// Runs each phase and records what it cost into that phase's slot of the record.
 class PhaseTimer {
  public:
-  explicit PhaseTimer(nlohmann::json& phases) : phases_(phases) {}
   template <class F>
-  auto run(const char* name, F&& f) {
+  auto run(const char* name, std::optional<PhaseMeasures>& slot, F&& f) {
     const bool reset = reset_peak_rss();
     // Under callgrind (`growbench suite --instructions`, which starts with instrumentation off) each
     // phase is instrumented and dumped on its own; natively these are a few no-op instructions. The
@@ -105,15 +106,14 @@ class PhaseTimer {
         CALLGRIND_DUMP_STATS_AT(name);
         CALLGRIND_STOP_INSTRUMENTATION;
       }
-      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
-      const double cpu = cpu_seconds() - c0;
+      PhaseMeasures& m = slot.emplace();
+      m.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+      m.cpu_s = cpu_seconds() - c0;
       const AllocStats a1 = alloc_stats();
-      phases_[name] = {{"wall_s", wall},
-                       {"cpu_s", cpu},
-                       {"peak_rss_bytes", status_kb("VmHWM") * 1024u},
-                       {"peak_rss_reset", reset},
-                       {"alloc_count", a1.count - a0.count},
-                       {"alloc_bytes", a1.bytes - a0.bytes}};
+      m.peak_rss_bytes = status_kb("VmHWM") * 1024u;
+      m.peak_rss_reset = reset;
+      m.alloc_count = a1.count - a0.count;
+      m.alloc_bytes = a1.bytes - a0.bytes;
     };
     if constexpr (std::is_void_v<decltype(f())>) {
       f();
@@ -124,9 +124,6 @@ class PhaseTimer {
       return r;
     }
   }
-
- private:
-  nlohmann::json& phases_;
 };
 
 std::string cpu_model() {
@@ -148,31 +145,28 @@ std::string run_command(const std::string& cmd) {
   return out;
 }
 
-// A growth curve that keeps at most 2 * kCurveCap points: when full, every other point is dropped and
-// the sampling interval doubles (deterministic for a given run).
+// Samples the growth curve, keeping at most 2 * kCurveCap points: when full, every other point is dropped
+// and the sampling interval doubles (deterministic for a given run).
 constexpr std::size_t kCurveCap = 256;
-struct Curve {
-  int every = 1;
-  std::vector<int> steps;
-  std::vector<std::size_t> nodes, organs;
-  std::vector<double> wall_s;
+struct CurveSampler {
+  Curve curve;
   void add(int step, std::size_t n, std::size_t o, double t) {
-    if (step % every != 0) return;
-    steps.push_back(step);
-    nodes.push_back(n);
-    organs.push_back(o);
-    wall_s.push_back(t);
-    if (steps.size() >= 2 * kCurveCap) {
+    if (step % curve.every != 0) return;
+    curve.step.push_back(step);
+    curve.nodes.push_back(n);
+    curve.organs.push_back(o);
+    curve.wall_s.push_back(t);
+    if (curve.step.size() >= 2 * kCurveCap) {
       auto halve = [](auto& v) {
         std::size_t w = 0;
         for (std::size_t i = 1; i < v.size(); i += 2) v[w++] = v[i];
         v.resize(w);
       };
-      halve(steps);
-      halve(nodes);
-      halve(organs);
-      halve(wall_s);
-      every *= 2;
+      halve(curve.step);
+      halve(curve.nodes);
+      halve(curve.organs);
+      halve(curve.wall_s);
+      curve.every *= 2;
     }
   }
 };
@@ -225,143 +219,148 @@ std::string binary_hash() {
   return in.bad() ? std::string("unknown") : fmt::format("{:016x}", h);
 }
 
-nlohmann::json run_context() {
+RunContext run_context_record() {
   const std::time_t now = std::time(nullptr);
   char date[32];
   std::strftime(date, sizeof(date), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  RunContext c;
   // The commit the binary was configured at; the source tree's current state when it is reachable.
-  std::string commit = GROWBENCH_GIT_COMMIT;
-  std::string dirty = "unknown";
-  nlohmann::json commit_time = nullptr;  // committer time (Unix seconds): orders a history by commit
+  c.growbench_commit = GROWBENCH_GIT_COMMIT;
   if (std::filesystem::exists(std::string(GROWBENCH_SOURCE_DIR) + "/.git")) {
-    const std::string c = run_command(fmt::format("git -C '{}' rev-parse --short=12 HEAD 2>/dev/null", GROWBENCH_SOURCE_DIR));
-    if (!c.empty()) commit = c;
+    const std::string commit = run_command(fmt::format("git -C '{}' rev-parse --short=12 HEAD 2>/dev/null", GROWBENCH_SOURCE_DIR));
+    if (!commit.empty()) c.growbench_commit = commit;
+    // Committer time (Unix seconds): orders a history by commit.
     const std::string ct = run_command(fmt::format("git -C '{}' show -s --format=%ct HEAD 2>/dev/null", GROWBENCH_SOURCE_DIR));
-    if (!ct.empty() && ct.find_first_not_of("0123456789") == std::string::npos) commit_time = std::stoll(ct);
-    dirty = run_command(fmt::format("git -C '{}' status --porcelain --untracked-files=no 2>/dev/null", GROWBENCH_SOURCE_DIR)).empty()
-                ? "false"
-                : "true";
+    if (!ct.empty() && ct.find_first_not_of("0123456789") == std::string::npos) c.commit_time = std::stoll(ct);
+    c.dirty = run_command(fmt::format("git -C '{}' status --porcelain --untracked-files=no 2>/dev/null", GROWBENCH_SOURCE_DIR)).empty()
+                  ? "false"
+                  : "true";
   }
-  return {{"growbench_commit", commit},
-          {"dirty", dirty},
-          {"commit_time", commit_time},
-          {"configured_commit", GROWBENCH_GIT_COMMIT},
-          {"build_type", GROWBENCH_BUILD_TYPE},
-          {"compiler", fmt::format("g++ {}", __VERSION__)},
-          {"cxx_flags", GROWBENCH_CXX_FLAGS},
-          {"binary_hash", binary_hash()},
-          {"cpu_model", cpu_model()},
-          {"hardware_threads", std::thread::hardware_concurrency()},
-          {"date", date},
-          {"alloc_counting", alloc_counting_enabled()},
-          {"dependencies",
-           {{"embree", fmt::format("{}.{}.{}", RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH)},
-            {"openvdb", OPENVDB_LIBRARY_VERSION_STRING},
-            {"tbb", TBB_VERSION_STRING},
-            {"fmt", FMT_VERSION}}}};
+  c.configured_commit = GROWBENCH_GIT_COMMIT;
+  c.build_type = GROWBENCH_BUILD_TYPE;
+  c.compiler = fmt::format("g++ {}", __VERSION__);
+  c.cxx_flags = GROWBENCH_CXX_FLAGS;
+  c.binary_hash = binary_hash();
+  c.cpu_model = cpu_model();
+  c.hardware_threads = std::thread::hardware_concurrency();
+  c.date = date;
+  c.alloc_counting = alloc_counting_enabled();
+  c.dependencies = {{"embree", fmt::format("{}.{}.{}", RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH)},
+                    {"openvdb", OPENVDB_LIBRARY_VERSION_STRING},
+                    {"tbb", TBB_VERSION_STRING},
+                    {"fmt", FMT_VERSION}};
+  return c;
 }
 
-nlohmann::json to_json(const TrialSpec& s) {
-  nlohmann::json seeds = nlohmann::json::array();
-  for (const auto& p : s.seed_at) seeds.push_back({p.x, p.y, p.z});
-  nlohmann::json j = {{"algorithm", s.algorithm},       {"scene", s.scene},
-          {"scene_params", s.scene_params}, {"params", s.params},
-          {"seed", s.seed},                 {"seed_at", seeds},
-          {"max_steps", s.max_steps},       {"time_limit_s", s.time_limit_s},
-          {"threads", s.threads},           {"voxel_size", s.voxel_size},
-          {"sides", s.mesher.sides},        {"budget_nodes", s.budget_nodes},
-          {"budget_length_m", s.budget_length_m}, {"metrics", s.metrics},
-          {"frame_every", s.frame_every},
-          {"fault", s.fault}};
-  if (!s.mesher.leaf_obj.empty()) j["leaf_obj"] = s.mesher.leaf_obj;  // only when given: older specs stay as they were
-  return j;
+nlohmann::json run_context() { return to_json(run_context_record()); }
+
+TrialSpecRecord to_record(const TrialSpec& s) {
+  TrialSpecRecord r;
+  r.algorithm = s.algorithm;
+  r.scene = s.scene;
+  r.scene_params = s.scene_params;
+  r.params = s.params;
+  r.seed = s.seed;
+  for (const auto& p : s.seed_at) r.seed_at.push_back({p.x, p.y, p.z});
+  r.max_steps = s.max_steps;
+  r.time_limit_s = s.time_limit_s;
+  r.threads = s.threads;
+  r.voxel_size = s.voxel_size;
+  r.sides = s.mesher.sides;
+  r.budget_nodes = s.budget_nodes;
+  r.budget_length_m = s.budget_length_m;
+  r.metrics = s.metrics;
+  r.frame_every = s.frame_every;
+  r.fault = s.fault;
+  if (!s.mesher.leaf_obj.empty()) r.leaf_obj = s.mesher.leaf_obj;
+  return r;
 }
 
-TrialSpec trial_spec_from_json(const nlohmann::json& j) {
+TrialSpec trial_spec_of(const TrialSpecRecord& r) {
   TrialSpec s;
-  s.algorithm = j.at("algorithm").get<std::string>();
-  s.scene = j.at("scene").get<std::string>();
-  s.scene_params = j.value("scene_params", std::vector<std::string>{});
-  s.params = j.value("params", std::vector<std::string>{});
-  s.seed = j.value("seed", std::uint64_t{1});
-  for (const auto& p : j.value("seed_at", nlohmann::json::array()))
-    s.seed_at.emplace_back(p[0].get<float>(), p[1].get<float>(), p[2].get<float>());
-  s.max_steps = j.value("max_steps", 5000);
-  s.time_limit_s = j.value("time_limit_s", 0.0);
-  s.threads = j.value("threads", 0);
-  s.voxel_size = j.value("voxel_size", 0.0f);
-  s.mesher.sides = j.value("sides", 6);
-  s.mesher.leaf_obj = j.value("leaf_obj", std::string{});
-  s.budget_nodes = j.value("budget_nodes", std::size_t{0});
-  s.budget_length_m = j.value("budget_length_m", 0.0);
-  s.metrics = j.value("metrics", true);
-  s.frame_every = j.value("frame_every", 0);
-  // Only in the spec file a suite hands to `growbench trial` (not in results):
-  s.out_dir = j.value("out_dir", std::string{});
-  s.context = j.value("context", true);
-  s.skip_teardown = j.value("skip_teardown", false);
-  s.fault = j.value("fault", std::string{});
+  s.algorithm = r.algorithm;
+  s.scene = r.scene;
+  s.scene_params = r.scene_params;
+  s.params = r.params;
+  s.seed = r.seed;
+  for (const auto& p : r.seed_at)
+    s.seed_at.emplace_back(static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2]));
+  s.max_steps = r.max_steps;
+  s.time_limit_s = r.time_limit_s;
+  s.threads = r.threads;
+  s.voxel_size = static_cast<float>(r.voxel_size);
+  s.mesher.sides = r.sides;
+  s.mesher.leaf_obj = r.leaf_obj.value_or("");
+  s.budget_nodes = r.budget_nodes;
+  s.budget_length_m = r.budget_length_m;
+  s.metrics = r.metrics;
+  s.frame_every = r.frame_every;
+  s.out_dir = r.out_dir.value_or("");
+  s.context = r.context.value_or(true);
+  s.skip_teardown = r.skip_teardown.value_or(false);
+  s.fault = r.fault;
   return s;
 }
 
-nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const Progress&)>& progress, Plant* plant_out) {
-  const AlgorithmEntry& entry = find_algorithm(spec.algorithm);
+nlohmann::json to_json(const TrialSpec& s) { return to_json(to_record(s)); }
+
+TrialSpec trial_spec_from_json(const nlohmann::json& j) {
+  return trial_spec_of(from_json<TrialSpecRecord>(j, "the trial spec"));
+}
+
+TrialSpec read_trial_spec(const std::string& path) {
+  return trial_spec_of(from_json<TrialSpecRecord>(read_json_file(path), path));
+}
+
+namespace {
+
+// The algorithm's effective parameters; InputError for bad input, before anything is loaded or grown.
+Params checked_params(const TrialSpec& spec, const AlgorithmEntry& entry) {
   Params params = default_params(entry);
   for (const auto& a : spec.params) params.set_assignment(a);
   if (spec.max_steps < 0) throw InputError(fmt::format("--max-steps must be >= 0, got {}", spec.max_steps));
   if (spec.frame_every < 0) throw InputError(fmt::format("--frames must be >= 0, got {}", spec.frame_every));
   if (spec.frame_every > 0 && spec.out_dir.empty()) throw InputError("--frames needs an output directory");
+  return params;
+}
 
-  // A custom leaf is read first: a bad file is invalid input before anything is grown.
-  const MesherOptions mesher = with_leaf_mesh(spec.mesher);
-  std::unique_ptr<tbb::global_control> threads;
-  if (spec.threads > 0)
-    threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                    static_cast<std::size_t>(spec.threads));
-  const auto used_threads = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
+// What a trial holds while it runs, kept to the end (see TrialSpec::skip_teardown).
+struct TrialState {
+  Scene scene;
+  std::unique_ptr<SceneQuery> query;
+  std::unique_ptr<GrowthAlgorithm> algo;
+  OutputMesh mesh;
+};
 
-  nlohmann::json rec;
-  rec["schema_version"] = 1;
-  rec["algorithm"] = spec.algorithm;
-  rec["seed"] = spec.seed;
-  rec["threads"] = used_threads;
-  rec["max_steps"] = spec.max_steps;
-  nlohmann::json& phases = rec["phases"];
-  PhaseTimer timer(phases);
-
-  Scene scene = timer.run("scene_load", [&] { return load_scene(spec.scene, spec.scene_params); });
+// The scene_load and query_build phases; the scene's seeds replaced by --seed-at, snapped to the surface.
+void load_scene_and_query(const TrialSpec& spec, TrialState& st, PhaseTimer& timer, TrialRecord& rec) {
+  st.scene = timer.run("scene_load", rec.phases.scene_load, [&] { return load_scene(spec.scene, spec.scene_params); });
   SceneQueryOptions qo;
   qo.voxel_size = spec.voxel_size;
-  auto query = timer.run("query_build", [&] { return std::make_unique<SceneQuery>(scene, qo); });
-  phases["query_build"]["bvh_s"] = query->bvh_build_seconds();
-  phases["query_build"]["sdf_s"] = query->sdf_build_seconds();
-  phases["query_build"]["sdf_active_voxels"] = query->sdf_active_voxels();
-  phases["query_build"]["voxel_size_m"] = query->voxel_size();
-
+  st.query = timer.run("query_build", rec.phases.query_build, [&] { return std::make_unique<SceneQuery>(st.scene, qo); });
+  PhaseMeasures& q = *rec.phases.query_build;
+  q.bvh_s = st.query->bvh_build_seconds();
+  q.sdf_s = st.query->sdf_build_seconds();
+  q.sdf_active_voxels = st.query->sdf_active_voxels();
+  q.voxel_size_m = st.query->voxel_size();
   if (!spec.seed_at.empty()) {
-    scene.seeds.clear();
+    st.scene.seeds.clear();
     for (const auto& p : spec.seed_at) {
-      const ClosestHit h = query->closest_point(p);
-      scene.seeds.push_back({h.found ? h.point : p, {0, 1, 0}, 0});
+      const ClosestHit h = st.query->closest_point(p);
+      st.scene.seeds.push_back({h.found ? h.point : p, {0, 1, 0}, 0});
     }
   }
-  rec["scene"] = {{"spec", spec.scene},
-                  {"name", scene.name},
-                  {"hash", scene.content_hash()},
-                  {"triangles", scene.triangle_count()},
-                  {"seeds", scene.seeds.size()},
-                  {"params", spec.scene_params}};
-  rec["params"] = params.to_json();
-  if (!spec.mesher.leaf_obj.empty()) rec["leaf_obj"] = spec.mesher.leaf_obj;
+  rec.scene = {spec.scene, st.scene.name, st.scene.content_hash(), st.scene.triangle_count(), st.scene.seeds.size(),
+               spec.scene_params};
+}
 
-  std::unique_ptr<GrowthAlgorithm> algo = entry.make();
-  int steps = 0;
-  std::string stopped_by = "finished";
-  Curve curve;
-  // Frame capture (growth animations): its cost is measured and taken out of the growth phase.
+// Frame capture (growth animations): OUT/frames/step_NNNNNN.gbplant, its cost measured to be taken out of
+// the growth phase.
+struct FrameCapture {
+  const TrialSpec& spec;
   int frames = 0, last_frame = -1;
-  double frame_wall = 0.0, frame_cpu = 0.0;
-  auto capture = [&](int step) {
+  double wall_s = 0.0, cpu_s = 0.0;
+  void capture(int step, const Plant& plant) {
     if (spec.frame_every <= 0 || step == last_frame) return;
     const auto w0 = std::chrono::steady_clock::now();
     const double c0 = cpu_seconds();
@@ -370,18 +369,28 @@ nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const P
       std::filesystem::remove_all(d);
       std::filesystem::create_directories(d);
     }
-    write_plant_snapshot((d / fmt::format("step_{:06d}.gbplant", step)).string(), algo->plant());
+    write_plant_snapshot((d / fmt::format("step_{:06d}.gbplant", step)).string(), plant);
     ++frames;
     last_frame = step;
-    frame_wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
-    frame_cpu += cpu_seconds() - c0;
-  };
-  timer.run("growth", [&] {
+    wall_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+    cpu_s += cpu_seconds() - c0;
+  }
+};
+
+// The growth phase: steps until the algorithm finishes or a limit stops it.
+void grow(const TrialSpec& spec, const Params& params, TrialState& st, PhaseTimer& timer, TrialRecord& rec,
+          const std::function<void(const Progress&)>& progress) {
+  GrowthAlgorithm& algo = *st.algo;
+  int steps = 0;
+  std::string stopped_by = "finished";
+  CurveSampler curve;
+  FrameCapture frames{spec};
+  timer.run("growth", rec.phases.growth, [&] {
     inject_fault(spec.fault);
-    algo->start(scene, *query, params, spec.seed);
+    algo.start(st.scene, *st.query, params, spec.seed);
     const auto t0 = std::chrono::steady_clock::now();
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
-    curve.add(0, algo->node_count(), algo->organ_count(), elapsed());
+    curve.add(0, algo.node_count(), algo.organ_count(), elapsed());
     while (true) {
       if (steps >= spec.max_steps) {
         stopped_by = "max_steps";
@@ -391,103 +400,122 @@ nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const P
         stopped_by = "time_limit";
         break;
       }
-      if (spec.budget_nodes > 0 && algo->node_count() >= spec.budget_nodes) {
+      if (spec.budget_nodes > 0 && algo.node_count() >= spec.budget_nodes) {
         stopped_by = "budget_nodes";
         break;
       }
-      if (spec.budget_length_m > 0.0 && algo->plant().total_length() >= spec.budget_length_m) {
+      if (spec.budget_length_m > 0.0 && algo.plant().total_length() >= spec.budget_length_m) {
         stopped_by = "budget_length";
         break;
       }
-      const bool more = algo->step();
+      const bool more = algo.step();
       ++steps;
       const double t = elapsed();
-      curve.add(steps, algo->node_count(), algo->organ_count(), t);
-      if (progress) progress({steps, algo->node_count(), t});
-      if (spec.frame_every > 0 && steps % spec.frame_every == 0 && more) capture(steps);
+      curve.add(steps, algo.node_count(), algo.organ_count(), t);
+      if (progress) progress({steps, algo.node_count(), t});
+      if (spec.frame_every > 0 && steps % spec.frame_every == 0 && more) frames.capture(steps, algo.plant());
       if (!more) break;
     }
-    algo->finish();
-    capture(steps);
+    algo.finish();
+    frames.capture(steps, algo.plant());
   });
   if (spec.frame_every > 0) {
-    phases["growth"]["wall_s"] = phases["growth"]["wall_s"].get<double>() - frame_wall;
-    phases["growth"]["cpu_s"] = phases["growth"]["cpu_s"].get<double>() - frame_cpu;
-    phases["growth"]["frame_capture_wall_s"] = frame_wall;
-    phases["growth"]["frame_capture_cpu_s"] = frame_cpu;
-    rec["frames"] = {{"every", spec.frame_every}, {"count", frames}, {"dir", "frames"}};
+    PhaseMeasures& g = *rec.phases.growth;
+    g.wall_s -= frames.wall_s;
+    g.cpu_s -= frames.cpu_s;
+    g.frame_capture_wall_s = frames.wall_s;
+    g.frame_capture_cpu_s = frames.cpu_s;
+    rec.frames = FramesInfo{spec.frame_every, frames.frames, "frames"};
   }
-  const Plant& plant = algo->plant();
-  if (const std::string bad = plant.validate(); !bad.empty())
-    throw std::logic_error(fmt::format("algorithm '{}' produced an invalid plant: {}", spec.algorithm, bad));
-  if (plant_out) *plant_out = plant;
-  rec["steps"] = steps;
-  rec["stopped_by"] = stopped_by;
-  rec["curve"] = {{"every", curve.every},
-                  {"step", curve.steps},
-                  {"nodes", curve.nodes},
-                  {"organs", curve.organs},
-                  {"wall_s", curve.wall_s}};
+  rec.steps = steps;
+  rec.stopped_by = stopped_by;
+  rec.curve = std::move(curve.curve);
+}
 
+// The meshing, export and metrics phases, then what the plant and its mesh hold.
+void mesh_export_measure(const TrialSpec& spec, const MesherOptions& mesher, TrialState& st, PhaseTimer& timer,
+                         TrialRecord& rec) {
+  const Plant& plant = st.algo->plant();
   // The plant itself, for rendering later (`growbench render`); not an output format, not timed. Written
   // before the exports: after them, tens of MB of dirty pages can make the kernel throttle this write.
   if (!spec.out_dir.empty()) {
     std::filesystem::create_directories(spec.out_dir);
-    rec["snapshot_bytes"] = write_plant_snapshot((std::filesystem::path(spec.out_dir) / "plant.gbplant").string(), plant);
+    rec.snapshot_bytes = write_plant_snapshot((std::filesystem::path(spec.out_dir) / "plant.gbplant").string(), plant);
   }
-  OutputMesh mesh = timer.run("meshing", [&] { return mesh_plant(plant, mesher); });
-
-  nlohmann::json bytes = nlohmann::json::object();
-  timer.run("export", [&] {
+  st.mesh = timer.run("meshing", rec.phases.meshing, [&] { return mesh_plant(plant, mesher); });
+  timer.run("export", rec.phases.exporting, [&] {
     if (spec.out_dir.empty()) return;
     std::filesystem::create_directories(spec.out_dir);
     const std::filesystem::path d(spec.out_dir);
-    bytes["obj"] = write_obj((d / "plant.obj").string(), mesh);
-    bytes["ply"] = write_ply((d / "plant.ply").string(), mesh);
-    bytes["glb"] = write_glb((d / "plant.glb").string(), mesh);
-    bytes["skeleton_obj"] = write_skeleton_obj((d / "skeleton.obj").string(), plant);
+    rec.output_bytes.obj = write_obj((d / "plant.obj").string(), st.mesh);
+    rec.output_bytes.ply = write_ply((d / "plant.ply").string(), st.mesh);
+    rec.output_bytes.glb = write_glb((d / "plant.glb").string(), st.mesh);
+    rec.output_bytes.skeleton_obj = write_skeleton_obj((d / "skeleton.obj").string(), plant);
   });
   if (spec.metrics) {
     MetricOptions metric_options;
     metric_options.organ_shape = organ_shape(mesher);
-    rec["metrics"] = timer.run("metrics", [&] { return compute_metrics(plant, *query, metric_options); });
+    rec.metrics = timer.run("metrics", rec.phases.metrics, [&] { return compute_metrics(plant, *st.query, metric_options); });
   }
-
   std::size_t segments = 0;
   for (const auto& n : plant.nodes) segments += n.parent != kNoParent ? 1 : 0;
-  rec["counts"] = {{"nodes", plant.nodes.size()},      {"segments", segments},
-                   {"leaves", plant.leaf_count()},     {"organs", plant.organs.size()},
-                   {"polygons", plant.polygons.size()}, {"mesh_vertices", mesh.positions.size()},
-                   {"mesh_triangles", mesh.triangles.size()}};
-  rec["total_length_m"] = plant.total_length();
-  rec["output_bytes"] = bytes;
-  rec["geometry_hash"] = plant.geometry_hash();
-  nlohmann::json stats = nlohmann::json::object();
-  for (const auto& [k, v] : algo->stats()) stats[k] = v;
-  rec["algorithm_stats"] = stats;
+  rec.counts = {plant.nodes.size(),    segments,          plant.leaf_count(),        plant.organs.size(),
+                plant.polygons.size(), st.mesh.positions.size(), st.mesh.triangles.size()};
+  rec.total_length_m = plant.total_length();
+  rec.geometry_hash = plant.geometry_hash();
+  for (const auto& [k, v] : st.algo->stats()) rec.algorithm_stats[k] = v;
+}
+
+}  // namespace
+
+TrialRecord run_trial_record(const TrialSpec& spec, const std::function<void(const Progress&)>& progress,
+                             Plant* plant_out) {
+  const AlgorithmEntry& entry = find_algorithm(spec.algorithm);
+  const Params params = checked_params(spec, entry);
+  // A custom leaf is read first: a bad file is invalid input before anything is grown.
+  const MesherOptions mesher = with_leaf_mesh(spec.mesher);
+  std::unique_ptr<tbb::global_control> threads;
+  if (spec.threads > 0)
+    threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                    static_cast<std::size_t>(spec.threads));
+
+  TrialRecord rec;
+  rec.algorithm = spec.algorithm;
+  rec.seed = spec.seed;
+  rec.threads = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
+  rec.max_steps = spec.max_steps;
+  PhaseTimer timer;
+  TrialState st;
+  load_scene_and_query(spec, st, timer, rec);
+  rec.params = params.to_json();
+  if (!spec.mesher.leaf_obj.empty()) rec.leaf_obj = spec.mesher.leaf_obj;
+
+  st.algo = entry.make();
+  grow(spec, params, st, timer, rec, progress);
+  const Plant& plant = st.algo->plant();
+  if (const std::string bad = plant.validate(); !bad.empty())
+    throw std::logic_error(fmt::format("algorithm '{}' produced an invalid plant: {}", spec.algorithm, bad));
+  if (plant_out) *plant_out = plant;
+  mesh_export_measure(spec, mesher, st, timer, rec);
+
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);
-  rec["peak_rss_bytes"] = static_cast<std::uint64_t>(ru.ru_maxrss) * 1024u;  // whole process, never reset
-  rec["status"] = "ok";
-  if (spec.context) rec["context"] = run_context();
+  rec.peak_rss_bytes = static_cast<std::uint64_t>(ru.ru_maxrss) * 1024u;  // whole process, never reset
+  rec.status = "ok";
+  if (spec.context) rec.context = run_context_record();
 
   if (!spec.out_dir.empty()) {
     const std::string path = (std::filesystem::path(spec.out_dir) / "record.json").string();
     // Indented for people reading `growbench run` output; compact when a suite parent parses it.
-    const std::string text = rec.dump(spec.skip_teardown ? -1 : 2) + "\n";
-    write_file_atomic(path, text);
+    write_file_atomic(path, json_text(to_json(rec), spec.skip_teardown ? -1 : 2));
   }
-  if (spec.skip_teardown) {
-    struct Kept {
-      Scene scene;
-      std::unique_ptr<SceneQuery> query;
-      std::unique_ptr<GrowthAlgorithm> algo;
-      OutputMesh mesh;
-    };
-    // Deliberately never freed: the process exits next and the kernel reclaims it all at once.
-    [[maybe_unused]] auto* kept = new Kept{std::move(scene), std::move(query), std::move(algo), std::move(mesh)};
-  }
+  // Deliberately never freed: the process exits next and the kernel reclaims it all at once.
+  if (spec.skip_teardown) [[maybe_unused]] auto* kept = new TrialState{std::move(st)};
   return rec;
+}
+
+nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const Progress&)>& progress, Plant* plant_out) {
+  return to_json(run_trial_record(spec, progress, plant_out));
 }
 
 }  // namespace growbench

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "harness/output/mesher.hpp"
+#include "harness/record/record.hpp"
 
 namespace growbench {
 
@@ -54,15 +55,23 @@ struct Progress {
 // Runs a trial. Bad input throws InputError before any growth; everything else is recorded.
 // The returned record is also written to OUT/record.json when out_dir is set.
 // `plant_out`, when given, receives the grown plant (tests check invariants on it).
+TrialRecord run_trial_record(const TrialSpec& spec, const std::function<void(const Progress&)>& progress = {},
+                             Plant* plant_out = nullptr);
+// The same record as JSON (to_json of the above).
 nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const Progress&)>& progress = {},
                          Plant* plant_out = nullptr);
 
 // The build and machine this binary runs on (commit and dirty flag, compiler, flags, build type,
 // dependency versions, CPU model, cores, date).
-nlohmann::json run_context();
+RunContext run_context_record();
+nlohmann::json run_context();  // to_json of the above
 
-// Serialises / reads a TrialSpec (suites hand them to child processes and store them in results).
+// A TrialSpec as suites hand it to child processes and store it in results (harness/record/record.hpp).
+TrialSpecRecord to_record(const TrialSpec& spec);
+TrialSpec trial_spec_of(const TrialSpecRecord& record);
 nlohmann::json to_json(const TrialSpec& spec);
+// InputError naming the JSON path ("the trial spec: at seed: ...") or the file for a bad spec.
 TrialSpec trial_spec_from_json(const nlohmann::json& j);
+TrialSpec read_trial_spec(const std::string& path);
 
 }  // namespace growbench

@@ -27,7 +27,9 @@
 #include "core/errors.hpp"
 #include "core/json_util.hpp"
 #include "harness/output/exporters.hpp"
+#include "harness/record/record.hpp"
 #include "harness/run/process.hpp"
+#include "harness/stats/stats.hpp"
 #include "scenes/scene_library.hpp"
 
 namespace growbench {
@@ -72,6 +74,39 @@ class SuiteReader : public JsonPathReader {
     Suite s;
     s.file = file();
     s.hash = fmt::format("{:016x}", XXH3_64bits(text.data(), text.size()));
+    const Common common = read_settings(j, s);
+    const std::vector<SceneEntry> scenes = read_scenes(j);
+    const std::vector<AlgoEntry> algos = read_algorithms(j);
+    make_cells(common, scenes, algos, s);
+    return s;
+  }
+
+ private:
+  // What every cell shares, from the top level of the file.
+  struct Common {
+    int threads = 0, max_steps = 5000;
+    std::vector<std::uint64_t> seeds = {1};
+    std::size_t budget_nodes = 0;
+    double budget_length = 0.0;
+  };
+  struct SceneEntry {
+    std::string spec, name;
+    std::vector<std::string> params;
+  };
+  struct AlgoEntry {
+    std::string label, name, fault, leaf_obj;
+    std::vector<std::string> params;
+    std::vector<std::pair<std::string, std::vector<json>>> sweep;
+    std::vector<json> points;  // explicit sweep points (instead of a product)
+    [[nodiscard]] std::size_t count() const {
+      if (!points.empty()) return points.size();
+      std::size_t n = 1;
+      for (const auto& [k, v] : sweep) n *= v.size();
+      return n;
+    }
+  };
+
+  Common read_settings(const json& j, Suite& s) const {
     s.name = j.value("name", fs::path(file()).stem().string());
     s.description = j.value("description", "");
     if (j.contains("repetitions")) s.repetitions = static_cast<int>(number(j["repetitions"], "/repetitions", 1, 1000));
@@ -79,27 +114,24 @@ class SuiteReader : public JsonPathReader {
     if (j.contains("timeout_s")) s.timeout_s = number(j["timeout_s"], "/timeout_s", 0.001, 1e6);
     if (j.contains("memory_limit_mb"))
       s.memory_limit_bytes = static_cast<std::uint64_t>(number(j["memory_limit_mb"], "/memory_limit_mb", 64, 1e7)) << 20;
-    const int threads = j.contains("threads") ? static_cast<int>(number(j["threads"], "/threads", 0, 1024)) : 0;
-    const int max_steps = j.contains("max_steps") ? static_cast<int>(number(j["max_steps"], "/max_steps", 0, 1e9)) : 5000;
-    std::vector<std::uint64_t> seeds = {1};
+    Common c;
+    if (j.contains("threads")) c.threads = static_cast<int>(number(j["threads"], "/threads", 0, 1024));
+    if (j.contains("max_steps")) c.max_steps = static_cast<int>(number(j["max_steps"], "/max_steps", 0, 1e9));
     if (j.contains("seeds")) {
       if (!j["seeds"].is_array() || j["seeds"].empty()) fail("/seeds", "expected a non-empty array of seeds");
-      seeds.clear();
+      c.seeds.clear();
       for (std::size_t i = 0; i < j["seeds"].size(); ++i)
-        seeds.push_back(static_cast<std::uint64_t>(number(j["seeds"][i], fmt::format("/seeds/{}", i), 0, 9e15)));
+        c.seeds.push_back(static_cast<std::uint64_t>(number(j["seeds"][i], fmt::format("/seeds/{}", i), 0, 9e15)));
     }
-    std::size_t budget_nodes = 0;
-    double budget_length = 0.0;
     if (j.contains("budget")) {
       only_keys(j["budget"], "/budget", {"nodes", "length_m"});
-      if (j["budget"].contains("nodes")) budget_nodes = static_cast<std::size_t>(number(j["budget"]["nodes"], "/budget/nodes", 0, 1e12));
-      if (j["budget"].contains("length_m")) budget_length = number(j["budget"]["length_m"], "/budget/length_m", 0, 1e12);
+      if (j["budget"].contains("nodes")) c.budget_nodes = static_cast<std::size_t>(number(j["budget"]["nodes"], "/budget/nodes", 0, 1e12));
+      if (j["budget"].contains("length_m")) c.budget_length = number(j["budget"]["length_m"], "/budget/length_m", 0, 1e12);
     }
+    return c;
+  }
 
-    struct SceneEntry {
-      std::string spec, name;
-      std::vector<std::string> params;
-    };
+  std::vector<SceneEntry> read_scenes(const json& j) const {
     std::vector<SceneEntry> scenes;
     if (!j.contains("scenes") || !j["scenes"].is_array() || j["scenes"].empty()) fail("/scenes", "expected a non-empty array of scenes");
     for (std::size_t i = 0; i < j["scenes"].size(); ++i) {
@@ -126,107 +158,107 @@ class SuiteReader : public JsonPathReader {
       }
       scenes.push_back(std::move(se));
     }
+    return scenes;
+  }
 
-    struct AlgoEntry {
-      std::string label, name, fault, leaf_obj;
-      std::vector<std::string> params;
-      std::vector<std::pair<std::string, std::vector<json>>> sweep;
-      std::vector<json> points;  // explicit sweep points (instead of a product)
-      [[nodiscard]] std::size_t count() const {
-        if (!points.empty()) return points.size();
-        std::size_t n = 1;
-        for (const auto& [k, v] : sweep) n *= v.size();
-        return n;
-      }
-    };
+  std::vector<AlgoEntry> read_algorithms(const json& j) const {
     std::vector<AlgoEntry> algos;
     if (!j.contains("algorithms") || !j["algorithms"].is_array() || j["algorithms"].empty())
       fail("/algorithms", "expected a non-empty array of algorithm entries");
     std::set<std::string> labels;
     for (std::size_t i = 0; i < j["algorithms"].size(); ++i) {
-      const auto& e = j["algorithms"][i];
-      const std::string path = fmt::format("/algorithms/{}", i);
-      AlgoEntry a;
-      if (e.is_string()) {
-        a.name = e.get<std::string>();
-      } else {
-        only_keys(e, path, {"name", "label", "params", "sweep", "fault", "leaf_obj"});
-        if (!e.contains("name") || !e["name"].is_string()) fail(path + "/name", "expected the algorithm's name");
-        a.name = e["name"].get<std::string>();
-        a.label = e.value("label", "");
-        a.fault = e.value("fault", "");
-        if (e.contains("leaf_obj")) {
-          if (!e["leaf_obj"].is_string()) fail(path + "/leaf_obj", "expected the path of an OBJ file");
-          a.leaf_obj = relative_to_suite(e["leaf_obj"].get<std::string>());
-          try {
-            (void)load_leaf_mesh(a.leaf_obj);
-          } catch (const InputError& err) {
-            fail(path + "/leaf_obj", err.what());
-          }
-        }
-      }
-      const AlgorithmEntry* entry = nullptr;
-      try {
-        entry = &find_algorithm(a.name);
-      } catch (const InputError& err) {
-        fail(path + "/name", err.what());
-      }
-      if (a.label.empty()) a.label = a.name;
-      if (!labels.insert(a.label).second) fail(path + "/label", fmt::format("label '{}' is used twice; give each entry its own", a.label));
-      Params p = default_params(*entry);
-      if (e.is_object() && e.contains("params")) {
-        if (!e["params"].is_object()) fail(path + "/params", "expected an object of parameters");
-        for (const auto& [k, v] : e["params"].items()) {
-          try {
-            p.set_json(k, v);
-          } catch (const InputError& err) {
-            fail(path + "/params/" + k, err.what());
-          }
-          a.params.push_back(k + "=" + value_text(v));
-        }
-      }
-      if (e.is_object() && e.contains("sweep")) {
-        const json& sw = e["sweep"];
-        if (sw.is_object()) {  // parameter -> values: the cartesian product
-          for (const auto& [k, vals] : sw.items()) {
-            if (!vals.is_array() || vals.empty()) fail(path + "/sweep/" + k, "expected a non-empty array of values");
-            for (std::size_t v = 0; v < vals.size(); ++v) {
-              try {
-                Params q = p;
-                q.set_json(k, vals[v]);
-              } catch (const InputError& err) {
-                fail(fmt::format("{}/sweep/{}/{}", path, k, v), err.what());
-              }
-            }
-            a.sweep.emplace_back(k, std::vector<json>(vals.begin(), vals.end()));
-          }
-        } else if (sw.is_array() && !sw.empty()) {  // an explicit list of points: {parameter: value, ...}
-          for (std::size_t v = 0; v < sw.size(); ++v) {
-            const std::string pp = fmt::format("{}/sweep/{}", path, v);
-            if (!sw[v].is_object() || sw[v].empty()) fail(pp, "expected an object of parameter values");
-            Params q = p;
-            for (const auto& [k, val] : sw[v].items()) {
-              try {
-                q.set_json(k, val);
-              } catch (const InputError& err) {
-                fail(pp + "/" + k, err.what());
-              }
-            }
-            a.points.push_back(sw[v]);
-          }
-        } else {
-          fail(path + "/sweep", "expected an object (parameter -> array of values) or an array of parameter objects");
-        }
-      }
-      algos.push_back(std::move(a));
+      algos.push_back(read_algorithm(j["algorithms"][i], fmt::format("/algorithms/{}", i), labels));
     }
+    return algos;
+  }
 
-    // Cells. Order: for each scene, seed and sweep point, every algorithm entry in turn (interleaved).
+  // One entry of "algorithms"; its label must not be in `labels` (the entries before it), and is added.
+  AlgoEntry read_algorithm(const json& e, const std::string& path, std::set<std::string>& labels) const {
+    AlgoEntry a;
+    if (e.is_string()) {
+      a.name = e.get<std::string>();
+    } else {
+      only_keys(e, path, {"name", "label", "params", "sweep", "fault", "leaf_obj"});
+      if (!e.contains("name") || !e["name"].is_string()) fail(path + "/name", "expected the algorithm's name");
+      a.name = e["name"].get<std::string>();
+      a.label = e.value("label", "");
+      a.fault = e.value("fault", "");
+      if (e.contains("leaf_obj")) {
+        if (!e["leaf_obj"].is_string()) fail(path + "/leaf_obj", "expected the path of an OBJ file");
+        a.leaf_obj = relative_to_suite(e["leaf_obj"].get<std::string>());
+        try {
+          (void)load_leaf_mesh(a.leaf_obj);
+        } catch (const InputError& err) {
+          fail(path + "/leaf_obj", err.what());
+        }
+      }
+    }
+    const AlgorithmEntry* entry = nullptr;
+    try {
+      entry = &find_algorithm(a.name);
+    } catch (const InputError& err) {
+      fail(path + "/name", err.what());
+    }
+    if (a.label.empty()) a.label = a.name;
+    if (!labels.insert(a.label).second) fail(path + "/label", fmt::format("label '{}' is used twice; give each entry its own", a.label));
+    Params p = default_params(*entry);
+    if (e.is_object() && e.contains("params")) {
+      if (!e["params"].is_object()) fail(path + "/params", "expected an object of parameters");
+      for (const auto& [k, v] : e["params"].items()) {
+        try {
+          p.set_json(k, v);
+        } catch (const InputError& err) {
+          fail(path + "/params/" + k, err.what());
+        }
+        a.params.push_back(k + "=" + value_text(v));
+      }
+    }
+    if (e.is_object() && e.contains("sweep")) read_sweep(e["sweep"], path, p, a);
+    return a;
+  }
+
+  // Every swept value is checked against the entry's parameters `p`.
+  void read_sweep(const json& sw, const std::string& path, const Params& p, AlgoEntry& a) const {
+    if (sw.is_object()) {  // parameter -> values: the cartesian product
+      for (const auto& [k, vals] : sw.items()) {
+        if (!vals.is_array() || vals.empty()) fail(path + "/sweep/" + k, "expected a non-empty array of values");
+        for (std::size_t v = 0; v < vals.size(); ++v) {
+          try {
+            Params q = p;
+            q.set_json(k, vals[v]);
+          } catch (const InputError& err) {
+            fail(fmt::format("{}/sweep/{}/{}", path, k, v), err.what());
+          }
+        }
+        a.sweep.emplace_back(k, std::vector<json>(vals.begin(), vals.end()));
+      }
+    } else if (sw.is_array() && !sw.empty()) {  // an explicit list of points: {parameter: value, ...}
+      for (std::size_t v = 0; v < sw.size(); ++v) {
+        const std::string pp = fmt::format("{}/sweep/{}", path, v);
+        if (!sw[v].is_object() || sw[v].empty()) fail(pp, "expected an object of parameter values");
+        Params q = p;
+        for (const auto& [k, val] : sw[v].items()) {
+          try {
+            q.set_json(k, val);
+          } catch (const InputError& err) {
+            fail(pp + "/" + k, err.what());
+          }
+        }
+        a.points.push_back(sw[v]);
+      }
+    } else {
+      fail(path + "/sweep", "expected an object (parameter -> array of values) or an array of parameter objects");
+    }
+  }
+
+  // Cells. Order: for each scene, seed and sweep point, every algorithm entry in turn (interleaved).
+  void make_cells(const Common& common, const std::vector<SceneEntry>& scenes, const std::vector<AlgoEntry>& algos,
+                  Suite& s) const {
     std::size_t max_points = 1;
     for (const auto& a : algos) max_points = std::max(max_points, a.count());
     std::set<std::string> ids;
     for (const auto& sc : scenes)
-      for (const auto seed : seeds)
+      for (const auto seed : common.seeds)
         for (std::size_t point = 0; point < max_points; ++point)
           for (const auto& a : algos) {
             if (point >= a.count()) continue;
@@ -238,10 +270,10 @@ class SuiteReader : public JsonPathReader {
             c.spec.scene_params = sc.params;
             c.spec.params = a.params;
             c.spec.seed = seed;
-            c.spec.threads = threads;
-            c.spec.max_steps = max_steps;
-            c.spec.budget_nodes = budget_nodes;
-            c.spec.budget_length_m = budget_length;
+            c.spec.threads = common.threads;
+            c.spec.max_steps = common.max_steps;
+            c.spec.budget_nodes = common.budget_nodes;
+            c.spec.budget_length_m = common.budget_length;
             c.spec.fault = a.fault;
             c.spec.mesher.leaf_obj = a.leaf_obj;
             std::size_t rest = point;
@@ -265,10 +297,8 @@ class SuiteReader : public JsonPathReader {
               fail("/scenes", fmt::format("two cells share the id '{}' (give the scenes distinct 'name's)", c.id));
             s.configs.push_back(std::move(c));
           }
-    return s;
   }
 
- private:
   fs::path dir_;
 };
 
@@ -289,9 +319,20 @@ std::string csv_row(const std::vector<std::string>& cells) {
   return row;
 }
 
+// The CSV's phase columns, in the order trials run them.
 const std::vector<std::string> kPhases = {"scene_load", "query_build", "growth", "meshing", "export", "metrics"};
 
-std::string results_csv(const json& results) {
+// A number as the JSON has it ("" when absent), so the CSV and results.json agree digit for digit.
+template <class T>
+std::string num(const std::optional<T>& v) {
+  return v ? json(*v).dump() : std::string();
+}
+template <class T>
+std::string num(const T& v) {
+  return json(v).dump();
+}
+
+std::string results_csv(const ResultsFile& results) {
   std::vector<std::string> head = {"id", "label", "algorithm", "scene", "seed", "sweep", "repetition", "status"};
   for (const auto& ph : kPhases) {
     head.push_back(ph + "_wall_s");
@@ -304,44 +345,41 @@ std::string results_csv(const json& results) {
                         "geometry_hash"})
     head.emplace_back(k);
   std::string out = csv_row(head) + "\n";
-  auto num = [](const json& j, const char* k) { return j.contains(k) ? j[k].dump() : std::string(); };
-  for (const auto& t : results["trials"]) {
-    for (const auto& s : t["samples"]) {
-      std::vector<std::string> row = {t["id"], t["label"], t["algorithm"], t["scene"], t["seed"].dump(),
-                                      t["sweep"].dump(), s["repetition"].dump(), s["status"]};
+  for (const auto& t : results.trials) {
+    const CellResults& c = t.results;
+    for (const auto& s : t.samples) {
+      std::vector<std::string> row = {t.id, t.label, t.algorithm, t.scene, num(t.seed), t.sweep.dump(), num(s.repetition),
+                                      s.status};
       for (const auto& ph : kPhases) {
-        const json p = s.contains("phases") && s["phases"].contains(ph) ? s["phases"][ph] : json::object();
-        row.push_back(num(p, "wall_s"));
-        row.push_back(num(p, "cpu_s"));
-        row.push_back(num(p, "peak_rss_bytes"));
-        row.push_back(num(p, "alloc_count"));
+        const PhaseMeasures* p = s.phases ? s.phases->find(ph) : nullptr;
+        row.push_back(p ? num(p->wall_s) : "");
+        row.push_back(p ? num(p->cpu_s) : "");
+        row.push_back(p ? num(p->peak_rss_bytes) : "");
+        row.push_back(p ? num(p->alloc_count) : "");
       }
-      const bool ok = s["status"] == "ok";
-      const json m = ok && t.contains("metrics") ? t["metrics"] : json::object();
-      const json b = ok && t.contains("output_bytes") ? t["output_bytes"] : json::object();
-      row.push_back(num(s, "child_wall_s"));
-      row.push_back(num(s, "child_max_rss_bytes"));
-      row.push_back(num(s, "harness_overhead_s"));
-      row.push_back(ok && t.contains("counts") ? t["counts"]["nodes"].dump() : "");
-      row.push_back(ok && t.contains("counts") ? t["counts"]["leaves"].dump() : "");
-      row.push_back(ok ? num(t, "total_length_m") : "");
-      row.push_back(num(b, "obj"));
-      row.push_back(num(b, "ply"));
-      row.push_back(num(b, "glb"));
-      row.push_back(num(m, "coverage"));
-      row.push_back(num(m, "attached_fraction"));
-      row.push_back(num(m, "penetration_nodes"));
-      row.push_back(ok && t.contains("geometry_hash") ? t["geometry_hash"].get<std::string>() : "");
+      const bool ok = s.status == "ok";
+      const OutputBytes b = ok && c.output_bytes ? *c.output_bytes : OutputBytes{};
+      auto metric = [&](const char* k) {
+        return ok && c.metrics && c.metrics->contains(k) ? (*c.metrics)[k].dump() : std::string();
+      };
+      row.push_back(num(s.child_wall_s));
+      row.push_back(num(s.child_max_rss_bytes));
+      row.push_back(num(s.harness_overhead_s));
+      row.push_back(ok && c.counts ? num(c.counts->nodes) : "");
+      row.push_back(ok && c.counts ? num(c.counts->leaves) : "");
+      row.push_back(ok ? num(c.total_length_m) : "");
+      row.push_back(num(b.obj));
+      row.push_back(num(b.ply));
+      row.push_back(num(b.glb));
+      row.push_back(metric("coverage"));
+      row.push_back(metric("attached_fraction"));
+      row.push_back(metric("penetration_nodes"));
+      row.push_back(ok && c.geometry_hash ? *c.geometry_hash : "");
       out += csv_row(row) + "\n";
     }
   }
   return out;
 }
-
-// The per-cell fields taken from the first successful repetition's record.
-const char* const kCellFields[] = {"geometry_hash", "counts",         "output_bytes", "metrics",   "total_length_m", "steps",
-                                   "stopped_by",    "curve",          "params",       "algorithm_stats", "threads", "scene_hash",
-                                   "alloc", "instructions"};
 
 // Under callgrind a trial runs this many times slower; its timeout grows with it.
 constexpr double kCallgrindSlowdown = 60.0;
@@ -349,8 +387,8 @@ constexpr double kCallgrindSlowdown = 60.0;
 // The per-phase instruction counts of a trial run under callgrind: every CALLGRIND_DUMP_STATS_AT(phase)
 // wrote DIR/callgrind.out.N with "desc: Trigger: Client Request: PHASE" and "totals: IR". The files are
 // removed once read (the final dump at program exit is not a phase).
-json read_callgrind_phases(const fs::path& dir) {
-  json out = json::object();
+InstructionCounts read_callgrind_phases(const fs::path& dir) {
+  InstructionCounts out;
   std::vector<fs::path> files;
   for (const auto& e : fs::directory_iterator(dir))
     if (e.path().filename().string().rfind("callgrind.out", 0) == 0) files.push_back(e.path());
@@ -373,26 +411,120 @@ json read_callgrind_phases(const fs::path& dir) {
   return out;
 }
 
+// The per-cell fields of a successful repetition's record: all of them for the cell's first success, else
+// just the geometry hash and counts, which are compared to catch nondeterminism.
+CellResults cell_results_of(const TrialRecord& rec, bool first, const std::optional<InstructionCounts>& instructions) {
+  CellResults c;
+  c.geometry_hash = rec.geometry_hash;
+  c.counts = rec.counts;
+  if (!first) return c;
+  c.output_bytes = rec.output_bytes;
+  c.metrics = rec.metrics;
+  c.total_length_m = rec.total_length_m;
+  c.steps = rec.steps;
+  c.stopped_by = rec.stopped_by;
+  c.curve = rec.curve;
+  c.params = rec.params;
+  c.algorithm_stats = rec.algorithm_stats;
+  c.threads = rec.threads;
+  c.scene_hash = rec.scene.hash;
+  AllocByPhase alloc;
+  rec.phases.each([&](std::string_view k, const PhaseMeasures& p) { alloc[std::string(k)] = {p.alloc_count, p.alloc_bytes}; });
+  c.alloc = alloc;
+  c.instructions = instructions;
+  return c;
+}
+
+// Every field `from` has, into `to`.
+void take_fields(CellResults& to, const CellResults& from) {
+  auto take = [](auto& a, const auto& b) {
+    if (b) a = b;
+  };
+  take(to.geometry_hash, from.geometry_hash);
+  take(to.counts, from.counts);
+  take(to.output_bytes, from.output_bytes);
+  take(to.metrics, from.metrics);
+  take(to.total_length_m, from.total_length_m);
+  take(to.steps, from.steps);
+  take(to.stopped_by, from.stopped_by);
+  take(to.curve, from.curve);
+  take(to.params, from.params);
+  take(to.algorithm_stats, from.algorithm_stats);
+  take(to.threads, from.threads);
+  take(to.scene_hash, from.scene_hash);
+  take(to.alloc, from.alloc);
+  take(to.instructions, from.instructions);
+}
+
+// The growth phase's wall time of every ok repetition of a cell, in repetition order.
+std::vector<double> growth_times(const SuiteCell& t) {
+  std::vector<double> v;
+  for (const auto& s : t.samples)
+    if (s.status == "ok" && s.phases && s.phases->growth) v.push_back(s.phases->growth->wall_s);
+  return v;
+}
+
+MedianSummary median_summary(const std::vector<double>& v) {
+  MedianSummary m;
+  m.n = v.size();
+  m.median = median_of(v);
+  const auto [lo, hi] = median_interval(v, m.exact);
+  m.lo = lo;
+  m.hi = hi;
+  return m;
+}
+
 // Adds one finished repetition to its cell: the live run and the journal replay both come here.
-// `cell` holds the record's per-cell fields (all of them for the cell's first success, else just the
-// geometry hash and counts, which are compared to catch nondeterminism).
-void apply_sample(json& t, const json& sample, const json& cell) {
-  if (sample["status"] == "ok" && cell.is_object()) {
-    if (!t.contains("geometry_hash")) {
-      for (const char* k : kCellFields)
-        if (cell.contains(k)) t[k] = cell[k];
-    } else if (t["geometry_hash"] != cell["geometry_hash"] || t["counts"] != cell["counts"]) {
-      t["nondeterministic"] = true;  // the same cell grew a different plant: report it loudly
+void apply_sample(SuiteCell& t, const SuiteSample& sample, const std::optional<CellResults>& cell) {
+  if (sample.status == "ok" && cell) {
+    if (!t.results.geometry_hash) {
+      take_fields(t.results, *cell);
+    } else if (t.results.geometry_hash != cell->geometry_hash || t.results.counts != cell->counts) {
+      t.nondeterministic = true;  // the same cell grew a different plant: report it loudly
     }
   }
-  t["samples"].push_back(sample);
+  t.samples.push_back(sample);
   std::string st = "ok";
-  for (const auto& s : t["samples"])
-    if (s["status"] != "ok") st = s["status"];
-  t["status"] = st;
+  for (const auto& s : t.samples)
+    if (s.status != "ok") st = s.status;
+  t.status = st;
   if (st != "ok")
-    for (const auto& s : t["samples"])
-      if (s["status"] != "ok" && s.contains("message")) t["message"] = s["message"];
+    for (const auto& s : t.samples)
+      if (s.status != "ok" && s.message) t.message = s.message;
+  // The growth time's median and interval, so that reports read them instead of computing them again.
+  const std::vector<double> growth = growth_times(t);
+  if (growth.empty()) t.summary.reset();
+  else t.summary = CellSummary{median_summary(growth)};
+}
+
+// The growth time over the seeds of each algorithm entry (and sweep point) on each scene: every ok cell's
+// ok repetitions pooled, as the report's table shows them.
+ResultsSummary results_summary(const std::vector<SuiteCell>& trials) {
+  ResultsSummary out;
+  std::vector<std::vector<double>> times;
+  for (const auto& t : trials) {
+    const std::vector<double> growth = growth_times(t);
+    if (t.status != "ok" || growth.empty()) continue;
+    std::size_t g = 0;
+    while (g < out.growth_s_over_seeds.size() &&
+           !(out.growth_s_over_seeds[g].label == t.label && out.growth_s_over_seeds[g].scene == t.scene &&
+             out.growth_s_over_seeds[g].sweep == t.sweep))
+      ++g;
+    if (g == out.growth_s_over_seeds.size()) {
+      out.growth_s_over_seeds.push_back({t.label, t.scene, t.sweep, {}, {}});
+      times.emplace_back();
+    }
+    out.growth_s_over_seeds[g].cells.push_back(t.id);
+    times[g].insert(times[g].end(), growth.begin(), growth.end());
+  }
+  for (std::size_t g = 0; g < times.size(); ++g) out.growth_s_over_seeds[g].growth_s = median_summary(times[g]);
+  return out;
+}
+
+// results.json as written: its pooled summary brought up to date first.
+std::string results_text(ResultsFile& results) {
+  results.summary = results_summary(results.trials);
+  return json_text(to_json(results), 1);
 }
 
 }  // namespace
@@ -402,45 +534,57 @@ Suite load_suite(const std::string& path) {
   return SuiteReader(path).read();
 }
 
+namespace {
+
 // What a shard's context must share with the others for their timings to be compared: the machine type
 // and the binary (its content hash, not the source tree's commit, which may move while shards run).
-// Host names and dates may differ.
-const char* const kMachineKeys[] = {"cpu_model", "hardware_threads", "binary_hash"};
+// Host names and dates may differ. Each as its name and its value as the JSON shows it.
+std::vector<std::pair<const char*, std::string>> machine_keys(const RunContext& c) {
+  return {{"cpu_model", json(c.cpu_model).dump()},
+          {"hardware_threads", json(c.hardware_threads).dump()},
+          {"binary_hash", json(c.binary_hash).dump()}};
+}
 
-json merge_results(const std::vector<json>& shards, const std::vector<std::string>& names, bool mixed_machines) {
-  if (shards.empty()) throw InputError("merge: no shard results given");
-  const json& first = shards.front();
-  const int count = first.at("shard").value("count", 1);
+// Which argument holds each shard (index -> argument); InputError for shards that do not fit together.
+std::vector<std::size_t> shard_slots(const std::vector<ResultsFile>& shards, const std::vector<std::string>& names) {
+  const ResultsFile& first = shards.front();
+  const int count = first.shard.count;
   if (count < 1) throw InputError(fmt::format("{}: shard count {} (expected at least 1)", names[0], count));
-  std::vector<std::size_t> slot(static_cast<std::size_t>(std::max(count, 1)), shards.size());  // shard index -> argument
+  std::vector<std::size_t> slot(static_cast<std::size_t>(std::max(count, 1)), shards.size());
   for (std::size_t k = 0; k < shards.size(); ++k) {
-    const json& s = shards[k];
-    if (s.value("kind", "") != "growbench-results")
-      throw InputError(fmt::format("{}: not a growbench results file", names[k]));
-    if (s.value("suite_hash", "") != first.value("suite_hash", ""))
-      throw InputError(fmt::format("{}: a shard of another suite (suite_hash {} vs {} in {})", names[k], s.value("suite_hash", ""),
-                                   first.value("suite_hash", ""), names[0]));
-    if (s.value("repetitions", 0) != first.value("repetitions", 0))
-      throw InputError(fmt::format("{}: {} repetitions, but {} has {}", names[k], s.value("repetitions", 0), names[0],
-                                   first.value("repetitions", 0)));
-    if (s.value("mode", "timing") != first.value("mode", "timing"))
-      throw InputError(fmt::format("{}: mode '{}' differs from {}'s", names[k], s.value("mode", "timing"), names[0]));
-    const int n = s.at("shard").value("count", 1), i = s.at("shard").value("index", 0);
+    const ResultsFile& s = shards[k];
+    if (s.kind != kResultsKind) throw InputError(fmt::format("{}: not a growbench results file", names[k]));
+    if (s.suite_hash != first.suite_hash)
+      throw InputError(fmt::format("{}: a shard of another suite (suite_hash {} vs {} in {})", names[k], s.suite_hash,
+                                   first.suite_hash, names[0]));
+    if (s.repetitions != first.repetitions)
+      throw InputError(fmt::format("{}: {} repetitions, but {} has {}", names[k], s.repetitions, names[0], first.repetitions));
+    if (s.mode != first.mode) throw InputError(fmt::format("{}: mode '{}' differs from {}'s", names[k], s.mode, names[0]));
+    const int n = s.shard.count, i = s.shard.index;
     if (n != count) throw InputError(fmt::format("{}: shard of {} but {} is a shard of {}", names[k], n, names[0], count));
     if (i < 0 || i >= n) throw InputError(fmt::format("{}: shard index {} outside 0..{}", names[k], i, n - 1));
     if (slot[static_cast<std::size_t>(i)] != shards.size())
       throw InputError(fmt::format("{}: shard {}/{} given twice", names[k], i, n));
     slot[static_cast<std::size_t>(i)] = k;
   }
+  return slot;
+}
+
+}  // namespace
+
+ResultsFile merge_results(const std::vector<ResultsFile>& shards, const std::vector<std::string>& names,
+                          bool mixed_machines) {
+  if (shards.empty()) throw InputError("merge: no shard results given");
+  const std::vector<std::size_t> slot = shard_slots(shards, names);
+  const ResultsFile& first = shards.front();
+  const int count = first.shard.count;
   std::vector<std::string> differ;
-  const json none = json::object();
-  const json& ctx0 = first.contains("context") ? first["context"] : none;
+  const auto keys0 = machine_keys(first.context);
   for (std::size_t k = 1; k < shards.size(); ++k) {
-    const json& ctx = shards[k].contains("context") ? shards[k]["context"] : none;
-    for (const char* key : kMachineKeys)
-      if (ctx.value(key, json()) != ctx0.value(key, json()))
-        differ.push_back(fmt::format("{} {} in {} vs {} in {}", key, ctx.value(key, json()).dump(), names[k],
-                                     ctx0.value(key, json()).dump(), names[0]));
+    const auto keys = machine_keys(shards[k].context);
+    for (std::size_t m = 0; m < keys.size(); ++m)
+      if (keys[m].second != keys0[m].second)
+        differ.push_back(fmt::format("{} {} in {} vs {} in {}", keys[m].first, keys[m].second, names[k], keys0[m].second, names[0]));
   }
   if (!differ.empty() && !mixed_machines)
     throw InputError(fmt::format("merge: the shards ran on different machines or builds, so their timings cannot be compared "
@@ -449,25 +593,32 @@ json merge_results(const std::vector<json>& shards, const std::vector<std::strin
   for (int i = 0; i < count; ++i)
     if (slot[static_cast<std::size_t>(i)] == shards.size()) throw InputError(fmt::format("merge: shard {}/{} is missing", i, count));
   // Cell k of the suite ran in shard k % count, as its (k / count)-th cell.
-  json merged = first;
-  merged["shard"] = {{"index", 0}, {"count", 1}};
-  merged["trials"] = json::array();
-  merged["shards"] = json::array();
+  ResultsFile merged = first;
+  merged.shard = {0, 1};
+  merged.trials.clear();
+  merged.shards.emplace();
   std::size_t total = 0;
   for (int i = 0; i < count; ++i) {
     const std::size_t a = slot[static_cast<std::size_t>(i)];
-    merged["shards"].push_back({{"index", i}, {"file", names[a]}, {"context", shards[a].value("context", json::object())}});
-    total += shards[a].at("trials").size();
+    merged.shards->push_back({i, names[a], shards[a].context});
+    total += shards[a].trials.size();
   }
   for (std::size_t k = 0; k < total; ++k) {
-    const json& trials = shards[slot[k % static_cast<std::size_t>(count)]].at("trials");
+    const std::vector<SuiteCell>& trials = shards[slot[k % static_cast<std::size_t>(count)]].trials;
     const std::size_t at = k / static_cast<std::size_t>(count);
     if (at >= trials.size()) throw InputError(fmt::format("merge: shard {} has fewer cells than its suite gives it", k % count));
-    merged["trials"].push_back(trials[at]);
+    merged.trials.push_back(trials[at]);
   }
-  if (!differ.empty()) merged["context"]["mixed_machines"] = true;
-  merged.erase("renders");  // per-shard render summaries do not describe the merged grid
+  if (!differ.empty()) merged.context.mixed_machines = true;
+  merged.renders.reset();  // per-shard render summaries do not describe the merged grid
+  merged.summary = results_summary(merged.trials);  // seeds of one entry and scene may have run in different shards
   return merged;
+}
+
+json merge_results(const std::vector<json>& shards, const std::vector<std::string>& names, bool mixed_machines) {
+  std::vector<ResultsFile> typed;
+  for (std::size_t k = 0; k < shards.size(); ++k) typed.push_back(from_json<ResultsFile>(shards[k], names.at(k)));
+  return to_json(merge_results(typed, names, mixed_machines));
 }
 
 int run_trial_child(const TrialSpec& spec, const std::string& dir_name, int report_fd) {
@@ -497,11 +648,11 @@ int run_trial_child(const TrialSpec& spec, const std::string& dir_name, int repo
 }
 
 json trial_job(const SuiteConfig& c, const std::string& dir) {
-  json spec = to_json(c.spec);
-  spec["out_dir"] = dir;
-  spec["context"] = false;
-  spec["skip_teardown"] = true;
-  return spec;
+  TrialSpecRecord spec = to_record(c.spec);
+  spec.out_dir = dir;
+  spec.context = false;
+  spec.skip_teardown = true;
+  return to_json(spec);
 }
 
 namespace {
@@ -536,269 +687,313 @@ std::unique_ptr<Launcher> start_trial_launcher() {
   });
 }
 
-std::string run_suite(const Suite& suite_in, const SuiteRunOptions& o) {
-  // Instruction counts: one repetition (they repeat exactly), no warm-up, one thread.
-  Suite suite = suite_in;
-  std::string valgrind, self_exe;
-  if (o.instructions) {
-    suite.repetitions = 1;
-    suite.warmup = 0;
-    for (auto& c : suite.configs) c.spec.threads = 1;
-    valgrind = find_program("valgrind");
-    if (valgrind.empty()) throw InputError("--instructions needs valgrind (Debian's valgrind package; scripts/install-deps)");
-    self_exe = fs::read_symlink("/proc/self/exe").string();
-  }
-  const fs::path out = o.out_dir.empty() ? fs::path("out/suites") / suite.name : fs::path(o.out_dir);
-  const fs::path results_path = out / "results.json";
-  fs::create_directories(out / "trials");
+namespace {
 
-  std::unique_ptr<Launcher> own_launcher;
-  Launcher* launcher = o.launcher;
-  if (!o.instructions && !launcher) {
-    own_launcher = start_trial_launcher();
-    launcher = own_launcher.get();
-  }
-  const ChildLimits limits{suite.timeout_s, suite.memory_limit_bytes};
-
-  const fs::path journal_path = out / "journal.jsonl";
-  json results;
-  if (!o.resume && fs::exists(journal_path) && !fs::exists(results_path))
-    throw InputError(fmt::format("{} holds a journal of an interrupted run: pass --resume to continue it, or another --out",
-                                 journal_path.string()));
-  if (fs::exists(results_path)) {
-    if (!o.resume)
-      throw InputError(fmt::format("{} already holds results: pass --resume to continue that run, or another --out",
-                                   results_path.string()));
-    try {
-      results = json::parse(read_text(results_path.string()));
-    } catch (const json::exception& e) {
-      throw InputError(fmt::format("{}: cannot resume, the file is not valid results JSON ({})", results_path.string(), e.what()));
+// One run of a suite into its output directory: results.json (rewritten), journal.jsonl (appended), and a
+// folder per cell under trials/.
+class SuiteRun {
+ public:
+  SuiteRun(const Suite& suite_in, const SuiteRunOptions& o) : suite_(suite_in), o_(o) {
+    // Instruction counts: one repetition (they repeat exactly), no warm-up, one thread.
+    if (o.instructions) {
+      suite_.repetitions = 1;
+      suite_.warmup = 0;
+      for (auto& c : suite_.configs) c.spec.threads = 1;
+      valgrind_ = find_program("valgrind");
+      if (valgrind_.empty()) throw InputError("--instructions needs valgrind (Debian's valgrind package; scripts/install-deps)");
+      self_exe_ = fs::read_symlink("/proc/self/exe").string();
     }
-    if (results.value("suite_hash", "") != suite.hash)
-      throw InputError(fmt::format("{}: cannot resume, it was written for a different version of {}", results_path.string(), suite.file));
-    if (results.value("repetitions", 0) != suite.repetitions)
-      throw InputError(fmt::format("{}: cannot resume, it ran {} repetitions per cell and this run asks {}", results_path.string(),
-                                   results.value("repetitions", 0), suite.repetitions));
-  } else {
-    results = {{"schema_version", 1},
-               {"kind", "growbench-results"},
-               {"mode", o.instructions ? "instructions" : "timing"},
-               {"suite", {{"name", suite.name}, {"file", suite.file}, {"description", suite.description}}},
-               {"suite_hash", suite.hash},
-               {"repetitions", suite.repetitions},
-               {"shard", {{"index", o.shard_index}, {"count", o.shard_count}}},
-               {"trials", json::array()}};
-  }
-  // The context is taken in the parent before any trial.
-  json ctx = run_context();
-  ctx["suite_file_hash"] = suite.hash;
-  if (g_threads_at_fork >= 0) ctx["parent_threads_at_fork"] = g_threads_at_fork;
-  results["context"] = ctx;
-
-  // Index the trials already recorded, and create entries for every cell of this shard.
-  std::map<std::string, std::size_t> index;
-  for (std::size_t i = 0; i < results["trials"].size(); ++i) index[results["trials"][i]["id"]] = i;
-  std::vector<const SuiteConfig*> cells;
-  for (std::size_t i = 0; i < suite.configs.size(); ++i) {
-    if (static_cast<int>(i % static_cast<std::size_t>(o.shard_count)) != o.shard_index) continue;
-    const SuiteConfig& c = suite.configs[i];
-    cells.push_back(&c);
-    if (index.count(c.id)) continue;
-    index[c.id] = results["trials"].size();
-    results["trials"].push_back({{"id", c.id},
-                                 {"label", c.label},
-                                 {"algorithm", c.spec.algorithm},
-                                 {"scene", c.scene_name},
-                                 {"scene_spec", c.spec.scene},
-                                 {"seed", c.spec.seed},
-                                 {"sweep", c.sweep},
-                                 {"spec", to_json(c.spec)},
-                                 {"status", "pending"},
-                                 {"samples", json::array()}});
+    out_ = o.out_dir.empty() ? fs::path("out/suites") / suite_.name : fs::path(o.out_dir);
+    results_path_ = out_ / "results.json";
+    journal_path_ = out_ / "journal.jsonl";
+    fs::create_directories(out_ / "trials");
+    launcher_ = o.launcher;
+    if (!o.instructions && !launcher_) {
+      own_launcher_ = start_trial_launcher();
+      launcher_ = own_launcher_.get();
+    }
   }
 
-  // Replay the journal: repetitions finished after the last snapshot (or before a kill) come back.
-  if (o.resume && fs::exists(journal_path)) {
-    std::ifstream jin(journal_path);
-    for (std::string line; std::getline(jin, line);) {
-      json e;
-      try {
-        e = json::parse(line);
-      } catch (const json::exception&) {
-        continue;  // a line cut short by a kill: its trial runs again
+  std::string run() {
+    open_results();
+    add_cells();
+    if (o_.resume && fs::exists(journal_path_)) replay_journal();
+    write_atomic(results_path_, results_text(results_));
+    journal_.reset(std::fopen(journal_path_.c_str(), "a"));
+    if (!journal_) throw std::runtime_error(fmt::format("{}: cannot open the journal", journal_path_.string()));
+    auto last_snapshot = std::chrono::steady_clock::now();
+    const std::vector<Job> jobs = plan_jobs();
+    const bool tty = isatty(STDERR_FILENO) != 0 && !o_.quiet;
+    const auto t_start = std::chrono::steady_clock::now();
+    for (std::size_t jn = 0; jn < jobs.size(); ++jn) {
+      if (!o_.quiet) print_progress(jobs, jn, t_start, tty);
+      if (!run_job(jobs[jn])) continue;  // a warm-up
+      // Readable snapshots of the whole run every few seconds (always written atomically).
+      if (std::chrono::steady_clock::now() - last_snapshot > std::chrono::seconds(10)) {
+        write_snapshot();
+        last_snapshot = std::chrono::steady_clock::now();
       }
-      const auto it = index.find(e.value("id", ""));
-      if (it == index.end()) continue;
-      json& t = results["trials"][it->second];
-      bool have = false;
-      for (const auto& smp : t["samples"]) have = have || smp["repetition"] == e["sample"]["repetition"];
-      if (!have) apply_sample(t, e["sample"], e["cell"]);
     }
+    write_snapshot();
+    if (tty) fmt::print(stderr, "\r{:<100}\r", "");
+    return results_path_.string();
   }
-  write_atomic(results_path, results.dump(1) + "\n");
-  std::unique_ptr<FILE, int (*)(FILE*)> journal(std::fopen(journal_path.c_str(), "a"), &std::fclose);
-  if (!journal) throw std::runtime_error(fmt::format("{}: cannot open the journal", journal_path.string()));
-  auto last_snapshot = std::chrono::steady_clock::now();
 
-  // Jobs: warm-ups, then repetitions, each pass over the interleaved cells.
+ private:
   struct Job {
     const SuiteConfig* cell;
     int repetition;  // -1: warm-up
   };
-  std::vector<Job> jobs;
-  if (!cells.empty())
-    for (int w = 0; w < suite.warmup; ++w) jobs.push_back({cells.front(), -1});
-  for (int r = 0; r < suite.repetitions; ++r)
-    for (const auto* c : cells) {
-      bool done = false;
-      for (const auto& s : results["trials"][index[c->id]]["samples"]) done = done || s["repetition"] == r;
-      if (!done) jobs.push_back({c, r});
-    }
-  if (o.resume && jobs.size() == static_cast<std::size_t>(cells.empty() ? 0 : suite.warmup)) jobs.clear();
-
-  const bool tty = isatty(STDERR_FILENO) != 0 && !o.quiet;
-  const auto t_start = std::chrono::steady_clock::now();
-  for (std::size_t jn = 0; jn < jobs.size(); ++jn) {
-    const Job& job = jobs[jn];
-    const SuiteConfig& c = *job.cell;
-    const fs::path dir = out / "trials" / c.id;
-    fs::create_directories(dir);
-    if (!o.quiet) {
-      const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
-      const double eta = jn > 0 ? el / static_cast<double>(jn) * static_cast<double>(jobs.size() - jn) : 0.0;
-      const std::string what = job.repetition < 0 ? "warm-up" : fmt::format("rep {}/{}", job.repetition + 1, suite.repetitions);
-      const std::string line = fmt::format("[{}/{}] {} ({}){}", jn + 1, jobs.size(), c.id, what,
-                                           jn > 0 ? fmt::format(", ETA {:.0f} s", eta) : std::string());
-      if (tty) fmt::print(stderr, "\r{:<100}", line.substr(0, 100));
-      else fmt::print(stderr, "{}\n", line);
-    }
-    const fs::path rec_path = dir / "record.json", err_path = dir / "error.txt";
-    fs::remove(rec_path);
-    fs::remove(err_path);
-    const auto t0 = std::chrono::steady_clock::now();
+  // One trial's process and what it left: the record, read while the kernel is still tearing the child
+  // down, and the child's report (steady-clock ns when it started, and when record.json was in place).
+  struct TrialProcess {
     ChildResult cr;
-    // What the child reports once record.json is in place (steady-clock ns), and the record itself,
-    // read while the kernel is still tearing the child down.
+    std::chrono::steady_clock::time_point t0, t_reaped;
     std::int64_t started_ns = 0, finished_ns = 0;
-    json rec;
+    std::optional<TrialRecord> rec;
     std::string rec_error;
     double read_record_s = 0.0;
+  };
+
+  // The results of an earlier run (--resume) or fresh ones; the context is taken now, before any trial.
+  void open_results() {
+    if (!o_.resume && fs::exists(journal_path_) && !fs::exists(results_path_))
+      throw InputError(fmt::format("{} holds a journal of an interrupted run: pass --resume to continue it, or another --out",
+                                   journal_path_.string()));
+    if (fs::exists(results_path_)) {
+      if (!o_.resume)
+        throw InputError(fmt::format("{} already holds results: pass --resume to continue that run, or another --out",
+                                     results_path_.string()));
+      try {
+        results_ = read_results(results_path_.string());
+      } catch (const InputError& e) {
+        throw InputError(fmt::format("{}: cannot resume, the file is not valid results JSON ({})", results_path_.string(), e.what()));
+      }
+      if (results_.suite_hash != suite_.hash)
+        throw InputError(fmt::format("{}: cannot resume, it was written for a different version of {}", results_path_.string(),
+                                     suite_.file));
+      if (results_.repetitions != suite_.repetitions)
+        throw InputError(fmt::format("{}: cannot resume, it ran {} repetitions per cell and this run asks {}",
+                                     results_path_.string(), results_.repetitions, suite_.repetitions));
+    } else {
+      results_.mode = o_.instructions ? "instructions" : "timing";
+      results_.suite = {suite_.name, suite_.file, suite_.description};
+      results_.suite_hash = suite_.hash;
+      results_.repetitions = suite_.repetitions;
+      results_.shard = {o_.shard_index, o_.shard_count};
+    }
+    results_.context = run_context_record();
+    results_.context.suite_file_hash = suite_.hash;
+    if (g_threads_at_fork >= 0) results_.context.parent_threads_at_fork = g_threads_at_fork;
+  }
+
+  // Indexes the cells already recorded, and creates entries for every cell of this shard.
+  void add_cells() {
+    for (std::size_t i = 0; i < results_.trials.size(); ++i) index_[results_.trials[i].id] = i;
+    for (std::size_t i = 0; i < suite_.configs.size(); ++i) {
+      if (static_cast<int>(i % static_cast<std::size_t>(o_.shard_count)) != o_.shard_index) continue;
+      const SuiteConfig& c = suite_.configs[i];
+      cells_.push_back(&c);
+      if (index_.count(c.id)) continue;
+      index_[c.id] = results_.trials.size();
+      SuiteCell t;
+      t.id = c.id;
+      t.label = c.label;
+      t.algorithm = c.spec.algorithm;
+      t.scene = c.scene_name;
+      t.scene_spec = c.spec.scene;
+      t.seed = c.spec.seed;
+      t.sweep = c.sweep;
+      t.spec = to_record(c.spec);
+      results_.trials.push_back(std::move(t));
+    }
+  }
+
+  // Repetitions finished after the last snapshot (or before a kill) come back from the journal.
+  void replay_journal() {
+    for (const JournalEntry& e : read_journal(journal_path_.string())) {
+      const auto it = index_.find(e.id);
+      if (it == index_.end()) continue;
+      SuiteCell& t = results_.trials[it->second];
+      bool have = false;
+      for (const auto& smp : t.samples) have = have || smp.repetition == e.sample.repetition;
+      if (!have) apply_sample(t, e.sample, e.cell);
+    }
+  }
+
+  // Warm-ups, then repetitions, each pass over the interleaved cells; repetitions already done are skipped.
+  [[nodiscard]] std::vector<Job> plan_jobs() const {
+    std::vector<Job> jobs;
+    if (!cells_.empty())
+      for (int w = 0; w < suite_.warmup; ++w) jobs.push_back({cells_.front(), -1});
+    for (int r = 0; r < suite_.repetitions; ++r)
+      for (const auto* c : cells_) {
+        bool done = false;
+        for (const auto& s : results_.trials[index_.at(c->id)].samples) done = done || s.repetition == r;
+        if (!done) jobs.push_back({c, r});
+      }
+    if (o_.resume && jobs.size() == static_cast<std::size_t>(cells_.empty() ? 0 : suite_.warmup)) jobs.clear();
+    return jobs;
+  }
+
+  void print_progress(const std::vector<Job>& jobs, std::size_t jn, std::chrono::steady_clock::time_point t_start,
+                      bool tty) const {
+    const Job& job = jobs[jn];
+    const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+    const double eta = jn > 0 ? el / static_cast<double>(jn) * static_cast<double>(jobs.size() - jn) : 0.0;
+    const std::string what = job.repetition < 0 ? "warm-up" : fmt::format("rep {}/{}", job.repetition + 1, suite_.repetitions);
+    const std::string line = fmt::format("[{}/{}] {} ({}){}", jn + 1, jobs.size(), job.cell->id, what,
+                                         jn > 0 ? fmt::format(", ETA {:.0f} s", eta) : std::string());
+    if (tty) fmt::print(stderr, "\r{:<100}", line.substr(0, 100));
+    else fmt::print(stderr, "{}\n", line);
+  }
+
+  // Runs the cell's trial in its own process: forked by the launcher, or under callgrind as `growbench trial`.
+  TrialProcess run_process(const SuiteConfig& c, const fs::path& dir) {
+    TrialProcess p;
+    const fs::path rec_path = dir / "record.json";
     auto read_record = [&] {
       const auto r0 = std::chrono::steady_clock::now();
       try {
-        rec = json::parse(read_text(rec_path.string()));
+        p.rec = read_trial_record(rec_path.string());
       } catch (const std::exception& e) {
-        rec = nullptr;
-        rec_error = e.what();
+        p.rec.reset();
+        p.rec_error = e.what();
       }
-      read_record_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
+      p.read_record_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
     };
-    if (o.instructions) {
+    p.t0 = std::chrono::steady_clock::now();
+    if (o_.instructions) {
       // Under callgrind: the trial runs in a fresh growbench process (`growbench trial`), single-threaded,
-      // and dumps its instruction count at the end of every phase (harness/trial.cpp).
-      write_atomic(dir / "spec.json", trial_job(c, dir.string()).dump() + "\n");
+      // and dumps its instruction count at the end of every phase (harness/run/trial.cpp).
+      write_atomic(dir / "spec.json", json_text(trial_job(c, dir.string()), -1));
       for (const auto& e : fs::directory_iterator(dir))
         if (e.path().filename().string().rfind("callgrind.out", 0) == 0) fs::remove(e.path());
-      std::vector<std::string> args = {valgrind, "--tool=callgrind", "--callgrind-out-file=" + (dir / "callgrind.out").string(),
+      std::vector<std::string> args = {valgrind_, "--tool=callgrind", "--callgrind-out-file=" + (dir / "callgrind.out").string(),
                                        // Ir do not depend on the cache model; it is pinned anyway, so a
                                        // run with --cache-sim=yes would be comparable across hosts.
                                        "--cache-sim=no", "--I1=32768,8,64", "--D1=32768,8,64", "--LL=8388608,16,64",
                                        "--instr-atstart=no",  // the trial turns it on per phase
-                                       self_exe, "trial", (dir / "spec.json").string()};
-      cr = run_program(args, "", {suite.timeout_s * kCallgrindSlowdown, 0}, (dir / "log.txt").string());
+                                       self_exe_, "trial", (dir / "spec.json").string()};
+      p.cr = run_program(args, "", {suite_.timeout_s * kCallgrindSlowdown, 0}, (dir / "log.txt").string());
     } else {
-      cr = launcher->run(trial_job(c, dir.string()).dump(), limits, [&](const std::string& report) {
+      const ChildLimits limits{suite_.timeout_s, suite_.memory_limit_bytes};
+      p.cr = launcher_->run(trial_job(c, dir.string()).dump(), limits, [&](const std::string& report) {
         std::istringstream in(report);
-        in >> started_ns >> finished_ns;
+        in >> p.started_ns >> p.finished_ns;
         read_record();
       });
     }
-    const auto t_reaped = std::chrono::steady_clock::now();
+    p.t_reaped = std::chrono::steady_clock::now();
+    if (!p.cr.timed_out && p.cr.signal == 0 && p.cr.exit_code == kExitOk && fs::exists(rec_path) && !p.rec &&
+        p.rec_error.empty())
+      read_record();  // no report (callgrind trials)
+    return p;
+  }
 
-    json sample = {{"repetition", job.repetition},
-                   {"child_wall_s", cr.wall_s},
-                   {"child_user_s", cr.user_s},
-                   {"child_system_s", cr.system_s},
-                   {"child_max_rss_bytes", cr.max_rss_bytes}};
-    std::string status, message;
+  // The sample's status and message from how the trial's process ended.
+  void judge(const TrialProcess& p, const fs::path& dir, SuiteSample& sample) const {
+    const ChildResult& cr = p.cr;
+    const fs::path rec_path = dir / "record.json", err_path = dir / "error.txt";
+    std::string message;
     if (cr.timed_out) {
-      status = "timeout";
-      message = fmt::format("killed after {} s", suite.timeout_s);
+      sample.status = "timeout";
+      message = fmt::format("killed after {} s", suite_.timeout_s);
     } else if (cr.signal != 0) {
       // SIGKILL that we did not send is the kernel's OOM killer.
-      status = cr.signal == SIGKILL ? "out_of_memory" : "crashed";
+      sample.status = cr.signal == SIGKILL ? "out_of_memory" : "crashed";
       message = signal_name(cr.signal);
     } else if (cr.exit_code == kExitOk && fs::exists(rec_path)) {
-      if (rec.is_null() && rec_error.empty()) read_record();  // no report (callgrind trials)
-      if (rec.is_null()) {
-        status = "crashed";
-        message = fmt::format("{} is unreadable: {}", rec_path.string(), rec_error);
+      if (!p.rec) {
+        sample.status = "crashed";
+        message = fmt::format("{} is unreadable: {}", rec_path.string(), p.rec_error);
       } else {
-        status = "ok";
-        if (o.instructions) {
-          rec["instructions"] = read_callgrind_phases(dir);
-          sample["instructions"] = rec["instructions"];
-        }
+        sample.status = "ok";
       }
     } else {
       message = fs::exists(err_path) ? read_text(err_path.string()) : fmt::format("exit code {}", cr.exit_code);
-      status = cr.exit_code == kExitInvalid ? "invalid_input" : cr.exit_code == kExitOom ? "out_of_memory" : "crashed";
+      sample.status = cr.exit_code == kExitInvalid ? "invalid_input" : cr.exit_code == kExitOom ? "out_of_memory" : "crashed";
     }
-    sample["status"] = status;
-    if (!message.empty()) sample["message"] = message;
-    if (job.repetition < 0) continue;  // a warm-up: run, not kept
-    json& t = results["trials"][index[c.id]];
-    json cell = nullptr;
-    if (status == "ok") {
-      sample["phases"] = rec["phases"];
+    if (!message.empty()) sample.message = message;
+  }
+
+  // Where the time outside the phases goes (README, "Harness overhead"): fork to the child's start; the
+  // child's own bookkeeping (measuring, record.json, snapshot); the kernel tearing the child down (freeing
+  // its memory), during which this process reads the record; and this process's work. Everything runs to
+  // just before the journal append (one short write).
+  static void account_overhead(const TrialProcess& p, double inside, SuiteSample& sample) {
+    const auto now = std::chrono::steady_clock::now();
+    sample.outside_phases_s = std::chrono::duration<double>(now - p.t0).count() - inside;
+    if (p.started_ns <= 0) return;
+    const auto secs = [](std::chrono::steady_clock::time_point tp) { return std::chrono::duration<double>(tp.time_since_epoch()).count(); };
+    const double started = 1e-9 * static_cast<double>(p.started_ns), finished = 1e-9 * static_cast<double>(p.finished_ns);
+    const double launch = started - secs(p.t0), bookkeeping = finished - started - inside;
+    const double parent = p.read_record_s + std::chrono::duration<double>(now - p.t_reaped).count();
+    sample.launch_s = launch;
+    sample.launch_fork_s = started - 1e-9 * static_cast<double>(p.cr.spawn_ns);
+    sample.child_bookkeeping_s = bookkeeping;
+    sample.teardown_s = secs(p.t_reaped) - finished;
+    sample.parent_s = parent;
+    sample.harness_overhead_s = launch + bookkeeping + parent;
+  }
+
+  // Runs one job; false for a warm-up, which is run but not kept.
+  bool run_job(const Job& job) {
+    const SuiteConfig& c = *job.cell;
+    const fs::path dir = out_ / "trials" / c.id;
+    fs::create_directories(dir);
+    fs::remove(dir / "record.json");
+    fs::remove(dir / "error.txt");
+    const TrialProcess p = run_process(c, dir);
+    SuiteSample sample;
+    sample.repetition = job.repetition;
+    sample.child_wall_s = p.cr.wall_s;
+    sample.child_user_s = p.cr.user_s;
+    sample.child_system_s = p.cr.system_s;
+    sample.child_max_rss_bytes = p.cr.max_rss_bytes;
+    judge(p, dir, sample);
+    std::optional<InstructionCounts> instructions;
+    if (sample.status == "ok" && o_.instructions) sample.instructions = instructions = read_callgrind_phases(dir);
+    if (job.repetition < 0) return false;
+    SuiteCell& t = results_.trials[index_[c.id]];
+    std::optional<CellResults> cell;
+    if (sample.status == "ok") {
+      const TrialRecord& rec = *p.rec;
+      sample.phases = rec.phases;
       double inside = 0.0;
-      for (const auto& [k, v] : rec["phases"].items()) inside += v["wall_s"].get<double>();
-      sample["steps"] = rec["steps"];
-      cell = {{"geometry_hash", rec["geometry_hash"]}, {"counts", rec["counts"]}};
-      if (!t.contains("geometry_hash")) {
-        for (const char* k : kCellFields)
-          if (rec.contains(k)) cell[k] = rec[k];
-        cell["scene_hash"] = rec["scene"]["hash"];
-        json alloc = json::object();
-        for (const auto& [k, v] : rec["phases"].items()) alloc[k] = {{"count", v["alloc_count"]}, {"bytes", v["alloc_bytes"]}};
-        cell["alloc"] = alloc;
-      }
-      // Where the time outside the phases goes (README, "Harness overhead"): fork to the child's start;
-      // the child's own bookkeeping (measuring, record.json, snapshot); the kernel tearing the child down
-      // (freeing its memory), during which this process reads the record; and this process's work.
-      // Everything runs to just before the journal append below (one short write).
-      const auto now = std::chrono::steady_clock::now();
-      sample["outside_phases_s"] = std::chrono::duration<double>(now - t0).count() - inside;
-      if (started_ns > 0) {
-        const auto secs = [](std::chrono::steady_clock::time_point tp) { return std::chrono::duration<double>(tp.time_since_epoch()).count(); };
-        const double started = 1e-9 * static_cast<double>(started_ns), finished = 1e-9 * static_cast<double>(finished_ns);
-        const double launch = started - secs(t0), bookkeeping = finished - started - inside;
-        const double parent = read_record_s + std::chrono::duration<double>(now - t_reaped).count();
-        sample["launch_s"] = launch;
-        sample["launch_fork_s"] = started - 1e-9 * static_cast<double>(cr.spawn_ns);
-        sample["child_bookkeeping_s"] = bookkeeping;
-        sample["teardown_s"] = secs(t_reaped) - finished;
-        sample["parent_s"] = parent;
-        sample["harness_overhead_s"] = launch + bookkeeping + parent;
-      }
+      rec.phases.each([&](std::string_view, const PhaseMeasures& m) { inside += m.wall_s; });
+      sample.steps = rec.steps;
+      cell = cell_results_of(rec, !t.results.geometry_hash, instructions);
+      account_overhead(p, inside, sample);
     }
     // The journal line is the durable record: appended and flushed before the next trial starts, so an
     // interrupted suite (even by kill -9) loses at most the trial in flight.
-    const std::string line = json{{"id", c.id}, {"sample", sample}, {"cell", cell}}.dump() + "\n";
-    if (std::fputs(line.c_str(), journal.get()) < 0 || std::fflush(journal.get()) != 0)
-      throw std::runtime_error(fmt::format("{}: cannot append to the journal", (out / "journal.jsonl").string()));
+    const std::string line = json_text(to_json(JournalEntry{c.id, sample, cell}), -1);
+    if (std::fputs(line.c_str(), journal_.get()) < 0 || std::fflush(journal_.get()) != 0)
+      throw std::runtime_error(fmt::format("{}: cannot append to the journal", journal_path_.string()));
     apply_sample(t, sample, cell);
-    // Readable snapshots of the whole run every few seconds (always written atomically).
-    if (std::chrono::steady_clock::now() - last_snapshot > std::chrono::seconds(10)) {
-      write_atomic(results_path, results.dump(1) + "\n");
-      write_atomic(out / "results.csv", results_csv(results));
-      last_snapshot = std::chrono::steady_clock::now();
-    }
+    return true;
   }
-  write_atomic(results_path, results.dump(1) + "\n");
-  write_atomic(out / "results.csv", results_csv(results));
-  if (tty) fmt::print(stderr, "\r{:<100}\r", "");
-  return results_path.string();
-}
+
+  void write_snapshot() {
+    write_atomic(results_path_, results_text(results_));
+    write_atomic(out_ / "results.csv", results_csv(results_));
+  }
+
+  Suite suite_;
+  const SuiteRunOptions& o_;
+  std::string valgrind_, self_exe_;
+  fs::path out_, results_path_, journal_path_;
+  std::unique_ptr<Launcher> own_launcher_;
+  Launcher* launcher_ = nullptr;
+  ResultsFile results_;
+  std::map<std::string, std::size_t> index_;  // cell id -> index in results_.trials
+  std::vector<const SuiteConfig*> cells_;     // this shard's, in run order
+  std::unique_ptr<FILE, int (*)(FILE*)> journal_{nullptr, &std::fclose};
+};
+
+}  // namespace
+
+std::string run_suite(const Suite& suite, const SuiteRunOptions& options) { return SuiteRun(suite, options).run(); }
 
 }  // namespace growbench

@@ -76,8 +76,11 @@ std::string run_suite(const Suite& suite, const SuiteRunOptions& options);
 // file) into one results document whose trials are in the unsharded run's order: identical to an
 // unsharded run apart from timings and the context (the first shard's; all of them under "shards").
 // Throws InputError naming the file that does not fit (another suite, a missing or repeated shard), and
-// for shards whose machines or builds differ (kMachineKeys of their contexts): their timings cannot be
-// compared with each other, so that takes `mixed_machines`, and the merged context then says so.
+// for shards whose machines or builds differ (CPU model, hardware threads, binary hash): their timings
+// cannot be compared with each other, so that takes `mixed_machines`, and the merged context then says so.
+ResultsFile merge_results(const std::vector<ResultsFile>& shards, const std::vector<std::string>& names,
+                          bool mixed_machines = false);
+// The same on results read as JSON (each read with from_json, errors naming names[k]).
 nlohmann::json merge_results(const std::vector<nlohmann::json>& shards, const std::vector<std::string>& names,
                              bool mixed_machines = false);
 

@@ -105,6 +105,20 @@ TEST(Stats, MedianRatioIntervalCoversTheTrueRatio) {
   EXPECT_NEAR(robust_cv({1, 2, 3, 4, 100}), 1.4826 / 3.0, 1e-12);
 }
 
+// The interval that results.json carries for every cell, and reports/report.py shows.
+TEST(Stats, MedianIntervalFromOrderStatistics) {
+  bool exact = false;
+  // n = 10: (x_(2), x_(9)) covers 1 - 2 * 11/1024 = 97.9%; (x_(3), x_(8)) only 89%.
+  EXPECT_EQ(median_interval({10, 9, 8, 7, 6, 5, 4, 3, 2, 1}, exact), std::make_pair(2.0, 9.0));
+  EXPECT_TRUE(exact);
+  // n = 6 is the smallest with a 95% pair: (x_(1), x_(6)) covers 1 - 2/64 = 96.9%.
+  EXPECT_EQ(median_interval({5, 1, 4, 2, 6, 3}, exact), std::make_pair(1.0, 6.0));
+  EXPECT_TRUE(exact);
+  // n = 5: no pair reaches 95%, the full range, marked inexact.
+  EXPECT_EQ(median_interval({5, 1, 4, 2, 3}, exact), std::make_pair(1.0, 5.0));
+  EXPECT_FALSE(exact);
+}
+
 TEST(Stats, VerdictsSlowerNoChangeAndInconclusive) {
   Rng rng(11, 2);
   auto sample = [&](double centre, double noise, int n) {

@@ -26,15 +26,6 @@ class Statistics(unittest.TestCase):
         self.assertEqual(report.median([3, 1, 2]), 2)
         self.assertEqual(report.median([4, 1, 3, 2]), 2.5)
 
-    def test_median_interval_from_order_statistics(self):
-        # n = 10: (x_(2), x_(9)) covers 1 - 2 * 11/1024 = 97.9%; (x_(3), x_(8)) only 89%.
-        lo, hi, exact = report.median_ci(list(range(10, 0, -1)))
-        self.assertEqual((lo, hi, exact), (2, 9, True))
-        # n = 6 is the smallest with a 95% pair: (x_(1), x_(6)) covers 1 - 2/64 = 96.9%.
-        self.assertEqual(report.median_ci([5, 1, 4, 2, 6, 3]), (1, 6, True))
-        # n = 5: no pair reaches 95%, the full range, marked inexact.
-        self.assertEqual(report.median_ci([5, 1, 4, 2, 3]), (1, 5, False))
-
     def test_exponent_of_an_exact_power_law(self):
         xs = [1e3, 1e4, 1e5, 1e6]
         b, ci, a = report.fit_exponent(xs, [3.0 * x ** 1.5 for x in xs])
@@ -65,19 +56,24 @@ class Tables(unittest.TestCase):
             trial("a", "wall", 2, [0.020, 0.021, 0.022], 3000),
             trial("b", "wall", 1, [], 0, status="timeout"),
         ]]
-        rows = report.table_rows(cells)
+        # The interval over both seeds' six samples is the suite's (harness/stats/stats.hpp): median
+        # (0.012 + 0.020) / 2 = 16 ms, interval (x_(1), x_(6)) = [10 ms, 22 ms].
+        pooled = {frozenset(["a/wall/s1", "a/wall/s2"]): {"n": 6, "median": 0.016, "lo": 0.010, "hi": 0.022, "exact": True}}
+        rows = report.table_rows(cells, pooled)
         self.assertEqual(len(rows), 2)
         a, b = rows
         self.assertEqual(a[:3], ["a", "wall", "2"])
-        # Six samples pooled: median (0.012 + 0.020) / 2 = 16 ms, interval (x_(1), x_(6)) = [10 ms, 22 ms].
         self.assertEqual(a[3], "16.0 ms [10.0 ms, 22.0 ms]")
+        # A file written before the suite wrote summaries: the median, no interval.
+        self.assertEqual(report.table_rows(cells)[0][3], "16.0 ms [no interval in this file]")
         self.assertEqual(a[6], "2000")
         self.assertEqual(a[7:], ["0.500", "0.250", "0.000", "-", "-"])  # no leaf metrics in these records
         self.assertEqual(b[3], "timeout")
 
     def test_latex_and_markdown(self):
         cells = [report.Cell(trial("ivy_luft", "wall", 1, [0.5, 0.6], 10))]
-        rows = report.table_rows(cells)
+        pooled = {frozenset(["ivy_luft/wall/s1"]): {"n": 2, "median": 0.55, "lo": 0.5, "hi": 0.6, "exact": False}}
+        rows = report.table_rows(cells, pooled)
         with tempfile.TemporaryDirectory() as d:
             report.write_latex(os.path.join(d, "t.tex"), rows, "50% of it")
             tex = open(os.path.join(d, "t.tex")).read()
@@ -100,6 +96,23 @@ class Tables(unittest.TestCase):
             with self.assertRaisesRegex(report.ReportError, "not a growbench results file"):
                 report.load_results(p)
             self.assertEqual(report.main([p, "--out", os.path.join(d, "out")]), 2)
+
+    def test_results_are_checked_against_the_schema(self):
+        schema = report.load_schema()
+        self.assertEqual(report.schema_version(schema), 1)
+        doc = {"kind": "growbench-results", "schema_version": 1, "trials": []}
+        with self.assertRaisesRegex(report.ReportError, r"r.json: at the top level: '\w+' is a required property"):
+            report.validate(doc, "r.json", schema)
+        with self.assertRaisesRegex(report.ReportError, "r.json: schema_version 2; this report reads 1"):
+            report.validate(dict(doc, schema_version=2), "r.json", schema)
+        self.assertEqual(report.json_path(["trials", 3, "samples", 0, "phases", "growth", "wall_s"]),
+                         "trials[3].samples[0].phases.growth.wall_s")
+
+    def test_cells_read_the_suites_summary(self):
+        t = trial("a", "wall", 1, [0.010, 0.030, 0.020], 1000)
+        self.assertEqual(report.Cell(t).growth_median(), 0.020)  # no summary: computed
+        t["summary"] = {"growth_s": {"n": 3, "median": 0.025, "lo": 0.010, "hi": 0.030, "exact": False}}
+        self.assertEqual(report.Cell(t).growth_median(), 0.025)  # the suite's, as written
 
 
 if __name__ == "__main__":
