@@ -94,8 +94,8 @@ AlgorithmEntry make_algorithm_entry(const AlgorithmInfo& (*info)(), std::string_
 // its parameters into, which the registry test checks keep no defaults of their own. Use it at the
 // scope of namespace growbench, outside any anonymous namespace. There is no static registration
 // object: the linker would drop it from the static library.
-#define GROWBENCH_REGISTER_ALGORITHM(NAME, CLASS, INFO, ...)                                    \
-  ::growbench::AlgorithmEntry algorithm_entry_##NAME() {                                        \
-    return ::growbench::make_algorithm_entry<CLASS, __VA_ARGS__>(                               \
-        []() -> const ::growbench::AlgorithmInfo& { return INFO; }, #__VA_ARGS__);              \
+#define GROWBENCH_REGISTER_ALGORITHM(NAME, CLASS, INFO, ...)                       \
+  ::growbench::AlgorithmEntry algorithm_entry_##NAME() {                           \
+    return ::growbench::make_algorithm_entry<CLASS, __VA_ARGS__>(                  \
+        []() -> const ::growbench::AlgorithmInfo& { return INFO; }, #__VA_ARGS__); \
   }

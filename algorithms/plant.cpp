@@ -12,10 +12,14 @@ namespace growbench {
 
 const char* to_string(OrganKind k) {
   switch (k) {
-    case OrganKind::Leaf: return "leaf";
-    case OrganKind::YoungLeaf: return "young_leaf";
-    case OrganKind::Flower: return "flower";
-    case OrganKind::Bud: return "bud";
+    case OrganKind::Leaf:
+      return "leaf";
+    case OrganKind::YoungLeaf:
+      return "young_leaf";
+    case OrganKind::Flower:
+      return "flower";
+    case OrganKind::Bud:
+      return "bud";
   }
   return "?";
 }

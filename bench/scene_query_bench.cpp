@@ -17,7 +17,8 @@ struct Bunny {
     const Aabb b = scene.bounds();
     Rng r(1, 1);
     pts.resize(1 << 14);
-    for (auto& p : pts) p = b.min - 0.1f * b.size() + glm::vec3(r.uniform(), r.uniform(), r.uniform()) * 1.2f * b.size();
+    for (auto& p : pts)
+      p = b.min - 0.1f * b.size() + glm::vec3(r.uniform(), r.uniform(), r.uniform()) * 1.2f * b.size();
   }
 };
 Bunny& bunny() {

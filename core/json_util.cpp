@@ -19,7 +19,6 @@ std::string read_text_file(const std::string& path) {
   return ss.str();
 }
 
-
 std::pair<std::size_t, std::size_t> line_column(const std::string& text, std::size_t byte) {
   std::size_t line = 1, col = 1;
   for (std::size_t i = 0; i + 1 < byte && i < text.size(); ++i) {
@@ -48,13 +47,15 @@ void JsonPathReader::fail(const std::string& path, const std::string& what) cons
   throw InputError(fmt::format("{}: at {}: {}", file_, path.empty() ? "/" : path, what));
 }
 
-void JsonPathReader::only_keys(const nlohmann::json& j, const std::string& path, const std::vector<std::string>& keys) const {
+void JsonPathReader::only_keys(const nlohmann::json& j, const std::string& path,
+                               const std::vector<std::string>& keys) const {
   if (!j.is_object()) fail(path, fmt::format("expected an object, got {}", j.type_name()));
   for (const auto& [k, v] : j.items()) {
     if (std::find(keys.begin(), keys.end(), k) != keys.end()) continue;
     const std::string near = closest_match(k, keys);
-    fail(path + "/" + k, fmt::format("unknown key '{}'{}; expected one of {}", k,
-                                     near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near), fmt::join(keys, ", ")));
+    fail(path + "/" + k,
+         fmt::format("unknown key '{}'{}; expected one of {}", k,
+                     near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near), fmt::join(keys, ", ")));
   }
 }
 

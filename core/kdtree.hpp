@@ -22,12 +22,15 @@ struct Vec3Cloud {
   [[nodiscard]] std::size_t kdtree_get_point_count() const { return pts->size(); }
   [[nodiscard]] float kdtree_get_pt(std::size_t i, std::size_t d) const { return (*pts)[i][static_cast<int>(d)]; }
   template <class BBox>
-  bool kdtree_get_bbox(BBox&) const { return false; }
+  bool kdtree_get_bbox(BBox&) const {
+    return false;
+  }
 };
 
-using Vec3Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Vec3Cloud>, Vec3Cloud, 3, std::uint32_t>;
-using Vec3DynamicTree =
-    nanoflann::KDTreeSingleIndexDynamicAdaptor<nanoflann::L2_Simple_Adaptor<float, Vec3Cloud>, Vec3Cloud, 3, std::uint32_t>;
+using Vec3Tree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Vec3Cloud>, Vec3Cloud, 3, std::uint32_t>;
+using Vec3DynamicTree = nanoflann::KDTreeSingleIndexDynamicAdaptor<nanoflann::L2_Simple_Adaptor<float, Vec3Cloud>,
+                                                                   Vec3Cloud, 3, std::uint32_t>;
 
 // Visits the points of `tree` closer than `radius` to `centre`: visit(index, d2) gets each with its
 // squared distance as nanoflann computes it, in the tree's order, and returns false to end the search.

@@ -14,12 +14,18 @@ namespace growbench {
 
 std::string_view to_string(ParamType t) {
   switch (t) {
-    case ParamType::Int: return "int";
-    case ParamType::Real: return "real";
-    case ParamType::Bool: return "bool";
-    case ParamType::String: return "string";
-    case ParamType::Vec3: return "vec3";
-    case ParamType::Choice: return "choice";
+    case ParamType::Int:
+      return "int";
+    case ParamType::Real:
+      return "real";
+    case ParamType::Bool:
+      return "bool";
+    case ParamType::String:
+      return "string";
+    case ParamType::Vec3:
+      return "vec3";
+    case ParamType::Choice:
+      return "choice";
   }
   return "?";
 }
@@ -35,11 +41,16 @@ std::string format_value(const ParamValue& v) {
   return std::visit(
       [](const auto& x) -> std::string {
         using T = std::decay_t<decltype(x)>;
-        if constexpr (std::is_same_v<T, std::int64_t>) return fmt::format("{}", x);
-        else if constexpr (std::is_same_v<T, double>) return fmt_num(x);
-        else if constexpr (std::is_same_v<T, bool>) return x ? "true" : "false";
-        else if constexpr (std::is_same_v<T, std::string>) return x;
-        else return fmt::format("{},{},{}", fmt_num(x.x), fmt_num(x.y), fmt_num(x.z));
+        if constexpr (std::is_same_v<T, std::int64_t>)
+          return fmt::format("{}", x);
+        else if constexpr (std::is_same_v<T, double>)
+          return fmt_num(x);
+        else if constexpr (std::is_same_v<T, bool>)
+          return x ? "true" : "false";
+        else if constexpr (std::is_same_v<T, std::string>)
+          return x;
+        else
+          return fmt::format("{},{},{}", fmt_num(x.x), fmt_num(x.y), fmt_num(x.z));
       },
       v);
 }
@@ -49,12 +60,18 @@ std::string ParamSpec::allowed() const {
   if (std::isfinite(min) || std::isfinite(max)) range = fmt::format(" in [{}, {}]", fmt_num(min), fmt_num(max));
   const std::string u = unit.empty() ? "" : fmt::format(" ({})", unit);
   switch (type) {
-    case ParamType::Int: return fmt::format("an integer{}{}", range, u);
-    case ParamType::Real: return fmt::format("a finite real number{}{}", range, u);
-    case ParamType::Bool: return "a boolean (true/false, 1/0, yes/no, on/off)";
-    case ParamType::String: return "a string";
-    case ParamType::Vec3: return fmt::format("three comma-separated numbers x,y,z each{}{}", range, u);
-    case ParamType::Choice: return fmt::format("one of {}", fmt::join(choices, ", "));
+    case ParamType::Int:
+      return fmt::format("an integer{}{}", range, u);
+    case ParamType::Real:
+      return fmt::format("a finite real number{}{}", range, u);
+    case ParamType::Bool:
+      return "a boolean (true/false, 1/0, yes/no, on/off)";
+    case ParamType::String:
+      return "a string";
+    case ParamType::Vec3:
+      return fmt::format("three comma-separated numbers x,y,z each{}{}", range, u);
+    case ParamType::Choice:
+      return fmt::format("one of {}", fmt::join(choices, ", "));
   }
   return "?";
 }
@@ -79,15 +96,25 @@ Row&& Row::doc(std::string doc) && {
   spec_.doc = std::move(doc);
   return std::move(*this);
 }
-Row::operator ParamSpec() && { return std::move(spec_); }
+Row::operator ParamSpec() && {
+  return std::move(spec_);
+}
 
-Row integer(std::string name, std::int64_t default_value) { return {std::move(name), ParamType::Int, default_value}; }
-Row real(std::string name, double default_value) { return {std::move(name), ParamType::Real, default_value}; }
-Row boolean(std::string name, bool default_value) { return {std::move(name), ParamType::Bool, default_value}; }
+Row integer(std::string name, std::int64_t default_value) {
+  return {std::move(name), ParamType::Int, default_value};
+}
+Row real(std::string name, double default_value) {
+  return {std::move(name), ParamType::Real, default_value};
+}
+Row boolean(std::string name, bool default_value) {
+  return {std::move(name), ParamType::Bool, default_value};
+}
 Row text(std::string name, std::string default_value) {
   return {std::move(name), ParamType::String, std::move(default_value)};
 }
-Row vec3(std::string name, const glm::dvec3& default_value) { return {std::move(name), ParamType::Vec3, default_value}; }
+Row vec3(std::string name, const glm::dvec3& default_value) {
+  return {std::move(name), ParamType::Vec3, default_value};
+}
 Row choice(std::string name, std::string default_value, std::vector<std::string> choices) {
   if (std::find(choices.begin(), choices.end(), default_value) == choices.end())
     throw std::logic_error(fmt::format("parameter '{}': default '{}' is not one of its choices", name, default_value));
@@ -109,7 +136,8 @@ std::string closest_match(std::string_view name, const std::vector<std::string>&
       for (std::size_t j = 1; j <= b.size(); ++j) {
         const std::size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
         d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + cost});
-        if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+        if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
+          d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
       }
     }
     return d[a.size()][b.size()];
@@ -141,23 +169,26 @@ std::size_t Params::index_of(std::string_view key) const {
   for (const auto& s : specs_) names.push_back(s.name);
   const std::string near = closest_match(key, names);
   throw InputError(fmt::format("unknown parameter '{}' for {}{}; known parameters: {}", key, owner_,
-                               near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near),
-                               fmt::join(names, ", ")));
+                               near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near), fmt::join(names, ", ")));
 }
 
 void Params::check_and_store(std::size_t i, ParamValue v, std::string_view shown) {
   const ParamSpec& s = specs_[i];
   auto bad = [&](std::string_view why) {
-    throw InputError(fmt::format("parameter '{}' of {}: value '{}' {}; expected {}", s.name, owner_, shown,
-                                 why, s.allowed()));
+    throw InputError(
+        fmt::format("parameter '{}' of {}: value '{}' {}; expected {}", s.name, owner_, shown, why, s.allowed()));
   };
   auto check_range = [&](double x) {
     if (!std::isfinite(x)) bad("is not finite");
     if (x < s.min || x > s.max) bad("is out of range");
   };
   switch (s.type) {
-    case ParamType::Int: check_range(static_cast<double>(std::get<std::int64_t>(v))); break;
-    case ParamType::Real: check_range(std::get<double>(v)); break;
+    case ParamType::Int:
+      check_range(static_cast<double>(std::get<std::int64_t>(v)));
+      break;
+    case ParamType::Real:
+      check_range(std::get<double>(v));
+      break;
     case ParamType::Vec3: {
       const auto& x = std::get<glm::dvec3>(v);
       check_range(x.x);
@@ -171,7 +202,8 @@ void Params::check_and_store(std::size_t i, ParamValue v, std::string_view shown
         bad(near.empty() ? "is not a valid choice" : fmt::format("is not a valid choice (did you mean '{}'?)", near));
       }
       break;
-    default: break;
+    default:
+      break;
   }
   values_[i] = std::move(v);
   set_[i] = true;
@@ -219,8 +251,8 @@ void Params::set(std::string_view key, std::string_view text) {
   const std::size_t i = index_of(key);
   const ParamSpec& s = specs_[i];
   auto bad = [&]() {
-    throw InputError(fmt::format("parameter '{}' of {}: cannot read '{}'; expected {}", s.name, owner_, text,
-                                 s.allowed()));
+    throw InputError(
+        fmt::format("parameter '{}' of {}: cannot read '{}'; expected {}", s.name, owner_, text, s.allowed()));
   };
   switch (s.type) {
     case ParamType::Int: {
@@ -244,14 +276,19 @@ void Params::set(std::string_view key, std::string_view text) {
       std::string t(text);
       std::transform(t.begin(), t.end(), t.begin(), [](unsigned char c) { return std::tolower(c); });
       bool v = false;
-      if (t == "true" || t == "1" || t == "yes" || t == "on") v = true;
-      else if (t == "false" || t == "0" || t == "no" || t == "off") v = false;
-      else bad();
+      if (t == "true" || t == "1" || t == "yes" || t == "on")
+        v = true;
+      else if (t == "false" || t == "0" || t == "no" || t == "off")
+        v = false;
+      else
+        bad();
       check_and_store(i, v, text);
       break;
     }
     case ParamType::String:
-    case ParamType::Choice: check_and_store(i, std::string(text), text); break;
+    case ParamType::Choice:
+      check_and_store(i, std::string(text), text);
+      break;
     case ParamType::Vec3: {
       glm::dvec3 v{0.0};
       std::string_view rest = text;
@@ -277,10 +314,12 @@ void Params::set_json(std::string_view key, const nlohmann::json& j) {
   };
   switch (s.type) {
     case ParamType::Int:
-      if (j.is_number_integer()) check_and_store(i, j.get<std::int64_t>(), shown);
+      if (j.is_number_integer())
+        check_and_store(i, j.get<std::int64_t>(), shown);
       else if (j.is_number_float() && j.get<double>() == std::floor(j.get<double>()))
         check_and_store(i, static_cast<std::int64_t>(j.get<double>()), shown);
-      else bad();
+      else
+        bad();
       break;
     case ParamType::Real:
       if (!j.is_number()) bad();
@@ -314,21 +353,29 @@ const ParamValue& Params::value(std::string_view key, ParamType expected) const 
   const ParamType t = specs_[i].type;
   const bool ok = t == expected || (expected == ParamType::String && t == ParamType::Choice);
   if (!ok)  // a programming error in an algorithm, not user input
-    throw std::logic_error(fmt::format("parameter '{}' of {} is {}, read as {}", key, owner_, to_string(t),
-                                       to_string(expected)));
+    throw std::logic_error(
+        fmt::format("parameter '{}' of {} is {}, read as {}", key, owner_, to_string(t), to_string(expected)));
   return values_[i];
 }
 
 std::int64_t Params::integer(std::string_view key) const {
   return std::get<std::int64_t>(value(key, ParamType::Int));
 }
-double Params::real(std::string_view key) const { return std::get<double>(value(key, ParamType::Real)); }
-bool Params::boolean(std::string_view key) const { return std::get<bool>(value(key, ParamType::Bool)); }
+double Params::real(std::string_view key) const {
+  return std::get<double>(value(key, ParamType::Real));
+}
+bool Params::boolean(std::string_view key) const {
+  return std::get<bool>(value(key, ParamType::Bool));
+}
 const std::string& Params::text(std::string_view key) const {
   return std::get<std::string>(value(key, ParamType::String));
 }
-glm::dvec3 Params::vec3(std::string_view key) const { return std::get<glm::dvec3>(value(key, ParamType::Vec3)); }
-bool Params::was_set(std::string_view key) const { return set_[index_of(key)]; }
+glm::dvec3 Params::vec3(std::string_view key) const {
+  return std::get<glm::dvec3>(value(key, ParamType::Vec3));
+}
+bool Params::was_set(std::string_view key) const {
+  return set_[index_of(key)];
+}
 
 nlohmann::json Params::to_json() const {
   nlohmann::json j = nlohmann::json::object();
@@ -336,8 +383,10 @@ nlohmann::json Params::to_json() const {
     std::visit(
         [&](const auto& x) {
           using T = std::decay_t<decltype(x)>;
-          if constexpr (std::is_same_v<T, glm::dvec3>) j[specs_[i].name] = {x.x, x.y, x.z};
-          else j[specs_[i].name] = x;
+          if constexpr (std::is_same_v<T, glm::dvec3>)
+            j[specs_[i].name] = {x.x, x.y, x.z};
+          else
+            j[specs_[i].name] = x;
         },
         values_[i]);
   }

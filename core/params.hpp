@@ -86,7 +86,7 @@ class Params {
   // Installs presets (see ParamPreset) and applies the one the `preset` parameter names now.
   void set_presets(const std::vector<ParamPreset>& presets);
 
-  void set(std::string_view key, std::string_view text);       // parse and validate
+  void set(std::string_view key, std::string_view text);  // parse and validate
   void set_json(std::string_view key, const nlohmann::json& value);
   // "key=value" as given on the command line.
   void set_assignment(std::string_view assignment);

@@ -38,8 +38,7 @@ class Rng {
     const double z = uniform(-1.0, 1.0);
     const double phi = uniform(0.0, 2.0 * std::numbers::pi);
     const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-    return {static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
-            static_cast<float>(z)};
+    return {static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)), static_cast<float>(z)};
   }
   // Uniform in the unit ball.
   glm::vec3 in_unit_ball() {

@@ -38,13 +38,12 @@ std::pair<V, TriangleFeature> closest_feature(const V& p, const V& a, const V& b
 }  // namespace
 
 TriangleFeaturePoint closest_feature_on_triangle(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b,
-                                                const glm::dvec3& c) {
+                                                 const glm::dvec3& c) {
   const auto [q, f] = closest_feature(p, a, b, c);
   return {q, f};
 }
 
-glm::vec3 closest_point_on_triangle(const glm::vec3& p, const glm::vec3& a, const glm::vec3& b,
-                                    const glm::vec3& c) {
+glm::vec3 closest_point_on_triangle(const glm::vec3& p, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
   return closest_feature(p, a, b, c).first;
 }
 
@@ -53,12 +52,17 @@ namespace {
 // The interval that triangle t covers on the line (point o, direction d) where its plane meets the
 // other's: dist holds t's signed distances to the other plane (not all zero, not all on one side). The
 // line crosses the two edges from the vertex alone on its side (Moller 1997).
-std::pair<double, double> line_interval(const glm::dvec3 t[3], const glm::dvec3& dist, const glm::dvec3& o, const glm::dvec3& d) {
+std::pair<double, double> line_interval(const glm::dvec3 t[3], const glm::dvec3& dist, const glm::dvec3& o,
+                                        const glm::dvec3& d) {
   int lone = 2;
-  if (dist[0] * dist[1] > 0) lone = 2;
-  else if (dist[0] * dist[2] > 0) lone = 1;
-  else if (dist[1] * dist[2] > 0 || dist[0] != 0) lone = 0;
-  else if (dist[1] != 0) lone = 1;
+  if (dist[0] * dist[1] > 0)
+    lone = 2;
+  else if (dist[0] * dist[2] > 0)
+    lone = 1;
+  else if (dist[1] * dist[2] > 0 || dist[0] != 0)
+    lone = 0;
+  else if (dist[1] != 0)
+    lone = 1;
   auto cross_at = [&](int other) {  // never divides by zero: dist[lone] and dist[other] differ in sign or one is 0
     const double s = dist[lone] / (dist[lone] - dist[other]);
     return glm::dot(t[lone] + s * (t[other] - t[lone]) - o, d);
@@ -94,7 +98,7 @@ double overlap_area_2d(const glm::dvec2 (&a)[3], const glm::dvec2 (&b)[3]) {
 
 bool triangles_overlap(const glm::vec3 (&t1)[3], const glm::vec3 (&t2)[3]) {
   const glm::dvec3 a[3] = {t1[0], t1[1], t1[2]}, b[3] = {t2[0], t2[1], t2[2]};
-  auto size_of = [](const glm::dvec3 (&t)[3]) {
+  auto size_of = [](const glm::dvec3(&t)[3]) {
     return std::max({glm::length(t[1] - t[0]), glm::length(t[2] - t[1]), glm::length(t[0] - t[2])});
   };
   const double scale = std::max(size_of(a), size_of(b));
@@ -112,7 +116,7 @@ bool triangles_overlap(const glm::vec3 (&t1)[3], const glm::vec3 (&t2)[3]) {
   na /= la;
   nb /= lb;
   // Each triangle's vertices against the other's plane; within eps counts as on it.
-  auto against = [&](const glm::dvec3 (&t)[3], const glm::dvec3& n, const glm::dvec3& o) {
+  auto against = [&](const glm::dvec3(&t)[3], const glm::dvec3& n, const glm::dvec3& o) {
     glm::dvec3 d;
     for (int i = 0; i < 3; ++i) {
       d[i] = glm::dot(n, t[i] - o);
@@ -122,7 +126,9 @@ bool triangles_overlap(const glm::vec3 (&t1)[3], const glm::vec3 (&t2)[3]) {
   };
   const glm::dvec3 da = against(a, nb, b[0]), db = against(b, na, a[0]);
   auto zeros = [](const glm::dvec3& d) { return (d[0] == 0.0) + (d[1] == 0.0) + (d[2] == 0.0); };
-  auto one_side = [](const glm::dvec3& d) { return (d[0] >= 0 && d[1] >= 0 && d[2] >= 0) || (d[0] <= 0 && d[1] <= 0 && d[2] <= 0); };
+  auto one_side = [](const glm::dvec3& d) {
+    return (d[0] >= 0 && d[1] >= 0 && d[2] >= 0) || (d[0] <= 0 && d[1] <= 0 && d[2] <= 0);
+  };
   if (zeros(da) < 3 && zeros(db) < 3) {
     // A triangle on one side of the other's plane meets it in a vertex at most, or in an edge lying on
     // it. Otherwise both cut the line where the planes meet, and their intervals there must share more
@@ -151,8 +157,7 @@ TriangleMesh make_box(const std::string& name, const glm::vec3& lo, const glm::v
   for (int i = 0; i < 8; ++i)
     m.vertices.emplace_back((i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z);
   // Outward-facing (counter-clockwise seen from outside).
-  const unsigned f[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
-                            {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+  const unsigned f[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
   for (const auto& q : f) {
     m.triangles.emplace_back(q[0], q[1], q[2]);
     m.triangles.emplace_back(q[0], q[2], q[3]);
@@ -160,8 +165,8 @@ TriangleMesh make_box(const std::string& name, const glm::vec3& lo, const glm::v
   return m;
 }
 
-TriangleMesh make_cylinder(const std::string& name, const glm::vec3& base, const glm::vec3& top,
-                           float r0, float r1, int sides) {
+TriangleMesh make_cylinder(const std::string& name, const glm::vec3& base, const glm::vec3& top, float r0, float r1,
+                           int sides) {
   TriangleMesh m;
   m.name = name;
   const glm::vec3 axis = glm::normalize(top - base);
@@ -190,19 +195,16 @@ TriangleMesh make_cylinder(const std::string& name, const glm::vec3& base, const
   return m;
 }
 
-TriangleMesh make_icosphere(const std::string& name, const glm::vec3& center, float radius,
-                            int subdivisions) {
+TriangleMesh make_icosphere(const std::string& name, const glm::vec3& center, float radius, int subdivisions) {
   TriangleMesh m;
   m.name = name;
   const float t = (1.0f + std::sqrt(5.0f)) / 2.0f;
-  std::vector<glm::vec3> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
-                              {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
-                              {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<glm::vec3> v = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                              {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
   for (auto& p : v) p = glm::normalize(p);
-  std::vector<glm::uvec3> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                               {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                               {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                               {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+  std::vector<glm::uvec3> f = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                               {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+                               {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
   for (int s = 0; s < subdivisions; ++s) {
     std::map<std::pair<unsigned, unsigned>, unsigned> mid;
     auto midpoint = [&](unsigned a, unsigned b) {
@@ -261,7 +263,8 @@ bool ear_clip(const std::vector<glm::vec3>& vertices, const std::vector<unsigned
   const glm::dvec3 helper = std::abs(normal.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
   const glm::dvec3 u = glm::normalize(glm::cross(normal, helper)), v = glm::cross(normal, u);
   std::vector<glm::dvec2> p(n);
-  for (std::size_t i = 0; i < n; ++i) p[i] = {glm::dot(glm::dvec3(vertices[loop[i]]), u), glm::dot(glm::dvec3(vertices[loop[i]]), v)};
+  for (std::size_t i = 0; i < n; ++i)
+    p[i] = {glm::dot(glm::dvec3(vertices[loop[i]]), u), glm::dot(glm::dvec3(vertices[loop[i]]), v)};
   auto cross2 = [](const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c) {
     return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
   };
@@ -328,7 +331,8 @@ bool fill_small_holes(TriangleMesh& m, double max_boundary_fraction) {
       for (const auto v : loop) c += glm::dvec3(m.vertices[v]);
       const auto centre = static_cast<unsigned>(filled.vertices.size());
       filled.vertices.emplace_back(c / static_cast<double>(loop.size()));
-      for (std::size_t i = 0; i < loop.size(); ++i) filled.triangles.emplace_back(centre, loop[i], loop[(i + 1) % loop.size()]);
+      for (std::size_t i = 0; i < loop.size(); ++i)
+        filled.triangles.emplace_back(centre, loop[i], loop[(i + 1) % loop.size()]);
     }
   }
   if (!filled.is_closed()) return false;

@@ -11,8 +11,7 @@
 namespace growbench::geom {
 
 // Closest point on triangle (a, b, c) to p (Ericson, Real-Time Collision Detection, 5.1.5).
-glm::vec3 closest_point_on_triangle(const glm::vec3& p, const glm::vec3& a, const glm::vec3& b,
-                                    const glm::vec3& c);
+glm::vec3 closest_point_on_triangle(const glm::vec3& p, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c);
 
 // The same in double precision, with the feature the point lies on: a vertex, the interior of an edge,
 // or the face. The feature picks the pseudonormal that decides the side of p (SceneQuery's exact inside
@@ -24,7 +23,7 @@ struct TriangleFeaturePoint {
   TriangleFeature feature;
 };
 TriangleFeaturePoint closest_feature_on_triangle(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b,
-                                                const glm::dvec3& c);
+                                                 const glm::dvec3& c);
 
 // Whether two triangles share more than isolated points: they cross along a segment, or lie in one plane
 // sharing area (Moller's interval test in double precision; coplanar pairs by clipping). Touching at a
@@ -38,10 +37,9 @@ std::vector<glm::vec3> vertex_normal_sums(const TriangleMesh& mesh);
 
 // Closed, outward-facing primitive meshes.
 TriangleMesh make_box(const std::string& name, const glm::vec3& min, const glm::vec3& max);
-TriangleMesh make_cylinder(const std::string& name, const glm::vec3& base, const glm::vec3& top,
-                           float radius_base, float radius_top, int sides);
-TriangleMesh make_icosphere(const std::string& name, const glm::vec3& center, float radius,
-                            int subdivisions);
+TriangleMesh make_cylinder(const std::string& name, const glm::vec3& base, const glm::vec3& top, float radius_base,
+                           float radius_top, int sides);
+TriangleMesh make_icosphere(const std::string& name, const glm::vec3& center, float radius, int subdivisions);
 
 // Closes the holes of a nearly closed mesh (boundary edges at most `max_boundary_fraction` of all
 // edges): each boundary loop is triangulated by ear clipping in its best-fit plane, or, when its

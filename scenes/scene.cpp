@@ -129,7 +129,9 @@ struct Hasher {
   Hasher& operator=(const Hasher&) = delete;
   void bytes(const void* p, std::size_t n) { XXH3_64bits_update(st, p, n); }
   template <class T>
-  void pod(const T& v) { bytes(&v, sizeof(T)); }
+  void pod(const T& v) {
+    bytes(&v, sizeof(T));
+  }
   void str(const std::string& s) {
     pod(s.size());
     bytes(s.data(), s.size());

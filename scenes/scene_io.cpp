@@ -39,10 +39,10 @@ std::string mesh_path(const std::string& ref) {
   std::string near = closest_match(ref, names);
   for (const auto& n : names)  // "bunny" means the Stanford bunny
     if (near.empty() && n.find(ref) != std::string::npos) near = n;
-  throw InputError(fmt::format("unknown mesh '{}'{}; expected a bundled mesh ({}) or a path to an OBJ file", ref,
-                               near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near),
-                               names.empty() ? fmt::format("none found in {}", GROWBENCH_MESH_DIR)
-                                             : fmt::format("{}", fmt::join(names, ", "))));
+  throw InputError(fmt::format(
+      "unknown mesh '{}'{}; expected a bundled mesh ({}) or a path to an OBJ file", ref,
+      near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near),
+      names.empty() ? fmt::format("none found in {}", GROWBENCH_MESH_DIR) : fmt::format("{}", fmt::join(names, ", "))));
 }
 
 TriangleMesh load_obj(const std::string& path) {
@@ -190,7 +190,8 @@ class JsonScene : public JsonPathReader {
   float number(const json& j, const std::string& path, float lo = -1e30f, float hi = 1e30f) const {
     if (!j.is_number()) fail(path, fmt::format("expected a number, got {}", j.dump()));
     const double v = j.get<double>();
-    if (!std::isfinite(v) || v < lo || v > hi) fail(path, fmt::format("expected a number in [{}, {}], got {}", lo, hi, v));
+    if (!std::isfinite(v) || v < lo || v > hi)
+      fail(path, fmt::format("expected a number in [{}, {}], got {}", lo, hi, v));
     return static_cast<float>(v);
   }
   glm::vec3 vec3(const json& j, const std::string& path) const {
@@ -241,7 +242,9 @@ class JsonScene : public JsonPathReader {
       ++kinds;
       const auto& s = j["sphere"];
       only_keys(s, path + "/sphere", {"center", "radius", "subdivisions"});
-      const int sub = s.contains("subdivisions") ? static_cast<int>(number(s["subdivisions"], path + "/sphere/subdivisions", 0, 7)) : 4;
+      const int sub = s.contains("subdivisions")
+                          ? static_cast<int>(number(s["subdivisions"], path + "/sphere/subdivisions", 0, 7))
+                          : 4;
       m = geom::make_icosphere(name, vec3(need(s, path + "/sphere", "center"), path + "/sphere/center"),
                                number(need(s, path + "/sphere", "radius"), path + "/sphere/radius", 1e-6f), sub);
     }
@@ -265,8 +268,10 @@ class JsonScene : public JsonPathReader {
       only_keys(t, tp, {"translate", "rotate_deg", "scale"});
       glm::vec3 scale(1.0f);
       if (t.contains("scale")) {
-        if (t["scale"].is_number()) scale = glm::vec3(number(t["scale"], tp + "/scale", 1e-9f));
-        else scale = vec3(t["scale"], tp + "/scale");
+        if (t["scale"].is_number())
+          scale = glm::vec3(number(t["scale"], tp + "/scale", 1e-9f));
+        else
+          scale = vec3(t["scale"], tp + "/scale");
         if (glm::any(glm::equal(scale, glm::vec3(0.0f)))) fail(tp + "/scale", "expected non-zero scale factors");
       }
       m.transform(geom::trs(t.contains("translate") ? vec3(t["translate"], tp + "/translate") : glm::vec3(0.0f),
@@ -311,9 +316,11 @@ class JsonScene : public JsonPathReader {
     return s;
   }
 
+  // Long because it reads each key of a scene file in turn, one short block per key, in the file's order.
   Scene scene(const json& j) const {
-    only_keys(j, "", {"schema_version", "name", "base", "base_params", "meshes", "seeds", "light", "envelope", "zones",
-                      "camera"});
+    only_keys(
+        j, "",
+        {"schema_version", "name", "base", "base_params", "meshes", "seeds", "light", "envelope", "zones", "camera"});
     const auto& ver = need(j, "", "schema_version");
     if (!ver.is_number_integer() || ver.get<int>() != 1)
       fail("/schema_version", fmt::format("expected 1 (the only scene schema so far), got {}", ver.dump()));
@@ -327,7 +334,8 @@ class JsonScene : public JsonPathReader {
           params.push_back(k + "=" + (v.is_string() ? v.get<std::string>() : v.dump()));
       }
       std::string base = string(j["base"], "/base");
-      if (base.rfind("mesh:", 0) == 0 && !is_mesh_name(base.substr(5))) base = "mesh:" + resolve(base.substr(5), "/base");
+      if (base.rfind("mesh:", 0) == 0 && !is_mesh_name(base.substr(5)))
+        base = "mesh:" + resolve(base.substr(5), "/base");
       try {
         s = load_scene(base, params);
       } catch (const InputError& e) {
@@ -355,7 +363,8 @@ class JsonScene : public JsonPathReader {
           if (glm::length(sd.direction) <= 0.0f) fail(p + "/direction", "expected a non-zero direction");
           sd.direction = glm::normalize(sd.direction);
         }
-        if (ss[i].contains("start_step")) sd.start_step = static_cast<int>(number(ss[i]["start_step"], p + "/start_step", 0, 1e9f));
+        if (ss[i].contains("start_step"))
+          sd.start_step = static_cast<int>(number(ss[i]["start_step"], p + "/start_step", 0, 1e9f));
         s.seeds.push_back(sd);
       }
     }
@@ -385,11 +394,16 @@ class JsonScene : public JsonPathReader {
         only_keys(zs[i], p, {"kind", "shape", "strength"});
         Zone z;
         const std::string kind = string(need(zs[i], p, "kind"), p + "/kind");
-        if (kind == "attract") z.kind = Zone::Kind::Attract;
-        else if (kind == "repel") z.kind = Zone::Kind::Repel;
-        else if (kind == "include") z.kind = Zone::Kind::Include;
-        else if (kind == "exclude") z.kind = Zone::Kind::Exclude;
-        else fail(p + "/kind", fmt::format("unknown zone kind '{}'; expected attract, repel, include or exclude", kind));
+        if (kind == "attract")
+          z.kind = Zone::Kind::Attract;
+        else if (kind == "repel")
+          z.kind = Zone::Kind::Repel;
+        else if (kind == "include")
+          z.kind = Zone::Kind::Include;
+        else if (kind == "exclude")
+          z.kind = Zone::Kind::Exclude;
+        else
+          fail(p + "/kind", fmt::format("unknown zone kind '{}'; expected attract, repel, include or exclude", kind));
         z.shape = shape(need(zs[i], p, "shape"), p + "/shape");
         if (zs[i].contains("strength")) z.strength = number(zs[i]["strength"], p + "/strength", 0.0f, 1e6f);
         s.zones.push_back(std::move(z));
@@ -430,7 +444,8 @@ Scene load_scene(const std::string& spec, const std::vector<std::string>& assign
     s = mesh_scene(path, p);
   } else if (spec.size() > 5 && spec.substr(spec.size() - 5) == ".json") {
     if (!assignments.empty())
-      throw InputError(fmt::format("scene '{}': scene parameters go in the file's 'base_params', not on the command line", spec));
+      throw InputError(
+          fmt::format("scene '{}': scene parameters go in the file's 'base_params', not on the command line", spec));
     s = json_scene(spec);
   } else {
     const auto& list = standard_scenes();

@@ -220,7 +220,8 @@ struct SceneQuery::Solid {
     }
     edge.resize(3 * m.triangles.size());
     for (std::size_t t = 0; t < m.triangles.size(); ++t)
-      for (int k = 0; k < 3; ++k) edge[3 * t + static_cast<std::size_t>(k)] = edges.at(key(m.triangles[t][k], m.triangles[t][(k + 1) % 3]));
+      for (int k = 0; k < 3; ++k)
+        edge[3 * t + static_cast<std::size_t>(k)] = edges.at(key(m.triangles[t][k], m.triangles[t][(k + 1) % 3]));
     pts = m.vertices;
     tree = std::make_unique<Vec3Tree>(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
   }
@@ -229,13 +230,20 @@ struct SceneQuery::Solid {
     using F = geom::TriangleFeature;
     const auto& tri = m.triangles[t];
     switch (f) {
-      case F::VertexA: return vertex[tri.x];
-      case F::VertexB: return vertex[tri.y];
-      case F::VertexC: return vertex[tri.z];
-      case F::EdgeAB: return edge[3 * t];
-      case F::EdgeBC: return edge[3 * t + 1];
-      case F::EdgeCA: return edge[3 * t + 2];
-      case F::Face: break;
+      case F::VertexA:
+        return vertex[tri.x];
+      case F::VertexB:
+        return vertex[tri.y];
+      case F::VertexC:
+        return vertex[tri.z];
+      case F::EdgeAB:
+        return edge[3 * t];
+      case F::EdgeBC:
+        return edge[3 * t + 1];
+      case F::EdgeCA:
+        return edge[3 * t + 2];
+      case F::Face:
+        break;
     }
     return face[t];
   }
@@ -277,7 +285,9 @@ struct SceneQuery::Embree {
   std::vector<std::pair<const Shape*, std::unique_ptr<BvhScene>>> shapes;  // mesh envelopes/zones
   Embree() {
     device = rtcNewDevice("threads=0");
-    if (!device) throw std::runtime_error(fmt::format("Embree: cannot create a device (error {})", static_cast<int>(rtcGetDeviceError(nullptr))));
+    if (!device)
+      throw std::runtime_error(
+          fmt::format("Embree: cannot create a device (error {})", static_cast<int>(rtcGetDeviceError(nullptr))));
     rtcSetDeviceErrorFunction(device, embree_error, nullptr);
   }
   ~Embree() {
@@ -293,7 +303,8 @@ SceneQuery::SceneQuery(const Scene& scene, SceneQueryOptions options)
     : scene_(scene), options_(options), embree_(std::make_unique<Embree>()) {
   if (scene.meshes.empty()) throw InputError(fmt::format("scene '{}' has no meshes", scene.name));
   for (const auto& m : scene.meshes)
-    if (m.triangles.empty()) throw InputError(fmt::format("scene '{}': mesh '{}' has no triangles", scene.name, m.name));
+    if (m.triangles.empty())
+      throw InputError(fmt::format("scene '{}': mesh '{}' has no triangles", scene.name, m.name));
 
   auto t0 = std::chrono::steady_clock::now();
   std::vector<const TriangleMesh*> ptrs;
@@ -463,10 +474,10 @@ Occluder::Occluder(void* device, std::vector<Capsule> capsules, std::vector<Tria
   rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
   if (!capsules.empty()) {
     RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE);
-    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float),
-                                                           2 * capsules.size()));
-    auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT, sizeof(unsigned),
-                                                              capsules.size()));
+    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
+                                                           4 * sizeof(float), 2 * capsules.size()));
+    auto* ib = static_cast<unsigned*>(
+        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT, sizeof(unsigned), capsules.size()));
     for (std::size_t i = 0; i < capsules.size(); ++i) {
       const Capsule& c = capsules[i];
       const float v[8] = {c.a.x, c.a.y, c.a.z, c.ra, c.b.x, c.b.y, c.b.z, c.rb};
@@ -479,10 +490,10 @@ Occluder::Occluder(void* device, std::vector<Capsule> capsules, std::vector<Tria
   }
   if (!triangles.empty()) {
     RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-                                                           3 * triangles.size()));
-    auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                              3 * sizeof(unsigned), triangles.size()));
+    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                           3 * sizeof(float), 3 * triangles.size()));
+    auto* ib = static_cast<unsigned*>(
+        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), triangles.size()));
     owners_.reserve(triangles.size());
     for (std::size_t i = 0; i < triangles.size(); ++i) {
       for (int k = 0; k < 3; ++k) {
@@ -501,7 +512,8 @@ Occluder::Occluder(void* device, std::vector<Capsule> capsules, std::vector<Tria
   tbb::task_arena one(1);
   one.execute([&] { rtcCommitScene(impl_->scene); });
   if (const RTCError e = rtcGetDeviceError(dev); e != RTC_ERROR_NONE)
-    throw std::runtime_error(fmt::format("Embree: building the plant's occluder failed (error {})", static_cast<int>(e)));
+    throw std::runtime_error(
+        fmt::format("Embree: building the plant's occluder failed (error {})", static_cast<int>(e)));
 }
 
 Occluder::~Occluder() = default;
@@ -548,7 +560,8 @@ bool SceneQuery::inside_mesh(std::uint32_t mesh, const glm::vec3& p) const {
   // Within a float's rounding of the surface (a micrometre at metre scale) a point is on it: outside.
   const glm::vec3 a = glm::abs(p);
   if (!st.found || st.distance <= 1e-6 * std::max({1.0f, a.x, a.y, a.z})) return false;
-  return glm::dot(glm::dvec3(p) - st.closest.point, glm::dvec3(solid.pseudonormal(scene_.meshes[mesh], st.triangle, st.closest.feature))) < 0.0;
+  return glm::dot(glm::dvec3(p) - st.closest.point,
+                  glm::dvec3(solid.pseudonormal(scene_.meshes[mesh], st.triangle, st.closest.feature))) < 0.0;
 }
 
 ClosestHit SceneQuery::closest_point(const glm::vec3& p, float max_distance, bool climbable_only) const {
@@ -599,8 +612,10 @@ SceneQuery::BandSample SceneQuery::band_sample(const glm::vec3& p) const {
   const float len = glm::length(g);
   // A cell with any corner at the background value is not resolved: treat it as outside the band.
   s.in_band = std::abs(s.distance) < 0.999f * band - voxel_size_ && len > 1e-12f;
-  if (s.in_band) s.gradient = g / len;
-  else s.distance = s.distance < 0.0f ? -band : band;
+  if (s.in_band)
+    s.gradient = g / len;
+  else
+    s.distance = s.distance < 0.0f ? -band : band;
   return s;
 }
 
@@ -643,6 +658,8 @@ SurfaceSample SceneQuery::sample_surface(std::uint64_t seed, std::uint64_t index
   return {a * m.vertices[t.x] + b * m.vertices[t.y] + c * m.vertices[t.z], face_normal(m, ti), mi, ti};
 }
 
-std::size_t SceneQuery::sdf_active_voxels() const { return sdf_ ? sdf_->active_voxels() : 0; }
+std::size_t SceneQuery::sdf_active_voxels() const {
+  return sdf_ ? sdf_->active_voxels() : 0;
+}
 
 }  // namespace growbench

@@ -33,7 +33,7 @@ namespace growbench {
 struct SceneQueryOptions {
   float voxel_size = 0.0f;  // 0: the meshes' bounding-box diagonal / 256
   float band_voxels = 3.0f;
-  bool build_sdf = true;    // false: only Embree (signed_distance etc. then throw)
+  bool build_sdf = true;  // false: only Embree (signed_distance etc. then throw)
 };
 
 struct ClosestHit {
@@ -76,7 +76,9 @@ class BoxIndex {
   using Visitor = bool (*)(void* user, std::uint32_t id);
   // Visits every box that contains p, and possibly a few that do not (Embree's leaves hold several
   // boxes): the visitor tests its own rule.
-  void visit_containing(const glm::vec3& p, Visitor visit, void* user) const { visit_segment(p, glm::vec3(0.0f), visit, user); }
+  void visit_containing(const glm::vec3& p, Visitor visit, void* user) const {
+    visit_segment(p, glm::vec3(0.0f), visit, user);
+  }
   // Visits every box the segment from o to o + d passes through (and possibly a few more). Boxes
   // touched only within rounding of their faces may be missed: pad the boxes if that matters.
   void visit_segment(const glm::vec3& o, const glm::vec3& d, Visitor visit, void* user) const;
@@ -129,7 +131,8 @@ class SceneQuery {
 
   // Closest surface point within max_distance (not found beyond it). climbable_only: among the climbable
   // meshes only (when the scene marks any; otherwise all meshes count).
-  [[nodiscard]] ClosestHit closest_point(const glm::vec3& p, float max_distance = std::numeric_limits<float>::infinity(),
+  [[nodiscard]] ClosestHit closest_point(const glm::vec3& p,
+                                         float max_distance = std::numeric_limits<float>::infinity(),
                                          bool climbable_only = false) const;
   // First hit along origin + t dir for t in (tmin, tmax); dir need not be normalised (t is in its units).
   // Calls `visit` for every triangle in a BVH leaf that comes within `radius` of p (an Embree point
@@ -205,7 +208,7 @@ class SceneQuery {
   std::unique_ptr<VertexIndex> vertices_;
   std::vector<bool> solid_;
   std::vector<std::unique_ptr<Solid>> solids_;  // per mesh; null when it is not solid
-  std::vector<bool> not_climbable_;  // per mesh; empty when no mesh is marked climbable
+  std::vector<bool> not_climbable_;             // per mesh; empty when no mesh is marked climbable
   float voxel_size_ = 0.0f;
   double bvh_seconds_ = 0.0, sdf_seconds_ = 0.0;
   // Surface sampling: cumulative areas over (mesh, triangle) pairs.

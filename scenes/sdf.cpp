@@ -30,8 +30,9 @@ SdfGrid::SdfGrid(const std::vector<const TriangleMesh*>& meshes, const std::vect
     for (const auto& t : m.triangles) tris.emplace_back(t.x, t.y, t.z);
     const std::vector<openvdb::Vec4I> quads;
     openvdb::FloatGrid::Ptr g =
-        solid[i] ? openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*xform, points, tris, band_voxels)
-                 : openvdb::tools::meshToUnsignedDistanceField<openvdb::FloatGrid>(*xform, points, tris, quads, band_voxels);
+        solid[i]
+            ? openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*xform, points, tris, band_voxels)
+            : openvdb::tools::meshToUnsignedDistanceField<openvdb::FloatGrid>(*xform, points, tris, quads, band_voxels);
     if (!impl_->grid) {
       impl_->grid = g;
     } else {
@@ -72,6 +73,8 @@ float SdfGrid::sample_gradient(const glm::vec3& p, glm::vec3& gradient) const {
   return lerp(x0, x1, x);
 }
 
-std::size_t SdfGrid::active_voxels() const { return impl_->grid->activeVoxelCount(); }
+std::size_t SdfGrid::active_voxels() const {
+  return impl_->grid->activeVoxelCount();
+}
 
 }  // namespace growbench

@@ -80,8 +80,8 @@ Scene build_facade(const Params& p) {
   for (int i = 0; i <= windows; ++i) {
     const float centre = -w / 2 + w * (static_cast<float>(i) + 0.5f) / static_cast<float>(windows);
     const float next = i < windows ? centre - win_w / 2 : w / 2;
-    s.meshes.push_back(geom::make_box(fmt::format("facade_pier{}", i), {x, sill - 0.01f, -t / 2},
-                                      {next, lintel + 0.01f, t / 2}));
+    s.meshes.push_back(
+        geom::make_box(fmt::format("facade_pier{}", i), {x, sill - 0.01f, -t / 2}, {next, lintel + 0.01f, t / 2}));
     x = centre + win_w / 2;
   }
   // A ledge under the upper band.
@@ -191,8 +191,8 @@ Scene build_trunk(const Params& p) {
   s.name = "trunk";
   s.meshes.push_back(ground(h));
   s.meshes.push_back(geom::make_cylinder("trunk", {0, -kSink, 0}, {0, h, 0}, r, 0.6f * r, 40));
-  s.meshes.push_back(geom::make_cylinder("branch", {0, 0.55f * h, 0}, {0.4f * h, 0.85f * h, 0.05f}, 0.45f * r,
-                                         0.25f * r, 24));
+  s.meshes.push_back(
+      geom::make_cylinder("branch", {0, 0.55f * h, 0}, {0.4f * h, 0.85f * h, 0.05f}, 0.45f * r, 0.25f * r, 24));
   seeds_around(s, static_cast<int>(p.integer("seeds")), 0.0f, 0.0f, r + 0.04f, 0.02f);
   s.envelope = box_shape({-r - 0.5f, 0.0f, -r - 0.5f}, {0.4f * h + 0.5f, h, r + 0.5f});
   s.camera = {{0.3f * h, 0.55f * h, 2.0f * h + 1.0f}, {0.15f * h, 0.45f * h, 0.0f}, 45.0f};
@@ -214,46 +214,54 @@ Scene build_envelope(const Params& p) {
 
 const std::vector<StandardScene>& standard_scenes() {
   static const std::vector<StandardScene> list = {
-      {"wall", "a 3 x 2.5 m wall standing on the ground, seeds at its foot",
+      {"wall",
+       "a 3 x 2.5 m wall standing on the ground, seeds at its foot",
        {param::real("width", 3.0).range(0.5, 50).unit("m").doc("wall width (x)"),
         param::real("height", 2.5).range(0.5, 50).unit("m").doc("wall height (y)"),
         param::real("thickness", 0.2).range(0.02, 5).unit("m").doc("wall thickness (z)"),
         param::integer("seeds", 3).range(1, 64).doc("number of seeds along the wall's foot")},
        build_wall},
-      {"facade", "a wall with window openings and a ledge",
+      {"facade",
+       "a wall with window openings and a ledge",
        {param::real("width", 4.0).range(1, 50).unit("m").doc("facade width"),
         param::real("height", 3.0).range(1, 50).unit("m").doc("facade height"),
         param::integer("windows", 2).range(1, 16).doc("number of window openings"),
         param::integer("seeds", 3).range(1, 64).doc("number of seeds along the facade's foot")},
        build_facade},
-      {"column", "a cylindrical pillar",
+      {"column",
+       "a cylindrical pillar",
        {param::real("radius", 0.25).range(0.02, 10).unit("m").doc("column radius"),
         param::real("height", 3.0).range(0.5, 50).unit("m").doc("column height"),
         param::integer("seeds", 3).range(1, 64).doc("number of seeds around the base")},
        build_column},
-      {"corner", "two walls meeting at a right angle under an overhanging roof",
+      {"corner",
+       "two walls meeting at a right angle under an overhanging roof",
        {param::real("width", 3.0).range(0.5, 50).unit("m").doc("length of each wall"),
         param::real("height", 2.6).range(0.5, 50).unit("m").doc("wall height"),
         param::real("overhang", 1.2).range(0, 20).unit("m").doc("how far the roof reaches out over the corner (z)"),
         param::integer("seeds", 3).range(1, 64).doc("number of seeds (the first in the corner)")},
        build_corner},
-      {"pergola", "four posts, two beams and rafters",
+      {"pergola",
+       "four posts, two beams and rafters",
        {param::real("width", 2.4).range(0.5, 50).unit("m").doc("distance between posts along x"),
         param::real("depth", 1.6).range(0.5, 50).unit("m").doc("distance between posts along z"),
         param::real("height", 2.4).range(0.5, 50).unit("m").doc("post height"),
         param::integer("rafters", 6).range(2, 64).doc("number of rafters")},
        build_pergola},
-      {"boulder", "a noisy rock on the ground",
+      {"boulder",
+       "a noisy rock on the ground",
        {param::real("radius", 1.0).range(0.1, 20).unit("m").doc("rock radius"),
         param::real("roughness", 0.15).range(0, 0.5).doc("relative bump height"),
         param::integer("seeds", 3).range(1, 64).doc("number of seeds around the rock")},
        build_boulder},
-      {"trunk", "a tree trunk with one branch",
+      {"trunk",
+       "a tree trunk with one branch",
        {param::real("radius", 0.3).range(0.05, 5).unit("m").doc("trunk radius at the base"),
         param::real("height", 3.5).range(0.5, 50).unit("m").doc("trunk height"),
         param::integer("seeds", 3).range(1, 64).doc("number of seeds around the base")},
        build_trunk},
-      {"envelope", "ground and a crown envelope, nothing to climb (free-growing trees)",
+      {"envelope",
+       "ground and a crown envelope, nothing to climb (free-growing trees)",
        {param::real("crown_radius", 1.2).range(0.1, 50).unit("m").doc("horizontal radius of the ellipsoidal crown"),
         param::real("crown_height", 2.2).range(0.2, 100).unit("m").doc("height of the crown's centre")},
        build_envelope},
@@ -263,7 +271,9 @@ const std::vector<StandardScene>& standard_scenes() {
 
 const std::vector<ParamSpec>& mesh_scene_params() {
   static const std::vector<ParamSpec> specs = {
-      param::real("size", 2.0).range(0.0, 1000).unit("m")
+      param::real("size", 2.0)
+          .range(0.0, 1000)
+          .unit("m")
           .doc("scale the mesh so its largest extent is this (0 keeps the file's units and placement)"),
       param::boolean("ground", true)
           .doc("a ground slab under the mesh (not climbable), where shoots that fall or hang come to rest, as on the "

@@ -47,77 +47,117 @@ const AlgorithmInfo kInfo = {
     .summary =
         "Hädrich et al. 2017 climbing plants: oriented particles grow at the tips, adapt to surfaces, seek light, "
         "branch (Leeuwenberg), carry leaves, anchor, collide with the distance field and bend under shape matching",
-    .params = {
-        // growth
-        param::real("particle_length", 0.02).range(1e-4, 10).unit("m")
-            .doc("length of a grown particle (one plant segment)"),
-        param::integer("max_particles", 10000).range(1, 20000000)
-            .doc("the preallocated pool; growth ends when it is full"),
-        param::real("growth_speed", 0.2).range(0, 100).unit("m/s").doc("tip extension speed in full light"),
-        param::real("growth_factor", 1.0).range(0, 100).doc("user factor on the growth speed"),
-        param::real("shade_growth", 0.25).range(0, 1)
-            .doc("growth in full shade as a fraction of full-light growth: speed x (this + (1 - this)(1 - O)) (the "
-                 "paper scales growth with light but gives no formula)"),
-        param::real("tip_radius", 0.002).range(1e-6, 10).unit("m").doc("radius of a new main-axis particle"),
-        param::real("max_radius", 0.012).range(1e-6, 10).unit("m").doc("radius a main-axis particle thickens to"),
-        param::real("thickening", 0.002).range(0, 10).unit("m/s")
-            .doc("secondary growth: radius gained per second by grown particles"),
-        param::real("radius_falloff", 0.7).range(0.01, 1).doc("a lateral branch's radii are its parent's times this"),
-        // tropisms
-        param::real("adaptation", 6.0).range(0, 1000).unit("1/s")
-            .doc("tau: surface adaptation, angle (v_s . v_f - sin(approach)) tau dt about v_s x v_f (the seed's tau "
-                 "in [0, 1] turns too slowly at dt = 25 ms; a rate here)"),
-        param::real("attraction_range", 0.15).range(0, 100).unit("m")
-            .doc("surfaces farther than this from a tip do not attract it"),
-        param::real("approach_angle", 25.0).range(0, 90).unit("deg")
-            .doc("a tip in range turns to meet the surface at this angle, falling linearly to 0 (parallel) at "
-                 "contact; 0: the paper's rule, which only aligns tips with surfaces"),
-        param::real("phototropism", 1.5).range(0, 1000).unit("1/s").doc("eta: turn toward the light by (1 - O) eta dt"),
-        param::integer("light_rays", 4).range(0, 256).doc("rays per tip to estimate occlusion O (0: O = 0)"),
-        param::real("light_spread", 5.0).range(0, 60).unit("deg")
-            .doc("half-angle of the cone of light rays (soft shadows)"),
-        param::real("direction_noise", 6.0).range(0, 90).unit("deg").doc("random turn of each new particle (at most)"),
-        param::real("zone_rate", 3.0).range(0, 1000).unit("1/s")
-            .doc("a tip in an attract (repel) zone turns toward (away from) its centre by strength x this x dt"),
-        // branching and leaves
-        param::integer("max_laterals", 1).range(0, 3).doc("B: lateral buds per particle (Leeuwenberg)"),
-        param::real("shoot_density", 0.08).range(0, 1).doc("BP: probability that each lateral bud grows a shoot"),
-        param::real("branch_variance", 0.8).range(0, 1)
-            .doc("V: a lateral leaves its parent at V x 90 deg (minus up to 30% at random)"),
-        param::integer("max_order", 3).range(0, 100).doc("shoots of this branch order grow no laterals"),
-        param::real("leaf_density", 0.7).range(0, 1).doc("probability of a leaf at each leaf_step-th particle"),
-        param::integer("leaf_step", 1).range(1, 1000).doc("phyllotaxis step: particles between leaf sites"),
-        param::real("phyllotaxis", 137.5).range(0, 360).unit("deg")
-            .doc("turn between successive leaf sites of a shoot"),
-        param::real("leaf_size", 0.05).range(0, 10).unit("m").doc("leaf blade length"),
-        param::real("leaf_light", 0.7).range(0, 1)
-            .doc("how far a leaf turns its upper side from its phyllotactic pose to face the light"),
-        // physics
-        param::real("dt", 0.025).range(1e-4, 1).unit("s").doc("time step (the paper: 25 ms)"),
-        param::real("gravity", 0.5).range(0, 1000).unit("m/s^2")
-            .doc("a_g, downwards. Growth runs in time-lapse (0.2 m per simulated second), and at 9.81 shoots not yet "
-                 "anchored fold to the ground under shape matching at 2 iterations. At 1 shoots peeled off convex "
-                 "and overhanging supports (the bunny: 5% of it covered, the rest on the ground); 0.5 keeps them on "
-                 "(18%) with a visible sag where a support ends"),
-        param::real("stiffness", 0.8).range(0, 1).doc("shape matching: fraction of the way to the goal per iteration"),
-        param::integer("iterations", 2).range(1, 100).doc("shape-matching iterations per step"),
-        param::real("damping", 0.05).range(0, 1).doc("fraction of linear and angular velocity removed per step"),
-        param::real("friction", 0.6).range(0, 1).doc("tangential velocity removed at a contact"),
-        param::real("elasticity", 0.1).range(0, 1).doc("normal velocity reflected at a contact"),
-        param::real("anchor_pull", 0.5).range(0, 1).doc("phi: x += phi (anchor - x) per step"),
-        param::real("anchor_release", 0.03).range(0, 100).unit("m")
-            .doc("an anchor lets go when its particle is this far from it"),
-        param::real("break_sensitivity", 0.0).range(0, 1e6)
-            .doc("a joint breaks when its gap exceeds particle_length / this; 0: never"),
-        param::vec3("wind", glm::dvec3(1.0, 0.0, 0.0)).range(-1e3, 1e3).doc("wind direction"),
-        param::real("wind_strength", 0.0).range(0, 1e4).unit("m/s^2").doc("wind acceleration a_e"),
-        param::real("wind_gusts", 0.5).range(0, 10)
-            .doc("gust amplitude relative to the strength (smooth counter-based noise per shoot)"),
-        param::real("gust_period", 1.5).range(1e-3, 1e3).unit("s").doc("time between gust peaks"),
-        param::text("prune")
-            .doc("cuts during the run, 'x,y,z,radius@step; ...': at that step the particles whose head is within "
-                 "radius of the point (radius 0: the nearest one) and all they grew are removed"),
-    },
+    .params =
+        {
+            // growth
+            param::real("particle_length", 0.02)
+                .range(1e-4, 10)
+                .unit("m")
+                .doc("length of a grown particle (one plant segment)"),
+            param::integer("max_particles", 10000)
+                .range(1, 20000000)
+                .doc("the preallocated pool; growth ends when it is full"),
+            param::real("growth_speed", 0.2).range(0, 100).unit("m/s").doc("tip extension speed in full light"),
+            param::real("growth_factor", 1.0).range(0, 100).doc("user factor on the growth speed"),
+            param::real("shade_growth", 0.25)
+                .range(0, 1)
+                .doc("growth in full shade as a fraction of full-light growth: speed x (this + (1 - this)(1 - O)) (the "
+                     "paper scales growth with light but gives no formula)"),
+            param::real("tip_radius", 0.002).range(1e-6, 10).unit("m").doc("radius of a new main-axis particle"),
+            param::real("max_radius", 0.012).range(1e-6, 10).unit("m").doc("radius a main-axis particle thickens to"),
+            param::real("thickening", 0.002)
+                .range(0, 10)
+                .unit("m/s")
+                .doc("secondary growth: radius gained per second by grown particles"),
+            param::real("radius_falloff", 0.7)
+                .range(0.01, 1)
+                .doc("a lateral branch's radii are its parent's times this"),
+            // tropisms
+            param::real("adaptation", 6.0)
+                .range(0, 1000)
+                .unit("1/s")
+                .doc(
+                    "tau: surface adaptation, angle (v_s . v_f - sin(approach)) tau dt about v_s x v_f (the seed's tau "
+                    "in [0, 1] turns too slowly at dt = 25 ms; a rate here)"),
+            param::real("attraction_range", 0.15)
+                .range(0, 100)
+                .unit("m")
+                .doc("surfaces farther than this from a tip do not attract it"),
+            param::real("approach_angle", 25.0)
+                .range(0, 90)
+                .unit("deg")
+                .doc("a tip in range turns to meet the surface at this angle, falling linearly to 0 (parallel) at "
+                     "contact; 0: the paper's rule, which only aligns tips with surfaces"),
+            param::real("phototropism", 1.5)
+                .range(0, 1000)
+                .unit("1/s")
+                .doc("eta: turn toward the light by (1 - O) eta dt"),
+            param::integer("light_rays", 4).range(0, 256).doc("rays per tip to estimate occlusion O (0: O = 0)"),
+            param::real("light_spread", 5.0)
+                .range(0, 60)
+                .unit("deg")
+                .doc("half-angle of the cone of light rays (soft shadows)"),
+            param::real("direction_noise", 6.0)
+                .range(0, 90)
+                .unit("deg")
+                .doc("random turn of each new particle (at most)"),
+            param::real("zone_rate", 3.0)
+                .range(0, 1000)
+                .unit("1/s")
+                .doc("a tip in an attract (repel) zone turns toward (away from) its centre by strength x this x dt"),
+            // branching and leaves
+            param::integer("max_laterals", 1).range(0, 3).doc("B: lateral buds per particle (Leeuwenberg)"),
+            param::real("shoot_density", 0.08).range(0, 1).doc("BP: probability that each lateral bud grows a shoot"),
+            param::real("branch_variance", 0.8)
+                .range(0, 1)
+                .doc("V: a lateral leaves its parent at V x 90 deg (minus up to 30% at random)"),
+            param::integer("max_order", 3).range(0, 100).doc("shoots of this branch order grow no laterals"),
+            param::real("leaf_density", 0.7).range(0, 1).doc("probability of a leaf at each leaf_step-th particle"),
+            param::integer("leaf_step", 1).range(1, 1000).doc("phyllotaxis step: particles between leaf sites"),
+            param::real("phyllotaxis", 137.5)
+                .range(0, 360)
+                .unit("deg")
+                .doc("turn between successive leaf sites of a shoot"),
+            param::real("leaf_size", 0.05).range(0, 10).unit("m").doc("leaf blade length"),
+            param::real("leaf_light", 0.7)
+                .range(0, 1)
+                .doc("how far a leaf turns its upper side from its phyllotactic pose to face the light"),
+            // physics
+            param::real("dt", 0.025).range(1e-4, 1).unit("s").doc("time step (the paper: 25 ms)"),
+            param::real("gravity", 0.5)
+                .range(0, 1000)
+                .unit("m/s^2")
+                .doc(
+                    "a_g, downwards. Growth runs in time-lapse (0.2 m per simulated second), and at 9.81 shoots not "
+                    "yet "
+                    "anchored fold to the ground under shape matching at 2 iterations. At 1 shoots peeled off convex "
+                    "and overhanging supports (the bunny: 5% of it covered, the rest on the ground); 0.5 keeps them on "
+                    "(18%) with a visible sag where a support ends"),
+            param::real("stiffness", 0.8)
+                .range(0, 1)
+                .doc("shape matching: fraction of the way to the goal per iteration"),
+            param::integer("iterations", 2).range(1, 100).doc("shape-matching iterations per step"),
+            param::real("damping", 0.05).range(0, 1).doc("fraction of linear and angular velocity removed per step"),
+            param::real("friction", 0.6).range(0, 1).doc("tangential velocity removed at a contact"),
+            param::real("elasticity", 0.1).range(0, 1).doc("normal velocity reflected at a contact"),
+            param::real("anchor_pull", 0.5).range(0, 1).doc("phi: x += phi (anchor - x) per step"),
+            param::real("anchor_release", 0.03)
+                .range(0, 100)
+                .unit("m")
+                .doc("an anchor lets go when its particle is this far from it"),
+            param::real("break_sensitivity", 0.0)
+                .range(0, 1e6)
+                .doc("a joint breaks when its gap exceeds particle_length / this; 0: never"),
+            param::vec3("wind", glm::dvec3(1.0, 0.0, 0.0)).range(-1e3, 1e3).doc("wind direction"),
+            param::real("wind_strength", 0.0).range(0, 1e4).unit("m/s^2").doc("wind acceleration a_e"),
+            param::real("wind_gusts", 0.5)
+                .range(0, 10)
+                .doc("gust amplitude relative to the strength (smooth counter-based noise per shoot)"),
+            param::real("gust_period", 1.5).range(1e-3, 1e3).unit("s").doc("time between gust peaks"),
+            param::text("prune").doc(
+                "cuts during the run, 'x,y,z,radius@step; ...': at that step the particles whose head is within "
+                "radius of the point (radius 0: the nearest one) and all they grew are removed"),
+        },
     .test_params = {"max_particles=2000"},
 };
 
@@ -194,8 +234,8 @@ std::vector<Cut> parse_cuts(const std::string& text) {
     ++n;
     if (entry.find_first_not_of(" \t") == std::string::npos) continue;
     auto bad = [&](const std::string& why) {
-      return InputError(fmt::format("hadrich: parameter 'prune', entry {} '{}': {}; expected 'x,y,z,radius@step'", n,
-                                    entry, why));
+      return InputError(
+          fmt::format("hadrich: parameter 'prune', entry {} '{}': {}; expected 'x,y,z,radius@step'", n, entry, why));
     };
     const auto at = entry.find('@');
     if (at == std::string::npos) throw bad("no '@step'");
@@ -210,7 +250,8 @@ std::vector<Cut> parse_cuts(const std::string& text) {
       const char* first = item.data() + b;
       const char* last = item.data() + e + 1;
       const auto r = std::from_chars(first, last, v[k]);
-      if (r.ec != std::errc() || r.ptr != last || !std::isfinite(v[k])) throw bad(fmt::format("'{}' is not a number", item));
+      if (r.ec != std::errc() || r.ptr != last || !std::isfinite(v[k]))
+        throw bad(fmt::format("'{}' is not a number", item));
       ++k;
     }
     if (k != 4) throw bad(fmt::format("{} numbers before '@'", k));
@@ -220,7 +261,8 @@ std::vector<Cut> parse_cuts(const std::string& text) {
     step.erase(step.find_last_not_of(" \t") + 1);
     int s = 0;
     const auto r = std::from_chars(step.data(), step.data() + step.size(), s);
-    if (r.ec != std::errc() || r.ptr != step.data() + step.size() || s < 0) throw bad(fmt::format("step '{}' is not a non-negative integer", step));
+    if (r.ec != std::errc() || r.ptr != step.data() + step.size() || s < 0)
+      throw bad(fmt::format("step '{}' is not a non-negative integer", step));
     cuts.push_back({{v[0], v[1], v[2]}, v[3], s});
   }
   return cuts;
@@ -289,7 +331,7 @@ std::size_t Particles::bytes_per_particle() {
   return 3 * sizeof(glm::vec3) + 2 * sizeof(glm::quat) + 2 * sizeof(float) + sizeof(std::int32_t) +
          sizeof(std::array<std::int32_t, kMaxChildren>) + 3 * sizeof(std::uint32_t) + sizeof(std::uint16_t) +
          sizeof(std::uint8_t) + 2 * sizeof(glm::vec3) + sizeof(float) +  // state
-         4 * sizeof(glm::vec3) + 3 * sizeof(glm::quat);                   // scratch
+         4 * sizeof(glm::vec3) + 3 * sizeof(glm::quat);                  // scratch
 }
 
 // ---- simulator ----
@@ -310,7 +352,9 @@ glm::vec3 Simulator::rest_offset(std::size_t parent, std::size_t child) const {
   return glm::vec3(0, 0, p_.half[parent]) + p_.rest[child] * glm::vec3(0, 0, p_.half[child]);
 }
 
-glm::vec3 Simulator::head(std::size_t i) const { return p_.x[i] + forward(i) * p_.half[i]; }
+glm::vec3 Simulator::head(std::size_t i) const {
+  return p_.x[i] + forward(i) * p_.half[i];
+}
 
 std::int32_t Simulator::activate(std::int32_t parent, const glm::vec3& tail, const glm::quat& q, std::uint32_t shoot,
                                  std::uint16_t order, std::uint32_t rank, bool pinned) {
@@ -334,7 +378,8 @@ std::int32_t Simulator::activate(std::int32_t parent, const glm::vec3& tail, con
   p_.birth.push_back(static_cast<std::uint32_t>(step_));
   p_.rank.push_back(rank);
   p_.order.push_back(order);
-  p_.flags.push_back(static_cast<std::uint8_t>(Particles::Active | Particles::Growing | (pinned ? Particles::Pinned : 0)));
+  p_.flags.push_back(
+      static_cast<std::uint8_t>(Particles::Active | Particles::Growing | (pinned ? Particles::Pinned : 0)));
   p_.anchor.push_back(glm::vec3(0.0f));
   p_.normal.push_back(parent >= 0 ? p_.normal[parent] : glm::vec3(0.0f));
   p_.light.push_back(parent >= 0 ? p_.light[parent] : 1.0f);
@@ -379,7 +424,9 @@ float Simulator::occlusion(std::size_t i, const glm::vec3& at) const {
   const auto phase = static_cast<float>(Rng(seed_, kLightStream, i).uniform() * 2.0 * std::numbers::pi);
   int blocked = 0;
   for (int k = 0; k < cfg_.light_rays; ++k) {
-    const float r = cfg_.light_rays == 1 ? 0.0f : spread * std::sqrt((static_cast<float>(k) + 0.5f) / static_cast<float>(cfg_.light_rays));
+    const float r = cfg_.light_rays == 1
+                        ? 0.0f
+                        : spread * std::sqrt((static_cast<float>(k) + 0.5f) / static_cast<float>(cfg_.light_rays));
     const float a = phase + 2.39996323f * static_cast<float>(k);
     const glm::vec3 d = glm::normalize(l + r * (std::cos(a) * u + std::sin(a) * v));
     if (query_.occluded(at, d, dist, 1e-3f)) ++blocked;
@@ -524,7 +571,8 @@ void Simulator::spawn() {
         const double azimuth = branch.uniform() * 2.0 * std::numbers::pi;
         const double jitter = branch.uniform();
         if (!grows) continue;
-        const float angle = cfg_.branch_variance * 0.5f * std::numbers::pi_v<float> * (1.0f - 0.3f * static_cast<float>(jitter));
+        const float angle =
+            cfg_.branch_variance * 0.5f * std::numbers::pi_v<float> * (1.0f - 0.3f * static_cast<float>(jitter));
         glm::quat ql = glm::normalize(p_.q[i] * glm::angleAxis(static_cast<float>(azimuth), kZ) *
                                       glm::angleAxis(angle, glm::vec3(1, 0, 0)));
         // On a support, a lateral leaves along it: its direction is laid into the surface's tangent
@@ -669,7 +717,8 @@ void Simulator::contact_pass() {
       glm::vec3 xp = p_.xp[i];
       if (p_.has(i, Particles::Anchored)) {
         xp += cfg_.anchor_pull * (p_.anchor[i] - xp);
-        if (glm::length(xp - p_.anchor[i]) > cfg_.anchor_release) p_.flags[i] &= static_cast<std::uint8_t>(~Particles::Anchored);
+        if (glm::length(xp - p_.anchor[i]) > cfg_.anchor_release)
+          p_.flags[i] &= static_cast<std::uint8_t>(~Particles::Anchored);
       }
       const glm::vec3 before = xp;
       // Pushed out to its longest semi-axis from the surface.
@@ -803,7 +852,8 @@ bool Simulator::step() {
   physics();
   ++step_;
   ++version_;
-  const bool seeds_pending = std::any_of(seed_started_.begin(), seed_started_.end(), [](std::uint8_t s) { return s == 0; });
+  const bool seeds_pending =
+      std::any_of(seed_started_.begin(), seed_started_.end(), [](std::uint8_t s) { return s == 0; });
   return (!tips_.empty() && !pool_full_) || seeds_pending;
 }
 
@@ -811,7 +861,8 @@ std::size_t Simulator::prune(const glm::vec3& point, float radius) {
   std::vector<std::int32_t> cut;
   if (radius > 0.0f) {
     for (std::size_t i = 0; i < p_.size(); ++i)
-      if (p_.has(i, Particles::Active) && glm::length(head(i) - point) <= radius) cut.push_back(static_cast<std::int32_t>(i));
+      if (p_.has(i, Particles::Active) && glm::length(head(i) - point) <= radius)
+        cut.push_back(static_cast<std::int32_t>(i));
   } else {
     float best = std::numeric_limits<float>::infinity();
     std::int32_t nearest = -1;

@@ -70,20 +70,20 @@ Setup make_setup(const Params& params);
 // tail (x - half f) to its head (x + half f); a child's tail sits at its parent's head.
 struct Particles {
   enum Flag : std::uint8_t {
-    Active = 1,     // in the plant (not pruned)
-    Growing = 2,    // a tip still lengthening
-    Pinned = 4,     // a seed's first particle: its tail is fixed at the seed
-    Anchored = 8,   // pulled toward `anchor`
-    Touched = 16,   // touched a surface while growing: anchors when it matures
-    Contact = 32,   // pushed out of a surface in the last step
+    Active = 1,    // in the plant (not pruned)
+    Growing = 2,   // a tip still lengthening
+    Pinned = 4,    // a seed's first particle: its tail is fixed at the seed
+    Anchored = 8,  // pulled toward `anchor`
+    Touched = 16,  // touched a surface while growing: anchors when it matures
+    Contact = 32,  // pushed out of a surface in the last step
   };
-  std::vector<glm::vec3> x, v, w;    // centre, velocity, angular velocity
-  std::vector<glm::quat> q;          // orientation (local +Z forward)
-  std::vector<glm::quat> rest;       // rest orientation relative to the parent's frame
+  std::vector<glm::vec3> x, v, w;  // centre, velocity, angular velocity
+  std::vector<glm::quat> q;        // orientation (local +Z forward)
+  std::vector<glm::quat> rest;     // rest orientation relative to the parent's frame
   std::vector<float> half, radius;
-  std::vector<std::int32_t> parent;  // -1: a seed's first particle, or broken off
+  std::vector<std::int32_t> parent;                              // -1: a seed's first particle, or broken off
   std::vector<std::array<std::int32_t, kMaxChildren>> children;  // -1: empty
-  std::vector<std::uint32_t> shoot, birth, rank;  // shoot id, step of birth, position along the shoot
+  std::vector<std::uint32_t> shoot, birth, rank;                 // shoot id, step of birth, position along the shoot
   std::vector<std::uint16_t> order;
   std::vector<std::uint8_t> flags;
   std::vector<glm::vec3> anchor, normal;  // anchor point; last surface normal seen (zero: none near)

@@ -31,7 +31,8 @@ Grown& grown(std::size_t particles, int which, std::size_t threads) {
   Grown& g = cache[{particles, which, threads}];
   if (!g.sim) {
     if (which == 0) {
-      g.scene = load_scene("wall", {"width=12", "height=6", fmt::format("seeds={}", std::max<std::size_t>(3, particles / 2500))});
+      g.scene = load_scene(
+          "wall", {"width=12", "height=6", fmt::format("seeds={}", std::max<std::size_t>(3, particles / 2500))});
     } else {
       g.scene = load_scene("mesh:stanford-bunny");
     }
@@ -40,7 +41,10 @@ Grown& grown(std::size_t particles, int which, std::size_t threads) {
       g.scene.seeds.clear();
       for (int k = 0; k < static_cast<int>(std::max<std::size_t>(3, particles / 2500)); ++k) {
         const float a = 6.2831853f * static_cast<float>(k) / 8.0f;
-        g.scene.seeds.push_back({g.query->closest_point({std::cos(a), 0.3f + 0.05f * static_cast<float>(k % 5), std::sin(a)}).point, {0, 1, 0}, 0});
+        g.scene.seeds.push_back(
+            {g.query->closest_point({std::cos(a), 0.3f + 0.05f * static_cast<float>(k % 5), std::sin(a)}).point,
+             {0, 1, 0},
+             0});
       }
     }
     Params p = default_params(find_algorithm("hadrich"));

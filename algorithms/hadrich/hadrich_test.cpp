@@ -76,7 +76,8 @@ TEST(Hadrich, AdaptationPullsAShootOntoAWallAndKeepsItThere) {
   for (std::size_t k = gaps.size() / 2; k < gaps.size(); ++k) EXPECT_LT(gaps[k], 0.015f) << "particle " << k;
   for (const float g : gaps) EXPECT_GT(g, 0.0f);
   // The same shoot with adaptation off stays where it started.
-  Simulator free(s, q, setup({"max_laterals=0", "max_particles=120", "direction_noise=0", "light_rays=0", "adaptation=0"}), 1);
+  Simulator free(
+      s, q, setup({"max_laterals=0", "max_particles=120", "direction_noise=0", "light_rays=0", "adaptation=0"}), 1);
   for (int i = 0; i < 600 && free.step(); ++i) {
   }
   const auto free_gaps = main_shoot_gaps(free);
@@ -94,7 +95,8 @@ TEST(Hadrich, PhototropismTurnsTowardTheLight) {
   SceneQuery q(s);
   auto tip_direction = [&](const std::vector<std::string>& sets) {
     auto sets2 = sets;
-    for (const char* x : {"max_laterals=0", "max_particles=60", "direction_noise=0", "gravity=0"}) sets2.emplace_back(x);
+    for (const char* x : {"max_laterals=0", "max_particles=60", "direction_noise=0", "gravity=0"})
+      sets2.emplace_back(x);
     Simulator sim(s, q, setup(sets2), 1);
     for (int i = 0; i < 400 && sim.step(); ++i) {
     }
@@ -117,7 +119,8 @@ TEST(Hadrich, GrowthSlowsInTheShade) {
   s.seeds.push_back({{3.0f, 0.0f, 0.0f}, {0, 1, 0}, 0});
   s.light.direction = {0.0f, 1.0f, 0.0f};
   SceneQuery q(s);
-  Simulator sim(s, q, setup({"max_laterals=0", "direction_noise=0", "phototropism=0", "gravity=0", "shade_growth=0.25"}), 1);
+  Simulator sim(s, q,
+                setup({"max_laterals=0", "direction_noise=0", "phototropism=0", "gravity=0", "shade_growth=0.25"}), 1);
   for (int i = 0; i < 100; ++i) sim.step();
   const Particles& p = sim.particles();
   float shaded = 0.0f, sunny = 0.0f;
@@ -158,7 +161,8 @@ TEST(Hadrich, PruningRemovesExactlyTheSubtree) {
   // A particle with a lateral among its descendants, a quarter of the way into the pool.
   std::int32_t cut = -1;
   for (std::size_t i = p.size() / 4; i < p.size() && cut < 0; ++i)
-    if (p.parent[i] >= 0 && std::count_if(p.children[i].begin(), p.children[i].end(), [](std::int32_t c) { return c >= 0; }) >= 2)
+    if (p.parent[i] >= 0 &&
+        std::count_if(p.children[i].begin(), p.children[i].end(), [](std::int32_t c) { return c >= 0; }) >= 2)
       cut = static_cast<std::int32_t>(i);
   ASSERT_GE(cut, 0);
   std::set<std::size_t> expected_removed, survivors;
@@ -204,7 +208,8 @@ TEST(Hadrich, PruneParameterCutsAtItsStep) {
   const std::size_t target = heads.size() / 2;
   const glm::vec3 at = heads[target];
   for (const float radius : {0.0f, 0.1f}) {
-    Simulator sim(s, q, setup({"max_particles=2000", fmt::format("prune={},{},{},{}@150", at.x, at.y, at.z, radius)}), 1);
+    Simulator sim(s, q, setup({"max_particles=2000", fmt::format("prune={},{},{},{}@150", at.x, at.y, at.z, radius)}),
+                  1);
     for (int i = 0; i < 150; ++i) sim.step();
     EXPECT_EQ(sim.node_count(), before);
     sim.step();
@@ -229,10 +234,9 @@ TEST(Hadrich, BreakingUnderLoadAndNeverWithSensitivityZero) {
   s.seeds.push_back({{0.0f, 0.02f, 0.0f}, {0, 1, 0}, 0});
   SceneQuery q(s);
   auto broken = [&](const char* sensitivity) {
-    Simulator sim(s, q,
-                  setup({"max_particles=150", "max_laterals=0", "gravity=0", "wind_strength=400", "wind=1,0,0",
-                          sensitivity}),
-                  1);
+    Simulator sim(
+        s, q,
+        setup({"max_particles=150", "max_laterals=0", "gravity=0", "wind_strength=400", "wind=1,0,0", sensitivity}), 1);
     for (int i = 0; i < 800; ++i) sim.step();
     std::size_t roots = 0;
     for (const auto& n : sim.plant().nodes) roots += n.parent == kNoParent ? 1 : 0;

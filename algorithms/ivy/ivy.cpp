@@ -11,8 +11,9 @@
 //    segment passes through, and the rule itself decides. Otherwise every position the loop can
 //    produce stays within the segment's length of the start (mirroring across a plane the segment
 //    crosses never moves the end farther from the start), so a ball query of that radius gathers a
-//    complete candidate set, and his loop over it in index order gives exactly his result. Embree's own ray-triangle hits could not promise that: its float test differs from
-//    Luft's rule along edges. (The Blender collision mode is a ray, because Blender's is.)
+//    complete candidate set, and his loop over it in index order gives exactly his result. Embree's own ray-triangle
+//    hits could not promise that: its float test differs from Luft's rule along edges. (The Blender collision mode is a
+//    ray, because Blender's is.)
 //  * Luft's branching scans every node of every alive root each iteration (quadratic over a run).
 //    The same distribution is drawn without the scan: a node can only branch where its weight
 //    w = 1 - (cos(2 pi l / L) / 2 + 1/2) exceeds the threshold b, a contiguous window of the root
@@ -41,71 +42,87 @@ const AlgorithmInfo kInfo = {
     .summary =
         "Luft's ivy generator (and Blender IvyGen): roots creep along surfaces by primary, random, adhesion and "
         "gravity terms, mirror off what they hit, branch, and carry leaves facing away from the surface",
-    .params = {
-        param::choice("preset", "luft", {"luft", "blender"})
-            .doc("luft: Luft's defaults, sizes relative to R (the scene's bounding-sphere radius); blender: Blender "
-                 "IvyGen 0.1.5 (absolute metres, max_root_length 1, one ray collision without death, closest-point "
-                 "adhesion, one smoothing pass, its leaves)"),
-        param::choice("units", "relative", {"relative", "absolute"})
-            .doc("relative: ivy_size, max_float_length, max_adhesion_distance and the length limits are multiples of "
-                 "R, leaf_size and branch_size multiples of R * ivy_size (Luft); absolute: all of them in metres "
-                 "(Blender)"),
-        param::real("ivy_size", 0.005).range(1e-6, 100).doc("length scale of one growth step"),
-        param::real("primary_weight", 0.5).range(0, 100).doc("weight of the previous direction"),
-        param::real("random_weight", 0.2).range(0, 100)
-            .doc("weight of a random direction (uniform in a cube, plus 0.2 up)"),
-        param::real("adhesion_weight", 0.1).range(0, 100)
-            .doc("weight of the pull to the nearest surface (the three weights are normalised by their sum)"),
-        param::real("gravity_weight", 1.0).range(0, 100)
-            .doc("gravity: ivy_size * this * (floating length / max_float_length)^0.7 downwards"),
-        param::real("branching_probability", 0.95).range(0, 1)
-            .doc("a node starts a new root when rand * w > this (w peaks mid-root); Blender's panel shows 1 - this"),
-        param::real("leaf_probability", 0.7).range(0, 10)
-            .doc("a leaf grows when rand * w > this (w grows toward the tip and on the ground); Blender's panel "
-                 "shows 1 - this"),
-        param::real("leaf_size", 1.5).range(0, 100).doc("leaf half-size (relative: times R * ivy_size)"),
-        param::real("branch_size", 0.15).range(0, 100).doc("branch radius scale (relative: times R * ivy_size)"),
-        param::real("max_float_length", 0.1).range(1e-6, 1e4)
-            .doc("a root dies once it has floated (not touched a surface) this far"),
-        param::real("max_adhesion_distance", 0.1).range(1e-6, 1e4).doc("surfaces farther than this do not attract"),
-        param::real("max_root_length", 3.0).range(0, 1e6)
-            .doc("stop when a root is this long (Blender's maxIvyLength; Luft's GUI has none, the user stops growth: "
-                 "roots that never leave a surface never die); 0: no limit"),
-        param::real("max_total_length", 0.0).range(0, 1e9)
-            .doc("stop when all roots together are this long; 0: no limit"),
-        param::choice("adhesion", "luft", {"luft", "closest"})
-            .doc("luft: face interiors only, front sides only (Luft); closest: true closest point incl. edges and "
-                 "vertices (Blender's BVH)"),
-        param::choice("collision", "luft", {"luft", "blender"})
-            .doc("luft: mirror across every entered face, repeat, the root dies after more than 5 passes; blender: "
-                 "one ray, mirror across the first face if entering, never dies"),
-        param::integer("max_depth", 3).range(0, 100).doc("roots this deep (ancestor count) can still branch"),
-        param::integer("branches_per_step", 1).range(1, 1000000).doc("new roots per iteration at most (Luft: 1)"),
-        param::integer("smoothing_passes", 5).range(0, 100)
-            .doc("passes of the 11-tap [1 2 4 7 9 10 9 7 4 2 1]/56 filter over each root's adhesion vectors"),
-        param::choice("leaves", "luft", {"luft", "blender", "none"})
-            .doc("luft: leaf_passes passes over each root's nodes, young and adult leaves; blender: leaf_passes "
-                 "tries along each segment; none"),
-        param::integer("leaf_passes", 10).range(0, 1000)
-            .doc("leaf passes per root (luft) or tries per segment (blender)"),
-    },
-    .presets = {
-        {"luft", {}},
-        {"blender",
-         {{"units", std::string("absolute")},
-          {"ivy_size", 0.02},
-          {"max_float_length", 0.5},
-          {"max_adhesion_distance", 1.0},
-          {"max_root_length", 1.0},
-          {"branching_probability", 0.95},
-          {"leaf_probability", 0.65},
-          {"leaf_size", 0.02},
-          {"branch_size", 0.001},
-          {"adhesion", std::string("closest")},
-          {"collision", std::string("blender")},
-          {"smoothing_passes", std::int64_t{1}},
-          {"leaves", std::string("blender")}}},
-    },
+    .params =
+        {
+            param::choice("preset", "luft", {"luft", "blender"})
+                .doc(
+                    "luft: Luft's defaults, sizes relative to R (the scene's bounding-sphere radius); blender: Blender "
+                    "IvyGen 0.1.5 (absolute metres, max_root_length 1, one ray collision without death, closest-point "
+                    "adhesion, one smoothing pass, its leaves)"),
+            param::choice("units", "relative", {"relative", "absolute"})
+                .doc("relative: ivy_size, max_float_length, max_adhesion_distance and the length limits are multiples "
+                     "of "
+                     "R, leaf_size and branch_size multiples of R * ivy_size (Luft); absolute: all of them in metres "
+                     "(Blender)"),
+            param::real("ivy_size", 0.005).range(1e-6, 100).doc("length scale of one growth step"),
+            param::real("primary_weight", 0.5).range(0, 100).doc("weight of the previous direction"),
+            param::real("random_weight", 0.2)
+                .range(0, 100)
+                .doc("weight of a random direction (uniform in a cube, plus 0.2 up)"),
+            param::real("adhesion_weight", 0.1)
+                .range(0, 100)
+                .doc("weight of the pull to the nearest surface (the three weights are normalised by their sum)"),
+            param::real("gravity_weight", 1.0)
+                .range(0, 100)
+                .doc("gravity: ivy_size * this * (floating length / max_float_length)^0.7 downwards"),
+            param::real("branching_probability", 0.95)
+                .range(0, 1)
+                .doc(
+                    "a node starts a new root when rand * w > this (w peaks mid-root); Blender's panel shows 1 - this"),
+            param::real("leaf_probability", 0.7)
+                .range(0, 10)
+                .doc("a leaf grows when rand * w > this (w grows toward the tip and on the ground); Blender's panel "
+                     "shows 1 - this"),
+            param::real("leaf_size", 1.5).range(0, 100).doc("leaf half-size (relative: times R * ivy_size)"),
+            param::real("branch_size", 0.15).range(0, 100).doc("branch radius scale (relative: times R * ivy_size)"),
+            param::real("max_float_length", 0.1)
+                .range(1e-6, 1e4)
+                .doc("a root dies once it has floated (not touched a surface) this far"),
+            param::real("max_adhesion_distance", 0.1).range(1e-6, 1e4).doc("surfaces farther than this do not attract"),
+            param::real("max_root_length", 3.0)
+                .range(0, 1e6)
+                .doc("stop when a root is this long (Blender's maxIvyLength; Luft's GUI has none, the user stops "
+                     "growth: "
+                     "roots that never leave a surface never die); 0: no limit"),
+            param::real("max_total_length", 0.0)
+                .range(0, 1e9)
+                .doc("stop when all roots together are this long; 0: no limit"),
+            param::choice("adhesion", "luft", {"luft", "closest"})
+                .doc("luft: face interiors only, front sides only (Luft); closest: true closest point incl. edges and "
+                     "vertices (Blender's BVH)"),
+            param::choice("collision", "luft", {"luft", "blender"})
+                .doc("luft: mirror across every entered face, repeat, the root dies after more than 5 passes; blender: "
+                     "one ray, mirror across the first face if entering, never dies"),
+            param::integer("max_depth", 3).range(0, 100).doc("roots this deep (ancestor count) can still branch"),
+            param::integer("branches_per_step", 1).range(1, 1000000).doc("new roots per iteration at most (Luft: 1)"),
+            param::integer("smoothing_passes", 5)
+                .range(0, 100)
+                .doc("passes of the 11-tap [1 2 4 7 9 10 9 7 4 2 1]/56 filter over each root's adhesion vectors"),
+            param::choice("leaves", "luft", {"luft", "blender", "none"})
+                .doc("luft: leaf_passes passes over each root's nodes, young and adult leaves; blender: leaf_passes "
+                     "tries along each segment; none"),
+            param::integer("leaf_passes", 10)
+                .range(0, 1000)
+                .doc("leaf passes per root (luft) or tries per segment (blender)"),
+        },
+    .presets =
+        {
+            {"luft", {}},
+            {"blender",
+             {{"units", std::string("absolute")},
+              {"ivy_size", 0.02},
+              {"max_float_length", 0.5},
+              {"max_adhesion_distance", 1.0},
+              {"max_root_length", 1.0},
+              {"branching_probability", 0.95},
+              {"leaf_probability", 0.65},
+              {"leaf_size", 0.02},
+              {"branch_size", 0.001},
+              {"adhesion", std::string("closest")},
+              {"collision", std::string("blender")},
+              {"smoothing_passes", std::int64_t{1}},
+              {"leaves", std::string("blender")}}},
+        },
     .test_params = {"max_root_length=1"},
 };
 
@@ -146,14 +163,16 @@ glm::vec3 cube(Rng& rng) {
 // once when the root clings, and there is no rule under which nothing near counts).
 class EmbreeGeometry final : public ivy::Geometry {
  public:
-  EmbreeGeometry(const SceneQuery& q, const ivy::TriangleTable& t, const ivy::Config& c) : query_(q), table_(t), cfg_(c) {
+  EmbreeGeometry(const SceneQuery& q, const ivy::TriangleTable& t, const ivy::Config& c)
+      : query_(q), table_(t), cfg_(c) {
     // One index of every triangle's box swept kShortPrism steps along its normal serves both the
     // short-prism lookup and the crossing test (a triangle's box lies inside its swept box): a
     // separate index of the bare boxes made bunny nodes ~4% faster but cost a third Embree build,
     // ~25 ms per trial on the bunny, more than it saves below ~500k nodes.
     const bool luft = cfg_.adhesion_mode == ivy::AdhesionMode::Luft;
     if (luft && kShortPrism * cfg_.step < cfg_.max_adhesion) short_height_ = kShortPrism * cfg_.step;
-    if (cfg_.collision_mode == ivy::CollisionMode::Luft || short_height_ > 0.0f) near_ = prism_index(short_height_, true);
+    if (cfg_.collision_mode == ivy::CollisionMode::Luft || short_height_ > 0.0f)
+      near_ = prism_index(short_height_, true);
     if (luft) prisms_ = prism_index(cfg_.max_adhesion);
   }
 
@@ -360,7 +379,9 @@ Config make_config(const Params& p, const Scene& scene) {
       .max_total_length = p.real("max_total_length") * R,
       .adhesion_mode = p.text("adhesion") == "luft" ? AdhesionMode::Luft : AdhesionMode::Closest,
       .collision_mode = p.text("collision") == "luft" ? CollisionMode::Luft : CollisionMode::Blender,
-      .leaf_mode = leaves == "luft" ? LeafMode::Luft : leaves == "blender" ? LeafMode::Blender : LeafMode::None,
+      .leaf_mode = leaves == "luft"      ? LeafMode::Luft
+                   : leaves == "blender" ? LeafMode::Blender
+                                         : LeafMode::None,
       .max_depth = static_cast<int>(p.integer("max_depth")),
       .branches_per_step = static_cast<int>(p.integer("branches_per_step")),
       .smoothing_passes = static_cast<int>(p.integer("smoothing_passes")),
@@ -473,7 +494,8 @@ Grower::Grown Grower::grow_one(const Root& r) const {
 
 std::ptrdiff_t Grower::pick_branch_node(const Root& r) const {
   Rng rng(seed_, kBranchStream ^ static_cast<std::uint64_t>(iteration_), static_cast<std::uint64_t>(r.id) << 20);
-  return sample_branch_node(r.nodes.size(), [&](std::size_t k) { return length_at(r, k); }, cfg_.branching, rng);
+  return sample_branch_node(
+      r.nodes.size(), [&](std::size_t k) { return length_at(r, k); }, cfg_.branching, rng);
 }
 
 bool Grower::limits_reached() const {
@@ -589,7 +611,7 @@ void Grower::finish() {
     const Root& r = roots_[ri];
     const std::size_t n = r.nodes.size();
     std::vector<glm::vec3> a(n);  // this root's (smoothed) adhesion vectors
-    a[0] = glm::vec3(0.0f);  // the start node carries no adhesion (Luft's new-root node)
+    a[0] = glm::vec3(0.0f);       // the start node carries no adhesion (Luft's new-root node)
     for (std::size_t k = 1; k < n; ++k) a[k] = adhesion_[r.nodes[k]];
     std::vector<glm::vec3> tmp(n);
     for (int pass = 0; pass < cfg_.smoothing_passes; ++pass) {
@@ -674,18 +696,19 @@ void Grower::finish() {
       }
     }
   };
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, roots_.size(), 16), [&](const tbb::blocked_range<std::size_t>& rg) {
-    for (std::size_t ri = rg.begin(); ri < rg.end(); ++ri) per_root(ri);
-  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, roots_.size(), 16),
+                    [&](const tbb::blocked_range<std::size_t>& rg) {
+                      for (std::size_t ri = rg.begin(); ri < rg.end(); ++ri) per_root(ri);
+                    });
   plant_.organs.clear();
   for (auto& l : leaves) plant_.organs.insert(plant_.organs.end(), l.begin(), l.end());
 }
 
 double Grower::state_bytes_per_node() const {
   if (plant_.nodes.empty()) return 0.0;
-  double bytes = static_cast<double>(plant_.nodes.capacity() * sizeof(PlantNode) + adhesion_.capacity() * sizeof(glm::vec3) +
-                                     (length_.capacity() + floating_.capacity()) * sizeof(float) +
-                                     roots_.capacity() * sizeof(Root));
+  double bytes = static_cast<double>(
+      plant_.nodes.capacity() * sizeof(PlantNode) + adhesion_.capacity() * sizeof(glm::vec3) +
+      (length_.capacity() + floating_.capacity()) * sizeof(float) + roots_.capacity() * sizeof(Root));
   for (const auto& r : roots_) bytes += static_cast<double>(r.nodes.capacity() * sizeof(std::uint32_t));
   return bytes / static_cast<double>(plant_.nodes.size());
 }

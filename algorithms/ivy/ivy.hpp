@@ -23,8 +23,8 @@ enum class LeafMode : std::uint8_t { Luft, Blender, None };
 // Parameters resolved to metres (units=relative multiplied through by R). Every value comes from the
 // parameter table and the scene (make_config): no member has a default of its own.
 struct Config {
-  float radius;            // R: the climbable meshes' bounding-sphere radius
-  float step;              // ivy size: length scale of one growth step
+  float radius;                     // R: the climbable meshes' bounding-sphere radius
+  float step;                       // ivy size: length scale of one growth step
   float primary, random, adhesion;  // normalised to sum 1
   float gravity;
   float branching;         // a node branches when rand * w > this
@@ -56,7 +56,8 @@ Config make_config(const Params& params, const Scene& scene);
 class Candidates {
  public:
   void push(std::uint32_t id) {
-    if (n_ < local_.size()) local_[n_++] = id;
+    if (n_ < local_.size())
+      local_[n_++] = id;
     else {
       if (heap_.empty()) heap_.assign(local_.begin(), local_.end());
       heap_.push_back(id);

@@ -83,14 +83,22 @@ void BM_IvyGrowth(benchmark::State& state) {
   }
   state.counters["nodes"] = static_cast<double>(r.nodes);
   state.counters["nodes_per_s"] = static_cast<double>(r.nodes) * static_cast<double>(state.iterations()) / total;
-  state.counters["ns_per_node"] = 1e9 * total / (static_cast<double>(r.nodes) * static_cast<double>(state.iterations()));
+  state.counters["ns_per_node"] =
+      1e9 * total / (static_cast<double>(r.nodes) * static_cast<double>(state.iterations()));
   state.counters["state_B_per_node"] = r.bytes_per_node;
   state.SetLabel(which == 0 ? "wall" : "bunny");
 }
 BENCHMARK(BM_IvyGrowth)
     ->ArgNames({"scene", "threads"})
-    ->Args({0, 1})->Args({0, 2})->Args({1, 1})->Args({1, 2})
-    ->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true);
+    ->Args({0, 1})
+    ->Args({0, 2})
+    ->Args({1, 1})
+    ->Args({1, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime()
+    ->Iterations(1)
+    ->Repetitions(3)
+    ->ReportAggregatesOnly(true);
 
 // What a node costs against the two queries it stands in for: one closest-point query bounded by the
 // adhesion distance and one ray of one step, at the positions the ivy actually grew through.
@@ -124,7 +132,15 @@ void BM_IvyNodeVsQueries(benchmark::State& state) {
   state.counters["ratio"] = node_ns / query_ns;
   state.SetLabel(which == 0 ? "wall" : "bunny");
 }
-BENCHMARK(BM_IvyNodeVsQueries)->ArgName("scene")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true);
+BENCHMARK(BM_IvyNodeVsQueries)
+    ->ArgName("scene")
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime()
+    ->Iterations(1)
+    ->Repetitions(3)
+    ->ReportAggregatesOnly(true);
 
 // Scaling on the bunny (one thread): time per node must stay flat from 10k to 1M nodes.
 void BM_IvyScaling(benchmark::State& state) {
@@ -139,7 +155,16 @@ void BM_IvyScaling(benchmark::State& state) {
   state.counters["ns_per_node"] = 1e9 * r.seconds / static_cast<double>(r.nodes);
   state.counters["state_B_per_node"] = r.bytes_per_node;
 }
-BENCHMARK(BM_IvyScaling)->ArgName("nodes")->Arg(10000)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true);
+BENCHMARK(BM_IvyScaling)
+    ->ArgName("nodes")
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Arg(1000000)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime()
+    ->Iterations(1)
+    ->Repetitions(3)
+    ->ReportAggregatesOnly(true);
 
 }  // namespace
 }  // namespace growbench

@@ -184,8 +184,10 @@ Plant grow_with(const Scene& scene, const SceneQuery& query, bool brute, std::ui
   const ivy::TriangleTable table(scene);
   const ivy::Config cfg = ivy::make_config(p, scene);
   std::unique_ptr<ivy::Geometry> g;
-  if (brute) g = std::make_unique<BruteForceGeometry>(table, cfg, query);
-  else g = ivy::make_embree_geometry(query, table, cfg);
+  if (brute)
+    g = std::make_unique<BruteForceGeometry>(table, cfg, query);
+  else
+    g = ivy::make_embree_geometry(query, table, cfg);
   ivy::Grower grower(scene, *g, table, cfg, seed);
   for (int i = 0; i < steps && grower.step(); ++i) {
   }
@@ -216,6 +218,8 @@ TEST(IvyReference, EmbreePathGrowsExactlyLuftsBruteForcePlant) {
 // force loops. Points: random ones on, above, below and far from the surface, and near-ties on the
 // bisector of two faces sharing an edge, where the two distances differ only by rounding (the case
 // in which a rejection test without enough slack let the triangle offered first win).
+// It is long because its checks share the bunny's tables and the per-mode tallies the last expectations
+// read; split, each piece would take them all as arguments.
 TEST(IvyReference, EmbreeAdhesionEqualsBruteForceOnTheBunny) {
   // The scan as it is, unsealed, so that the rims of its holes are exercised too (any open OBJ has them).
   Scene bunny = load_scene("mesh:stanford-bunny"), raw;
@@ -374,7 +378,9 @@ TEST(IvyReference, ClosestAdhesionModeAgreesWithBruteForceToo) {
   EXPECT_EQ(fast.geometry_hash(), slow.geometry_hash());
 }
 
-std::size_t nodes_inside(const Plant& p, const SceneQuery& q) { return test::nodes_inside_solids(p, q).size(); }
+std::size_t nodes_inside(const Plant& p, const SceneQuery& q) {
+  return test::nodes_inside_solids(p, q).size();
+}
 
 TEST(IvyScenes, NoNodeEndsInsideAClosedMesh) {
   for (const std::string name : {"column", "boulder"}) {

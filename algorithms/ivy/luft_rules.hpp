@@ -37,8 +37,8 @@ namespace growbench::ivy {
 // were stored as well, are six min/max operations away).
 struct alignas(64) Triangle {
   glm::vec3 a{0.0f}, b{0.0f}, c{0.0f};
-  glm::vec3 n{0.0f};              // unit normal of (b - a) x (c - a); zero when degenerate
-  bool adhesive = true;           // on a climbable mesh (only those attract)
+  glm::vec3 n{0.0f};     // unit normal of (b - a) x (c - a); zero when degenerate
+  bool adhesive = true;  // on a climbable mesh (only those attract)
   [[nodiscard]] glm::vec3 lo() const { return glm::min(a, glm::min(b, c)); }
   [[nodiscard]] glm::vec3 hi() const { return glm::max(a, glm::max(b, c)); }
 };
@@ -112,7 +112,9 @@ inline bool crosses(const Triangle& t, const glm::vec3& o, const glm::vec3& q) {
 }
 
 // p mirrored across t's plane.
-inline glm::vec3 mirror(const Triangle& t, const glm::vec3& p) { return p - 2.0f * t.n * glm::dot(t.n, p - t.a); }
+inline glm::vec3 mirror(const Triangle& t, const glm::vec3& p) {
+  return p - 2.0f * t.n * glm::dot(t.n, p - t.a);
+}
 
 struct CollisionResult {
   bool climbing = false;  // something was mirrored
@@ -231,8 +233,10 @@ std::ptrdiff_t sample_branch_node(std::size_t n, Length&& length, float b, Rng& 
     std::size_t lo = 1, hi = n;
     while (lo < hi) {
       const std::size_t mid = (lo + hi) / 2;
-      if (static_cast<double>(length(mid)) > l) hi = mid;
-      else lo = mid + 1;
+      if (static_cast<double>(length(mid)) > l)
+        hi = mid;
+      else
+        lo = mid + 1;
     }
     return lo;
   };

@@ -21,7 +21,9 @@ double draw(std::uint64_t seed, std::uint64_t stream, int generation, std::size_
   return static_cast<double>(bits >> 11) * 0x1.0p-53;
 }
 
-std::size_t block_count(std::size_t n) { return (n + kBlock - 1) / kBlock; }
+std::size_t block_count(std::size_t n) {
+  return (n + kBlock - 1) / kBlock;
+}
 
 }  // namespace
 
@@ -132,8 +134,10 @@ bool Deriver::bind(const Rule& r, const LString& in, std::size_t m, std::size_t 
             const std::uint16_t w2 = sym[pos];
             off -= count_of(w2);
             const char c2 = symbol_of(w2);
-            if (c2 == ']') ++depth;
-            else if (c2 == '[') --depth;
+            if (c2 == ']')
+              ++depth;
+            else if (c2 == '[')
+              --depth;
             --pos;
           }
           continue;
@@ -163,7 +167,8 @@ bool Deriver::bind(const Rule& r, const LString& in, std::size_t m, std::size_t 
         while (true) {
           if (pos >= n) return false;
           const char c = symbol_of(sym[pos]);
-          if (c == '[') ++depth;
+          if (c == '[')
+            ++depth;
           else if (c == ']') {
             if (depth == 0) break;
             --depth;
@@ -193,8 +198,10 @@ bool Deriver::bind(const Rule& r, const LString& in, std::size_t m, std::size_t 
             if (pos >= n) return false;
             const std::uint16_t w2 = sym[pos];
             const char c2 = symbol_of(w2);
-            if (c2 == '[') ++depth;
-            else if (c2 == ']') --depth;
+            if (c2 == '[')
+              ++depth;
+            else if (c2 == ']')
+              --depth;
             off += count_of(w2);
             ++pos;
           }
@@ -343,16 +350,19 @@ void Deriver::rewrite(const LString& in, LString& out, int generation, const std
   }
   const std::size_t total_syms = block_out_syms_[nb], total_pars = block_out_params_[nb];
   if (total_syms > s_.max_symbols)
-    throw InputError(fmt::format("L-system runaway: generation {} would have {} symbols (from {}), over the limit "
-                                 "max_symbols={}; lower generations or raise max_symbols",
-                                 generation, total_syms, n, s_.max_symbols));
+    throw InputError(
+        fmt::format("L-system runaway: generation {} would have {} symbols (from {}), over the limit "
+                    "max_symbols={}; lower generations or raise max_symbols",
+                    generation, total_syms, n, s_.max_symbols));
   if (total_pars > s_.max_params)
     throw InputError(fmt::format("L-system runaway: generation {} would have {} parameters, over the limit of {}",
                                  generation, total_pars, s_.max_params));
   out.symbols.resize_discard(total_syms);
   out.params.resize_discard(total_pars);
-  if (ages) out.ages.resize_discard(total_syms);
-  else out.ages.release();
+  if (ages)
+    out.ages.resize_discard(total_syms);
+  else
+    out.ages.release();
 
   // pass 2: write
   tbb::parallel_for(std::size_t{0}, nb, [&](std::size_t b) {

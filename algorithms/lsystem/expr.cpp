@@ -36,22 +36,38 @@ struct Reserved {
   bool turtle;
 };
 constexpr Reserved kReserved[] = {
-    {"a", kVarA, false},        {"b", kVarB, false},        {"c", kVarC, false},
-    {"d", kVarD, false},        {"g", kVarAge, false},      {"i", kVarIndex, false},
-    {"t", kVarGeneration, false}, {"x", kVarX, true},       {"y", kVarY, true},
-    {"z", kVarZ, true},         {"A", kVarArc, true},       {"L", kVarLength, true},
-    {"T", kVarGravity, false},  {"U", kVarU, true},         {"V", kVarV, true},
-    {"W", kVarWidth, true},
+    {"a", kVarA, false},       {"b", kVarB, false},     {"c", kVarC, false},          {"d", kVarD, false},
+    {"g", kVarAge, false},     {"i", kVarIndex, false}, {"t", kVarGeneration, false}, {"x", kVarX, true},
+    {"y", kVarY, true},        {"z", kVarZ, true},      {"A", kVarArc, true},         {"L", kVarLength, true},
+    {"T", kVarGravity, false}, {"U", kVarU, true},      {"V", kVarV, true},           {"W", kVarWidth, true},
 };
 
 int stack_effect(Op op) {
   switch (op) {
-    case Op::Const: case Op::Load: return 1;
-    case Op::Neg: case Op::Not: case Op::Sin: case Op::Cos: case Op::Tan: case Op::Asin: case Op::Acos:
-    case Op::Atan: case Op::Sqrt: case Op::Abs: case Op::Floor: case Op::Ceil: case Op::Rand: case Op::Chan:
+    case Op::Const:
+    case Op::Load:
+      return 1;
+    case Op::Neg:
+    case Op::Not:
+    case Op::Sin:
+    case Op::Cos:
+    case Op::Tan:
+    case Op::Asin:
+    case Op::Acos:
+    case Op::Atan:
+    case Op::Sqrt:
+    case Op::Abs:
+    case Op::Floor:
+    case Op::Ceil:
+    case Op::Rand:
+    case Op::Chan:
       return 0;
-    case Op::In: case Op::Pic: case Op::Clamp: return -2;
-    default: return -1;  // binary operators
+    case Op::In:
+    case Op::Pic:
+    case Op::Clamp:
+      return -2;
+    default:
+      return -1;  // binary operators
   }
 }
 
@@ -212,12 +228,11 @@ class Parser {
     }
     if (std::isdigit(static_cast<unsigned char>(ch)) || ch == '.') {
       const std::size_t start = pos_;
-      while (pos_ < s_.size() &&
-             (std::isdigit(static_cast<unsigned char>(s_[pos_])) || s_[pos_] == '.' ||
-              ((s_[pos_] == 'e' || s_[pos_] == 'E') && pos_ + 1 < s_.size() &&
-               (std::isdigit(static_cast<unsigned char>(s_[pos_ + 1])) ||
-                ((s_[pos_ + 1] == '-' || s_[pos_ + 1] == '+') && pos_ + 2 < s_.size() &&
-                 std::isdigit(static_cast<unsigned char>(s_[pos_ + 2]))))))) {
+      while (pos_ < s_.size() && (std::isdigit(static_cast<unsigned char>(s_[pos_])) || s_[pos_] == '.' ||
+                                  ((s_[pos_] == 'e' || s_[pos_] == 'E') && pos_ + 1 < s_.size() &&
+                                   (std::isdigit(static_cast<unsigned char>(s_[pos_ + 1])) ||
+                                    ((s_[pos_ + 1] == '-' || s_[pos_ + 1] == '+') && pos_ + 2 < s_.size() &&
+                                     std::isdigit(static_cast<unsigned char>(s_[pos_ + 2]))))))) {
         if (s_[pos_] == 'e' || s_[pos_] == 'E') ++pos_;  // the exponent sign (if any) follows
         ++pos_;
       }
@@ -243,7 +258,8 @@ class Parser {
             if (k > 0 && !accept(",")) fail(fmt::format("{}() takes {} arguments; expected ','", f.name, f.arity));
             parse_or();
           }
-          if (!accept(")")) fail(fmt::format("{}() takes {} argument{}; expected ')'", f.name, f.arity, f.arity == 1 ? "" : "s"));
+          if (!accept(")"))
+            fail(fmt::format("{}() takes {} argument{}; expected ')'", f.name, f.arity, f.arity == 1 ? "" : "s"));
           emit(f.op);
           if (f.op == Op::In || f.op == Op::Pic) use_.turtle = true;
           return;
@@ -283,9 +299,10 @@ class Parser {
       }
     }
     pos_ = at;
-    fail(fmt::format("unknown variable '{}' (not a parameter of this rule, a reserved variable "
-                     "a b c d g i t x y z A L T U V W, or a user variable)",
-                     name));
+    fail(
+        fmt::format("unknown variable '{}' (not a parameter of this rule, a reserved variable "
+                    "a b c d g i t x y z A L T U V W, or a user variable)",
+                    name));
   }
 
   std::string_view s_;
@@ -320,7 +337,8 @@ bool ExprCompiler::compile(std::string_view text, const ExprScope& scope, Expr& 
   }
   bool pure = out.code_.size() > 1;
   for (const auto& in : out.code_)
-    if (in.op == Op::Load || in.op == Op::Rand || in.op == Op::In || in.op == Op::Pic || in.op == Op::Chan) pure = false;
+    if (in.op == Op::Load || in.op == Op::Rand || in.op == Op::In || in.op == Op::Pic || in.op == Op::Chan)
+      pure = false;
   if (pure) {
     struct NoHost final : ExprHost {
       double in(double, double, double) const override { return 0.0; }
@@ -339,42 +357,134 @@ double Expr::eval(const double* env, const ExprHost& host) const {
   int sp = 0;
   for (const Instr& in : code_) {
     switch (in.op) {
-      case Op::Const: st[sp++] = in.value; break;
-      case Op::Load: st[sp++] = env[in.slot]; break;
-      case Op::Add: --sp; st[sp - 1] += st[sp]; break;
-      case Op::Sub: --sp; st[sp - 1] -= st[sp]; break;
-      case Op::Mul: --sp; st[sp - 1] *= st[sp]; break;
-      case Op::Div: --sp; st[sp - 1] /= st[sp]; break;
-      case Op::Mod: --sp; st[sp - 1] = std::fmod(st[sp - 1], st[sp]); break;
-      case Op::Pow: --sp; st[sp - 1] = std::pow(st[sp - 1], st[sp]); break;
-      case Op::Neg: st[sp - 1] = -st[sp - 1]; break;
-      case Op::Not: st[sp - 1] = st[sp - 1] == 0.0 ? 1.0 : 0.0; break;
-      case Op::Lt: --sp; st[sp - 1] = st[sp - 1] < st[sp] ? 1.0 : 0.0; break;
-      case Op::Le: --sp; st[sp - 1] = st[sp - 1] <= st[sp] ? 1.0 : 0.0; break;
-      case Op::Gt: --sp; st[sp - 1] = st[sp - 1] > st[sp] ? 1.0 : 0.0; break;
-      case Op::Ge: --sp; st[sp - 1] = st[sp - 1] >= st[sp] ? 1.0 : 0.0; break;
-      case Op::Eq: --sp; st[sp - 1] = st[sp - 1] == st[sp] ? 1.0 : 0.0; break;
-      case Op::Ne: --sp; st[sp - 1] = st[sp - 1] != st[sp] ? 1.0 : 0.0; break;
-      case Op::And: --sp; st[sp - 1] = (st[sp - 1] != 0.0 && st[sp] != 0.0) ? 1.0 : 0.0; break;
-      case Op::Or: --sp; st[sp - 1] = (st[sp - 1] != 0.0 || st[sp] != 0.0) ? 1.0 : 0.0; break;
-      case Op::Sin: st[sp - 1] = std::sin(st[sp - 1] * kDeg); break;
-      case Op::Cos: st[sp - 1] = std::cos(st[sp - 1] * kDeg); break;
-      case Op::Tan: st[sp - 1] = std::tan(st[sp - 1] * kDeg); break;
-      case Op::Asin: st[sp - 1] = std::asin(std::clamp(st[sp - 1], -1.0, 1.0)) / kDeg; break;
-      case Op::Acos: st[sp - 1] = std::acos(std::clamp(st[sp - 1], -1.0, 1.0)) / kDeg; break;
-      case Op::Atan: st[sp - 1] = std::atan(st[sp - 1]) / kDeg; break;
-      case Op::Atan2: --sp; st[sp - 1] = std::atan2(st[sp - 1], st[sp]) / kDeg; break;
-      case Op::Sqrt: st[sp - 1] = std::sqrt(st[sp - 1]); break;
-      case Op::Abs: st[sp - 1] = std::fabs(st[sp - 1]); break;
-      case Op::Floor: st[sp - 1] = std::floor(st[sp - 1]); break;
-      case Op::Ceil: st[sp - 1] = std::ceil(st[sp - 1]); break;
-      case Op::Min: --sp; st[sp - 1] = std::min(st[sp - 1], st[sp]); break;
-      case Op::Max: --sp; st[sp - 1] = std::max(st[sp - 1], st[sp]); break;
-      case Op::Clamp: sp -= 2; st[sp - 1] = std::clamp(st[sp - 1], std::min(st[sp], st[sp + 1]), std::max(st[sp], st[sp + 1])); break;
-      case Op::Rand: st[sp - 1] = host.rand(st[sp - 1]); break;
-      case Op::Chan: st[sp - 1] = host.chan(st[sp - 1]); break;
-      case Op::In: sp -= 2; st[sp - 1] = host.in(st[sp - 1], st[sp], st[sp + 1]); break;
-      case Op::Pic: sp -= 2; st[sp - 1] = host.pic(st[sp - 1], st[sp], st[sp + 1]); break;
+      case Op::Const:
+        st[sp++] = in.value;
+        break;
+      case Op::Load:
+        st[sp++] = env[in.slot];
+        break;
+      case Op::Add:
+        --sp;
+        st[sp - 1] += st[sp];
+        break;
+      case Op::Sub:
+        --sp;
+        st[sp - 1] -= st[sp];
+        break;
+      case Op::Mul:
+        --sp;
+        st[sp - 1] *= st[sp];
+        break;
+      case Op::Div:
+        --sp;
+        st[sp - 1] /= st[sp];
+        break;
+      case Op::Mod:
+        --sp;
+        st[sp - 1] = std::fmod(st[sp - 1], st[sp]);
+        break;
+      case Op::Pow:
+        --sp;
+        st[sp - 1] = std::pow(st[sp - 1], st[sp]);
+        break;
+      case Op::Neg:
+        st[sp - 1] = -st[sp - 1];
+        break;
+      case Op::Not:
+        st[sp - 1] = st[sp - 1] == 0.0 ? 1.0 : 0.0;
+        break;
+      case Op::Lt:
+        --sp;
+        st[sp - 1] = st[sp - 1] < st[sp] ? 1.0 : 0.0;
+        break;
+      case Op::Le:
+        --sp;
+        st[sp - 1] = st[sp - 1] <= st[sp] ? 1.0 : 0.0;
+        break;
+      case Op::Gt:
+        --sp;
+        st[sp - 1] = st[sp - 1] > st[sp] ? 1.0 : 0.0;
+        break;
+      case Op::Ge:
+        --sp;
+        st[sp - 1] = st[sp - 1] >= st[sp] ? 1.0 : 0.0;
+        break;
+      case Op::Eq:
+        --sp;
+        st[sp - 1] = st[sp - 1] == st[sp] ? 1.0 : 0.0;
+        break;
+      case Op::Ne:
+        --sp;
+        st[sp - 1] = st[sp - 1] != st[sp] ? 1.0 : 0.0;
+        break;
+      case Op::And:
+        --sp;
+        st[sp - 1] = (st[sp - 1] != 0.0 && st[sp] != 0.0) ? 1.0 : 0.0;
+        break;
+      case Op::Or:
+        --sp;
+        st[sp - 1] = (st[sp - 1] != 0.0 || st[sp] != 0.0) ? 1.0 : 0.0;
+        break;
+      case Op::Sin:
+        st[sp - 1] = std::sin(st[sp - 1] * kDeg);
+        break;
+      case Op::Cos:
+        st[sp - 1] = std::cos(st[sp - 1] * kDeg);
+        break;
+      case Op::Tan:
+        st[sp - 1] = std::tan(st[sp - 1] * kDeg);
+        break;
+      case Op::Asin:
+        st[sp - 1] = std::asin(std::clamp(st[sp - 1], -1.0, 1.0)) / kDeg;
+        break;
+      case Op::Acos:
+        st[sp - 1] = std::acos(std::clamp(st[sp - 1], -1.0, 1.0)) / kDeg;
+        break;
+      case Op::Atan:
+        st[sp - 1] = std::atan(st[sp - 1]) / kDeg;
+        break;
+      case Op::Atan2:
+        --sp;
+        st[sp - 1] = std::atan2(st[sp - 1], st[sp]) / kDeg;
+        break;
+      case Op::Sqrt:
+        st[sp - 1] = std::sqrt(st[sp - 1]);
+        break;
+      case Op::Abs:
+        st[sp - 1] = std::fabs(st[sp - 1]);
+        break;
+      case Op::Floor:
+        st[sp - 1] = std::floor(st[sp - 1]);
+        break;
+      case Op::Ceil:
+        st[sp - 1] = std::ceil(st[sp - 1]);
+        break;
+      case Op::Min:
+        --sp;
+        st[sp - 1] = std::min(st[sp - 1], st[sp]);
+        break;
+      case Op::Max:
+        --sp;
+        st[sp - 1] = std::max(st[sp - 1], st[sp]);
+        break;
+      case Op::Clamp:
+        sp -= 2;
+        st[sp - 1] = std::clamp(st[sp - 1], std::min(st[sp], st[sp + 1]), std::max(st[sp], st[sp + 1]));
+        break;
+      case Op::Rand:
+        st[sp - 1] = host.rand(st[sp - 1]);
+        break;
+      case Op::Chan:
+        st[sp - 1] = host.chan(st[sp - 1]);
+        break;
+      case Op::In:
+        sp -= 2;
+        st[sp - 1] = host.in(st[sp - 1], st[sp], st[sp + 1]);
+        break;
+      case Op::Pic:
+        sp -= 2;
+        st[sp - 1] = host.pic(st[sp - 1], st[sp], st[sp + 1]);
+        break;
     }
   }
   return st[0];

@@ -24,20 +24,25 @@ namespace growbench::lsys {
 
 // Where each variable lives in the evaluation environment (a flat array of doubles).
 enum Slot : std::uint8_t {
-  kFormal0 = 0,      // rule formals: predecessor and context parameters, up to kMaxFormals
+  kFormal0 = 0,  // rule formals: predecessor and context parameters, up to kMaxFormals
   kMaxFormals = 24,
   kVarA = kMaxFormals,  // a: angle
-  kVarB, kVarC, kVarD,
-  kVarAge,          // g
-  kVarIndex,        // i
-  kVarGeneration,   // t
-  kVarX, kVarY, kVarZ,
-  kVarArc,          // A
-  kVarLength,       // L
-  kVarGravity,      // T
-  kVarU, kVarV,     // colour indices
-  kVarWidth,        // W
-  kUserVar0,        // user-defined single-letter variables follow
+  kVarB,
+  kVarC,
+  kVarD,
+  kVarAge,         // g
+  kVarIndex,       // i
+  kVarGeneration,  // t
+  kVarX,
+  kVarY,
+  kVarZ,
+  kVarArc,      // A
+  kVarLength,   // L
+  kVarGravity,  // T
+  kVarU,
+  kVarV,      // colour indices
+  kVarWidth,  // W
+  kUserVar0,  // user-defined single-letter variables follow
   kMaxSlots = 96,
 };
 
@@ -52,11 +57,42 @@ class ExprHost {
 };
 
 enum class Op : std::uint8_t {
-  Const, Load,
-  Add, Sub, Mul, Div, Mod, Pow, Neg, Not,
-  Lt, Le, Gt, Ge, Eq, Ne, And, Or,
-  Sin, Cos, Tan, Asin, Acos, Atan, Atan2, Sqrt, Abs, Floor, Ceil, Min, Max, Clamp,
-  Rand, In, Pic, Chan,
+  Const,
+  Load,
+  Add,
+  Sub,
+  Mul,
+  Div,
+  Mod,
+  Pow,
+  Neg,
+  Not,
+  Lt,
+  Le,
+  Gt,
+  Ge,
+  Eq,
+  Ne,
+  And,
+  Or,
+  Sin,
+  Cos,
+  Tan,
+  Asin,
+  Acos,
+  Atan,
+  Atan2,
+  Sqrt,
+  Abs,
+  Floor,
+  Ceil,
+  Min,
+  Max,
+  Clamp,
+  Rand,
+  In,
+  Pic,
+  Chan,
 };
 
 struct Instr {

@@ -51,7 +51,8 @@ class LineParser {
       const char c = s.text[k];
       if (depth > 0 && c == '"') quoted = !quoted;
       if (quoted) continue;
-      if (c == '(') ++depth;
+      if (c == '(')
+        ++depth;
       else if (c == ')') {
         if (--depth < 0) fail(s.column + k, "unbalanced ')'");
       } else if (depth == 0 && pred(s.text, k)) {
@@ -88,7 +89,9 @@ class LineParser {
         std::size_t start = 0, col0 = s.column + j + 1;
         while (true) {
           const std::size_t comma = inside.find(',', start);
-          const Span name = trim({inside.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start), col0 + start});
+          const Span name =
+              trim({inside.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start),
+                    col0 + start});
           if (name.text.empty()) fail(name.column, "expected a parameter name");
           if (!(std::isalpha(static_cast<unsigned char>(name.text[0])) || name.text[0] == '_'))
             fail(name.column, fmt::format("expected a parameter name, found '{}'", name.text));
@@ -113,7 +116,8 @@ class LineParser {
     if (t.text.empty()) fail(s.column, fmt::format("expected {}", what));
     Expr e;
     ExprError err;
-    if (!ExprCompiler::compile(t.text, scope, e, err)) fail(t.column + err.offset, fmt::format("in {}: {}", what, err.message));
+    if (!ExprCompiler::compile(t.text, scope, e, err))
+      fail(t.column + err.offset, fmt::format("in {}: {}", what, err.message));
     return e;
   }
 
@@ -143,9 +147,12 @@ class LineParser {
           const char ch = s.text[close];
           if (ch == '"') quoted = !quoted;
           if (quoted) continue;
-          if (ch == '(') ++depth;
-          else if (ch == ')' && --depth == 0) break;
-          else if (ch == ',' && depth == 1) commas.push_back(close);
+          if (ch == '(')
+            ++depth;
+          else if (ch == ')' && --depth == 0)
+            break;
+          else if (ch == ',' && depth == 1)
+            commas.push_back(close);
         }
         if (close >= s.text.size()) fail(s.column + j, "expected ')' to close the parameter list");
         std::size_t start = j + 1;
@@ -183,9 +190,8 @@ class LineParser {
     r.text = std::string(trim(line).text);
     // the separator: the first top-level "->", else the last lone top-level "="
     std::size_t sep = std::string_view::npos, sep_len = 1;
-    const auto arrows = top_level(line, [](std::string_view t, std::size_t k) {
-      return t[k] == '-' && k + 1 < t.size() && t[k + 1] == '>';
-    });
+    const auto arrows = top_level(
+        line, [](std::string_view t, std::size_t k) { return t[k] == '-' && k + 1 < t.size() && t[k + 1] == '>'; });
     if (!arrows.empty()) {
       sep = arrows.front();
       sep_len = 2;
@@ -196,7 +202,8 @@ class LineParser {
         if (k > 0 && (t[k - 1] == '=' || t[k - 1] == '<' || t[k - 1] == '>' || t[k - 1] == '!')) return false;
         return true;
       });
-      if (eqs.empty()) fail(line.column + trim(line).text.size(), "expected '=' or '->' between the predecessor and the replacement");
+      if (eqs.empty())
+        fail(line.column + trim(line).text.size(), "expected '=' or '->' between the predecessor and the replacement");
       sep = eqs.back();
     }
     const Span lhs{line.text.substr(0, sep), line.column};
@@ -242,7 +249,8 @@ class LineParser {
     for (const auto& p : r.left) add_formals(p);
     for (const auto& p : r.right) add_formals(p);
     if (r.formals.size() > static_cast<std::size_t>(kMaxFormals))
-      fail(line.column, fmt::format("a rule may name at most {} parameters in its predecessor and contexts", int(kMaxFormals)));
+      fail(line.column,
+           fmt::format("a rule may name at most {} parameters in its predecessor and contexts", int(kMaxFormals)));
     const ExprScope scope{&r.formals, &g_.user_variables};
     if (!cond.text.empty() || !colons.empty()) r.condition = expression(cond, scope, "the condition");
 
@@ -251,11 +259,13 @@ class LineParser {
     const auto rcolons = top_level(rhs, [](std::string_view t, std::size_t k) { return t[k] == ':'; });
     if (!rcolons.empty()) {
       repl = {rhs.text.substr(0, rcolons.back()), rhs.column};
-      r.probability = expression({rhs.text.substr(rcolons.back() + 1), rhs.column + rcolons.back() + 1}, scope,
-                                 "the probability");
-      if (r.probability.constant() && !(r.probability.constant_value() >= 0.0 && r.probability.constant_value() <= 100.0))
+      r.probability =
+          expression({rhs.text.substr(rcolons.back() + 1), rhs.column + rcolons.back() + 1}, scope, "the probability");
+      if (r.probability.constant() &&
+          !(r.probability.constant_value() >= 0.0 && r.probability.constant_value() <= 100.0))
         fail(rhs.column + rcolons.back() + 1,
-             fmt::format("expected a probability in [0, 1] (or a percentage up to 100), found {}", r.probability.constant_value()));
+             fmt::format("expected a probability in [0, 1] (or a percentage up to 100), found {}",
+                         r.probability.constant_value()));
     }
     r.successor = modules(repl, scope);
 
@@ -358,7 +368,8 @@ Grammar parse_grammar(const GrammarText& premise, const std::vector<GrammarText>
         g.premise.push_back(std::move(m));
       }
     }
-    if (g.premise.empty()) throw InputError(fmt::format("{}: the premise is empty; expected at least one symbol", premise.source));
+    if (g.premise.empty())
+      throw InputError(fmt::format("{}: the premise is empty; expected at least one symbol", premise.source));
   }
   return g;
 }
@@ -380,7 +391,8 @@ GrammarFile read_grammar_file(const std::string& path, const std::vector<std::st
       std::size_t c = b;
       while (c < l.size() && (l[c] == ' ' || l[c] == '\t')) ++c;
       // A word of two or more letters followed by ':' or '=' is a setting (a rule's predecessor is one symbol).
-      if (b - a >= 2 && c < l.size() && (l[c] == ':' || l[c] == '=') && std::isalpha(static_cast<unsigned char>(l[a]))) {
+      if (b - a >= 2 && c < l.size() && (l[c] == ':' || l[c] == '=') &&
+          std::isalpha(static_cast<unsigned char>(l[a]))) {
         is_setting = true;
         const std::string key(l.substr(a, b - a));
         if (std::find(known_settings.begin(), known_settings.end(), key) == known_settings.end()) {
@@ -400,7 +412,9 @@ GrammarFile read_grammar_file(const std::string& path, const std::vector<std::st
   return f;
 }
 
-GrammarText read_rules_file(const std::string& path) { return {path, read_text(path, "rules file"), 1}; }
+GrammarText read_rules_file(const std::string& path) {
+  return {path, read_text(path, "rules file"), 1};
+}
 
 std::vector<std::pair<std::string, double>> parse_variables(const std::string& source, const std::string& text) {
   std::vector<std::pair<std::string, double>> out;
@@ -418,8 +432,8 @@ std::vector<std::pair<std::string, double>> parse_variables(const std::string& s
       const bool letter = name.size() == 1 && std::isalpha(static_cast<unsigned char>(name[0]));
       if (!letter) throw InputError(fmt::format("{}: variable names are single letters, found '{}'", source, name));
       if (reserved_slot(name) >= 0 && name != "b" && name != "c" && name != "d")
-        throw InputError(fmt::format("{}: '{}' is a reserved variable (a g i t x y z A L T U V W); choose another letter",
-                                     source, name));
+        throw InputError(fmt::format(
+            "{}: '{}' is a reserved variable (a g i t x y z A L T U V W); choose another letter", source, name));
       double v = 0.0;
       const auto [p, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
       if (ec != std::errc() || p != value.data() + value.size() || value.empty())

@@ -35,13 +35,13 @@ struct OutModule {
 };
 
 struct Rule {
-  std::vector<Pattern> left;   // left context, in string order
+  std::vector<Pattern> left;  // left context, in string order
   Pattern pred;
   std::vector<Pattern> right;  // right context, may contain '[' and ']'
   Expr condition;              // empty: always true
   std::vector<OutModule> successor;
-  Expr probability;            // empty: no probability
-  std::string where;           // "SOURCE:LINE" for messages
+  Expr probability;   // empty: no probability
+  std::string where;  // "SOURCE:LINE" for messages
   std::string text;
   // Formal slots: the predecessor's formals first, then the left context's, then the right's.
   std::vector<std::string> formals;
@@ -65,9 +65,9 @@ struct GrammarText {
 struct Grammar {
   std::vector<OutModule> premise;
   std::vector<Rule> rules;
-  std::vector<std::string> user_variables;  // single letters, slot kUserVar0 + k
-  std::vector<std::string> strings;         // interned string literals: a("Cd", ...)
-  std::bitset<128> ignore;                  // context ignore list
+  std::vector<std::string> user_variables;                // single letters, slot kUserVar0 + k
+  std::vector<std::string> strings;                       // interned string literals: a("Cd", ...)
+  std::bitset<128> ignore;                                // context ignore list
   std::array<std::vector<std::uint16_t>, 128> rules_for;  // rule indices per predecessor symbol
   bool uses_turtle = false;
   bool uses_age = false;

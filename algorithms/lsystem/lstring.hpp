@@ -18,11 +18,18 @@ constexpr int kCountShift = 7;
 constexpr std::uint16_t kNewFlag = 1u << 10;
 
 constexpr std::uint16_t encode(char symbol, int count) {
-  return static_cast<std::uint16_t>((static_cast<unsigned>(symbol) & kSymbolMask) | (static_cast<unsigned>(count) << kCountShift));
+  return static_cast<std::uint16_t>((static_cast<unsigned>(symbol) & kSymbolMask) |
+                                    (static_cast<unsigned>(count) << kCountShift));
 }
-constexpr char symbol_of(std::uint16_t w) { return static_cast<char>(w & kSymbolMask); }
-constexpr int count_of(std::uint16_t w) { return (w >> kCountShift) & 7; }
-constexpr bool is_new(std::uint16_t w) { return (w & kNewFlag) != 0; }
+constexpr char symbol_of(std::uint16_t w) {
+  return static_cast<char>(w & kSymbolMask);
+}
+constexpr int count_of(std::uint16_t w) {
+  return (w >> kCountShift) & 7;
+}
+constexpr bool is_new(std::uint16_t w) {
+  return (w & kNewFlag) != 0;
+}
 
 // A growable array of trivially copyable values that does not zero what it allocates (the writers
 // fill every element), so a generation's output costs one pass of writes, not two.

@@ -40,57 +40,71 @@ const AlgorithmInfo kInfo = {
     .summary =
         "L-system, Houdini dialect: parametric, stochastic, context-sensitive rules, 3D turtle, J/K/M organs, "
         "in(), wrap",
-    .params = {
-        param::text("grammar")
-            .doc("a .lsys grammar file (premise, rules and values) or an example name (koch-island, bush, ...)"),
-        param::text("premise", "FFFA").doc("the string at generation 0"),
-        param::text("rules", "A = !\"[&FFFA]////[&FFFA]////[&FFFA]")
-            .doc("rules, one per line: [left<] sym [>right] [:cond] = replacement [:prob]"),
-        param::text("rules_file").doc("read the rules from this file (one per line, # comments) instead"),
-        param::real("generations", 5.0).range(0, 200).doc("rewrites; a fraction adds a partly grown last generation"),
-        param::real("step_size", 0.1).range(0, 1e4).unit("m").doc("default length of F, f, G (and of J/K/M organs)"),
-        param::real("step_scale", 0.8).range(0, 1e4).doc("factor of \" (and divisor of _)"),
-        param::real("angle", 28.0).range(-360, 360).unit("deg")
-            .doc("default angle of + - & ^ \\ /; also the variable a"),
-        param::real("angle_scale", 0.9).range(0, 1e4).doc("factor of ; (and divisor of @)"),
-        param::real("thickness", 0.02).range(0, 1e3).unit("m").doc("initial width (node radius = width / 2)"),
-        param::real("thickness_scale", 0.7).range(0, 1e4).doc("factor of ! (and divisor of ?)"),
-        param::real("gravity", 0.2).range(-100, 100).doc("tropism of T toward -Y (radians per unit sin); also T"),
-        param::real("random_scale", 0.0).range(0, 1)
-            .doc("every move length is scaled by 1 + random_scale * uniform(-1, 1)"),
-        param::real("u_increment", 0.1).range(-1e4, 1e4).doc("default increment of ' (colour index U)"),
-        param::real("v_increment", 0.1).range(-1e4, 1e4).doc("default increment of # (colour index V)"),
-        param::real("b", 0.0).range(-1e12, 1e12).doc("expression variable b"),
-        param::real("c", 0.0).range(-1e12, 1e12).doc("expression variable c"),
-        param::real("d", 0.0).range(-1e12, 1e12).doc("expression variable d"),
-        param::text("variables").doc("user variables, single letters: 'k=0.5, q=2'"),
-        param::text("channels").doc("values of chan(0), chan(1), ...: '1, 0.5'"),
-        param::text("context_ignore")
-            .doc("symbols skipped when matching contexts, e.g. '+-F'; with '[' or ']' brackets become transparent"),
-        param::boolean("context_siblings", false)
-            .doc("contexts read across branch brackets (pre-Houdini 10 behaviour) instead of skipping sub-branches"),
-        param::choice("probability", "sequential", {"sequential", "normalized"})
-            .doc("sequential: each applicable rule fires with its own chance, in order (Houdini); normalized: one of "
-                 "the applicable probabilistic rules by weight (ABOP)"),
-        param::choice("convention", "houdini", {"houdini", "abop"})
-            .doc("houdini: + turns right; abop: + turns left (The Algorithmic Beauty of Plants)"),
-        param::boolean("continuous_length", true).doc("fractional generation scales new lengths"),
-        param::boolean("continuous_angles", true).doc("fractional generation scales new angles"),
-        param::boolean("continuous_width", true).doc("fractional generation scales new widths"),
-        param::choice("start", "seeds", {"seeds", "origin"})
-            .doc("seeds: one plant per scene seed (along its direction); origin: one plant at start_position, +Y"),
-        param::vec3("start_position", glm::dvec3(0.0)).range(-1e6, 1e6).unit("m")
-            .doc("where the turtle starts when start=origin"),
-        param::choice("surface", "free", {"free", "wrap"})
-            .doc("free: the turtle moves in space; wrap: every move is mapped onto the nearest scene surface"),
-        param::real("wrap_offset", 0.01).range(0, 10).unit("m").doc("distance kept from the surface when wrapping"),
-        param::choice("in_test", "auto", {"auto", "envelope", "solids"})
-            .doc("what in(x,y,z) tests: the scene envelope, the scene's solids, or auto (envelope if any, else "
-                 "solids)"),
-        param::text("pic_image").doc("image read by pic(u, v, plane) (PNG, JPEG, ...)"),
-        param::integer("max_symbols", 50'000'000).range(1, 2e9)
-            .doc("a generation that would exceed this many symbols stops the run with an error"),
-    },
+    .params =
+        {
+            param::text("grammar").doc(
+                "a .lsys grammar file (premise, rules and values) or an example name (koch-island, bush, ...)"),
+            param::text("premise", "FFFA").doc("the string at generation 0"),
+            param::text("rules", "A = !\"[&FFFA]////[&FFFA]////[&FFFA]")
+                .doc("rules, one per line: [left<] sym [>right] [:cond] = replacement [:prob]"),
+            param::text("rules_file").doc("read the rules from this file (one per line, # comments) instead"),
+            param::real("generations", 5.0)
+                .range(0, 200)
+                .doc("rewrites; a fraction adds a partly grown last generation"),
+            param::real("step_size", 0.1)
+                .range(0, 1e4)
+                .unit("m")
+                .doc("default length of F, f, G (and of J/K/M organs)"),
+            param::real("step_scale", 0.8).range(0, 1e4).doc("factor of \" (and divisor of _)"),
+            param::real("angle", 28.0)
+                .range(-360, 360)
+                .unit("deg")
+                .doc("default angle of + - & ^ \\ /; also the variable a"),
+            param::real("angle_scale", 0.9).range(0, 1e4).doc("factor of ; (and divisor of @)"),
+            param::real("thickness", 0.02).range(0, 1e3).unit("m").doc("initial width (node radius = width / 2)"),
+            param::real("thickness_scale", 0.7).range(0, 1e4).doc("factor of ! (and divisor of ?)"),
+            param::real("gravity", 0.2).range(-100, 100).doc("tropism of T toward -Y (radians per unit sin); also T"),
+            param::real("random_scale", 0.0)
+                .range(0, 1)
+                .doc("every move length is scaled by 1 + random_scale * uniform(-1, 1)"),
+            param::real("u_increment", 0.1).range(-1e4, 1e4).doc("default increment of ' (colour index U)"),
+            param::real("v_increment", 0.1).range(-1e4, 1e4).doc("default increment of # (colour index V)"),
+            param::real("b", 0.0).range(-1e12, 1e12).doc("expression variable b"),
+            param::real("c", 0.0).range(-1e12, 1e12).doc("expression variable c"),
+            param::real("d", 0.0).range(-1e12, 1e12).doc("expression variable d"),
+            param::text("variables").doc("user variables, single letters: 'k=0.5, q=2'"),
+            param::text("channels").doc("values of chan(0), chan(1), ...: '1, 0.5'"),
+            param::text("context_ignore")
+                .doc("symbols skipped when matching contexts, e.g. '+-F'; with '[' or ']' brackets become transparent"),
+            param::boolean("context_siblings", false)
+                .doc(
+                    "contexts read across branch brackets (pre-Houdini 10 behaviour) instead of skipping sub-branches"),
+            param::choice("probability", "sequential", {"sequential", "normalized"})
+                .doc("sequential: each applicable rule fires with its own chance, in order (Houdini); normalized: one "
+                     "of "
+                     "the applicable probabilistic rules by weight (ABOP)"),
+            param::choice("convention", "houdini", {"houdini", "abop"})
+                .doc("houdini: + turns right; abop: + turns left (The Algorithmic Beauty of Plants)"),
+            param::boolean("continuous_length", true).doc("fractional generation scales new lengths"),
+            param::boolean("continuous_angles", true).doc("fractional generation scales new angles"),
+            param::boolean("continuous_width", true).doc("fractional generation scales new widths"),
+            param::choice("start", "seeds", {"seeds", "origin"})
+                .doc("seeds: one plant per scene seed (along its direction); origin: one plant at start_position, +Y"),
+            param::vec3("start_position", glm::dvec3(0.0))
+                .range(-1e6, 1e6)
+                .unit("m")
+                .doc("where the turtle starts when start=origin"),
+            param::choice("surface", "free", {"free", "wrap"})
+                .doc("free: the turtle moves in space; wrap: every move is mapped onto the nearest scene surface"),
+            param::real("wrap_offset", 0.01).range(0, 10).unit("m").doc("distance kept from the surface when wrapping"),
+            param::choice("in_test", "auto", {"auto", "envelope", "solids"})
+                .doc("what in(x,y,z) tests: the scene envelope, the scene's solids, or auto (envelope if any, else "
+                     "solids)"),
+            param::text("pic_image").doc("image read by pic(u, v, plane) (PNG, JPEG, ...)"),
+            param::integer("max_symbols", 50'000'000)
+                .range(1, 2e9)
+                .doc("a generation that would exceed this many symbols stops the run with an error"),
+        },
     .test_params = {"surface=wrap"},  // a free tree passes through solids
 };
 
@@ -157,7 +171,8 @@ std::vector<double> parse_channels(const std::string& text) {
     if (!item.empty()) {
       char* e = nullptr;
       const double v = std::strtod(item.c_str(), &e);
-      if (e == item.c_str() || *e != '\0') throw InputError(fmt::format("channels: expected a number, found '{}'", item));
+      if (e == item.c_str() || *e != '\0')
+        throw InputError(fmt::format("channels: expected a number, found '{}'", item));
       out.push_back(v);
     }
     start = end + 1;
@@ -239,7 +254,8 @@ Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* quer
     int w = 0, h = 0, ch = 0;
     unsigned char* px = stbi_load(p.text("pic_image").c_str(), &w, &h, &ch, 3);
     if (!px)
-      throw InputError(fmt::format("pic_image '{}': cannot read the image ({})", p.text("pic_image"), stbi_failure_reason()));
+      throw InputError(
+          fmt::format("pic_image '{}': cannot read the image ({})", p.text("pic_image"), stbi_failure_reason()));
     s.host->image_.w = w;
     s.host->image_.h = h;
     s.host->image_.rgb.resize(static_cast<std::size_t>(w) * h * 3);
@@ -253,10 +269,9 @@ Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* quer
       .host = s.host.get(),
       .seed = seed,
       .stream = 0,  // set for each plant before it is rewritten
-      .probability = p.text("probability") == "normalized" ? lsys::ProbabilityMode::Normalized
-                                                           : lsys::ProbabilityMode::Sequential,
-      .brackets_transparent =
-          p.boolean("context_siblings") || s.grammar.ignore.test('[') || s.grammar.ignore.test(']'),
+      .probability =
+          p.text("probability") == "normalized" ? lsys::ProbabilityMode::Normalized : lsys::ProbabilityMode::Sequential,
+      .brackets_transparent = p.boolean("context_siblings") || s.grammar.ignore.test('[') || s.grammar.ignore.test(']'),
       .max_symbols = max_symbols,
       .max_params = max_symbols * 2,
       .env = {},
@@ -480,7 +495,8 @@ DerivedString derive_lsystem(const Params& params, std::uint64_t seed, const Sce
   out.generations = rewrites;
   const auto counts = lsys::symbol_counts(cur);
   for (int c = 0; c < 128; ++c)
-    if (counts[static_cast<std::size_t>(c)] > 0) out.counts.emplace_back(static_cast<char>(c), counts[static_cast<std::size_t>(c)]);
+    if (counts[static_cast<std::size_t>(c)] > 0)
+      out.counts.emplace_back(static_cast<char>(c), counts[static_cast<std::size_t>(c)]);
   return out;
 }
 

@@ -13,10 +13,10 @@ namespace growbench {
 // What `growbench lsystem FILE --print` shows: the derived string (of the first plant) and its symbol
 // counts, without drawing (the turtle runs only if rules read its state).
 struct DerivedString {
-  std::string text;        // up to print_limit modules (0: all)
+  std::string text;  // up to print_limit modules (0: all)
   std::size_t modules = 0;
   std::size_t params = 0;
-  std::size_t bytes = 0;   // memory of the string
+  std::size_t bytes = 0;  // memory of the string
   int generations = 0;
   std::vector<std::pair<char, std::size_t>> counts;  // by symbol, in ASCII order
 };

@@ -36,7 +36,8 @@ DeriveSettings settings(const NoHost& host) {
 }
 
 // Derives `generations - 1` generations, then times the last one.
-void time_last_generation(benchmark::State& state, const std::string& premise, const std::string& rules, int generations) {
+void time_last_generation(benchmark::State& state, const std::string& premise, const std::string& rules,
+                          int generations) {
   tbb::global_control gc(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(state.range(0)));
   static const NoHost host;
   const Grammar g = grammar(premise, rules);
@@ -54,7 +55,8 @@ void time_last_generation(benchmark::State& state, const std::string& premise, c
     benchmark::DoNotOptimize(b.symbols.data());
   }
   state.counters["symbols"] = static_cast<double>(out);
-  state.counters["symbols_per_s"] = benchmark::Counter(static_cast<double>(out), benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["symbols_per_s"] =
+      benchmark::Counter(static_cast<double>(out), benchmark::Counter::kIsIterationInvariantRate);
   // input and output strings together, per output symbol (what one generation holds in memory)
   state.counters["bytes_per_symbol"] = static_cast<double>(a.bytes() + b.bytes()) / static_cast<double>(out);
 }
@@ -62,8 +64,14 @@ void time_last_generation(benchmark::State& state, const std::string& premise, c
 void BM_LsysPlainRewrite(benchmark::State& state) {  // F -> F[+F]F[-F]F, generation 10: 24.4 M symbols
   time_last_generation(state, "F", "F = F[+F]F[-F]F", 10);
 }
-BENCHMARK(BM_LsysPlainRewrite)->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()
-    ->Repetitions(3)->ReportAggregatesOnly(true);
+BENCHMARK(BM_LsysPlainRewrite)
+    ->ArgName("threads")
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Repetitions(3)
+    ->ReportAggregatesOnly(true);
 
 void BM_LsysParametricRewrite(benchmark::State& state) {  // conditions and expressions, ~12.6 M symbols
   time_last_generation(state, "A(1,0)",
@@ -71,8 +79,14 @@ void BM_LsysParametricRewrite(benchmark::State& state) {  // conditions and expr
                        "A(l,k) = F(l)",
                        21);
 }
-BENCHMARK(BM_LsysParametricRewrite)->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()
-    ->Repetitions(3)->ReportAggregatesOnly(true);
+BENCHMARK(BM_LsysParametricRewrite)
+    ->ArgName("threads")
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Repetitions(3)
+    ->ReportAggregatesOnly(true);
 
 // The plain plant at generation 9: 4.9 M symbols, 2 M nodes. Arg 0: a fresh Plant per interpretation
 // (cold: the node array's pages are touched for the first time); arg 1: the Plant is cleared and
@@ -119,9 +133,17 @@ void BM_LsysTurtle(benchmark::State& state) {
   }
   state.counters["symbols"] = static_cast<double>(a.size());
   state.counters["nodes"] = static_cast<double>(nodes);
-  state.counters["symbols_per_s"] = benchmark::Counter(static_cast<double>(a.size()), benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["symbols_per_s"] =
+      benchmark::Counter(static_cast<double>(a.size()), benchmark::Counter::kIsIterationInvariantRate);
 }
-BENCHMARK(BM_LsysTurtle)->ArgName("reuse")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->Repetitions(3)->ReportAggregatesOnly(true);
+BENCHMARK(BM_LsysTurtle)
+    ->ArgName("reuse")
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Repetitions(3)
+    ->ReportAggregatesOnly(true);
 
 }  // namespace
 }  // namespace growbench::lsys

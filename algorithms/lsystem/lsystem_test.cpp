@@ -119,8 +119,7 @@ TEST(LSystemDerivation, HoudiniReferenceExamples) {
   const std::string rules =
       "F(i,j,k,l,m) :m=0 = F(i,j,k,l,0)+F(i,j,k,l,1)+\n"
       "F(i,j,k,l,m) :m=1 =-F(i,j,k,l,0)-F(i,j,k,l,1)";
-  EXPECT_EQ(derive("F(1,1,3,3,0)", rules, 2),
-            "F(1,1,3,3,0)+F(1,1,3,3,1)++-F(1,1,3,3,0)-F(1,1,3,3,1)+");
+  EXPECT_EQ(derive("F(1,1,3,3,0)", rules, 2), "F(1,1,3,3,0)+F(1,1,3,3,1)++-F(1,1,3,3,0)-F(1,1,3,3,1)+");
   // t is the iteration count during each rewrite; b = generations; the table of the reference
   const std::string lr = "l:t<b=l+r+\nr:t<b=-l-r\nl=F\nr=F";
   EXPECT_EQ(derive("l", lr, 1, {"b=1"}), "F");
@@ -214,7 +213,8 @@ TEST(LSystemErrors, NameSourceLineColumnAndWhatWasExpected) {
     p.set("grammar", file);
     derive_lsystem(p, 1, nullptr, nullptr, 0);
   });
-  EXPECT_NE(e1.find("bad.lsys:3:1: unknown setting 'generatons' (did you mean 'generations'?)"), std::string::npos) << e1;
+  EXPECT_NE(e1.find("bad.lsys:3:1: unknown setting 'generatons' (did you mean 'generations'?)"), std::string::npos)
+      << e1;
   const std::string file2 = test::write_text(dir / "bad2.lsys", "premise: A\n\nA = B(\n");
   const std::string e2 = test::error_of([&] {
     Params p = default_params(find_algorithm("lsystem"));
@@ -251,9 +251,9 @@ class LSystemTurtle : public ::testing::Test {
   }
   static Plant grow(const std::string& premise, const std::string& rules, double generations,
                     std::vector<std::string> extra = {}, int threads = 0) {
-    std::vector<std::string> sets = {"premise=" + premise, "rules=" + rules,
-                                     "generations=" + std::to_string(generations), "start=origin", "step_size=1",
-                                     "thickness=0.1"};
+    std::vector<std::string> sets = {
+        "premise=" + premise, "rules=" + rules, "generations=" + std::to_string(generations),
+        "start=origin",       "step_size=1",    "thickness=0.1"};
     sets.insert(sets.end(), extra.begin(), extra.end());
     return test::grow("lsystem", *scene_, *query_, sets, threads);
   }
@@ -265,7 +265,7 @@ SceneQuery* LSystemTurtle::query_ = nullptr;
 
 TEST_F(LSystemTurtle, KochIslandClosesWithExactLengthsAndRightAngles) {
   const Plant p = grow("F-F-F-F", "F = F-F+F+FF-F-F+F", 2, {"angle=90"});
-  ASSERT_EQ(p.nodes.size(), 4u * 64u + 1u);  // a root and one node per F
+  ASSERT_EQ(p.nodes.size(), 4u * 64u + 1u);                                            // a root and one node per F
   EXPECT_LT(glm::distance(p.nodes.front().position, p.nodes.back().position), 1e-4f);  // closes
   for (std::size_t k = 1; k < p.nodes.size(); ++k) {
     const glm::vec3 d = p.nodes[k].position - p.nodes[static_cast<std::size_t>(p.nodes[k].parent)].position;
@@ -344,7 +344,7 @@ TEST_F(LSystemTurtle, ScalesWidthsOrgansPolygonsGroupsAttributes) {
   ASSERT_EQ(p.nodes.size(), 6u);
   EXPECT_NEAR(p.nodes[2].position.y - p.nodes[1].position.y, 0.5f, 1e-6f);
   EXPECT_NEAR(p.nodes[4].position.y - p.nodes[3].position.y, 1.0f, 1e-6f);  // _ undid "
-  EXPECT_NEAR(p.nodes[1].radius, 0.05f, 1e-7f);                            // width 0.1 -> radius 0.05
+  EXPECT_NEAR(p.nodes[1].radius, 0.05f, 1e-7f);                             // width 0.1 -> radius 0.05
   EXPECT_NEAR(p.nodes[3].radius, 0.025f, 1e-7f);
   EXPECT_NEAR(p.nodes[5].radius, 0.05f, 1e-7f);
 

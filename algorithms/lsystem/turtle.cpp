@@ -52,7 +52,8 @@ class Interpreter {
     t.length = s_.step;
     t.width = s_.thickness;
     t.angle = s_.angle;
-    for (const auto& nd : plant_.nodes) shoot_counter_ = std::max(shoot_counter_, nd.shoot + 1);  // after earlier plants'
+    for (const auto& nd : plant_.nodes)
+      shoot_counter_ = std::max(shoot_counter_, nd.shoot + 1);  // after earlier plants'
     t.shoot = next_shoot();
     if (s_.wrap) snap_start(t);
     const std::size_t first_node = plant_.nodes.size();
@@ -83,7 +84,11 @@ class Interpreter {
       if (states_) record(t, m);
       const bool fresh = is_new(w) && s_.fraction < 1.0;
       switch (c) {
-        case 'F': case 'H': case 'G': case 'f': case 'h': {
+        case 'F':
+        case 'H':
+        case 'G':
+        case 'f':
+        case 'h': {
           double len = k > 0 ? a[0] : t.length;
           if (c == 'H' || c == 'h') len *= 0.5;
           if (s_.random_scale != 0.0) {
@@ -99,11 +104,15 @@ class Interpreter {
           t.pos += t.H * len;
           if (s_.wrap) snap(t);
           if (c == 'F' || c == 'H' || c == 'G') t.arc += glm::length(t.pos - before);
-          if (draw) t.node = add_node(t.pos, width, t.node, t);
-          else if (c == 'f' || c == 'h') t.node = kNoParent;
+          if (draw)
+            t.node = add_node(t.pos, width, t.node, t);
+          else if (c == 'f' || c == 'h')
+            t.node = kNoParent;
           break;
         }
-        case 'J': case 'K': case 'M': {
+        case 'J':
+        case 'K':
+        case 'M': {
           Organ o;
           o.position = glm::vec3(t.pos);
           o.orientation = glm::quat_cast(glm::mat3(glm::vec3(t.L), glm::vec3(t.U), glm::vec3(t.H)));
@@ -131,18 +140,35 @@ class Interpreter {
           }
           break;
         }
-        case '+': case '-': case '&': case '^': case '\\': case '/': {
+        case '+':
+        case '-':
+        case '&':
+        case '^':
+        case '\\':
+        case '/': {
           double ang = k > 0 ? a[0] : t.angle;
           if (fresh && s_.continuous_angles) ang *= s_.fraction;
           double cs, sn;
           sincos_deg(ang, cs, sn);
           switch (c) {
-            case '+': rotate_pair(t.H, t.L, cs, turn_sign * sn); break;   // about U
-            case '-': rotate_pair(t.H, t.L, cs, -turn_sign * sn); break;
-            case '&': rotate_pair(t.H, t.U, cs, -sn); break;              // about L: pitch down
-            case '^': rotate_pair(t.H, t.U, cs, sn); break;
-            case '\\': rotate_pair(t.L, t.U, cs, sn); break;              // about H: roll
-            default: rotate_pair(t.L, t.U, cs, -sn); break;               // '/'
+            case '+':
+              rotate_pair(t.H, t.L, cs, turn_sign * sn);
+              break;  // about U
+            case '-':
+              rotate_pair(t.H, t.L, cs, -turn_sign * sn);
+              break;
+            case '&':
+              rotate_pair(t.H, t.U, cs, -sn);
+              break;  // about L: pitch down
+            case '^':
+              rotate_pair(t.H, t.U, cs, sn);
+              break;
+            case '\\':
+              rotate_pair(t.L, t.U, cs, sn);
+              break;  // about H: roll
+            default:
+              rotate_pair(t.L, t.U, cs, -sn);
+              break;  // '/'
           }
           break;
         }
@@ -166,14 +192,30 @@ class Interpreter {
           rotate_pair(t.H, t.L, cs, sn);
           break;
         }
-        case '"': t.length *= k > 0 ? a[0] : s_.step_scale; break;
-        case '_': t.length /= k > 0 ? a[0] : s_.step_scale; break;
-        case '!': t.width *= k > 0 ? a[0] : s_.thickness_scale; break;
-        case '?': t.width /= k > 0 ? a[0] : s_.thickness_scale; break;
-        case ';': t.angle *= k > 0 ? a[0] : s_.angle_scale; break;
-        case '@': t.angle /= k > 0 ? a[0] : s_.angle_scale; break;
-        case '\'': t.u += k > 0 ? a[0] : s_.uv_increment.x; break;
-        case '#': t.v += k > 0 ? a[0] : s_.uv_increment.y; break;
+        case '"':
+          t.length *= k > 0 ? a[0] : s_.step_scale;
+          break;
+        case '_':
+          t.length /= k > 0 ? a[0] : s_.step_scale;
+          break;
+        case '!':
+          t.width *= k > 0 ? a[0] : s_.thickness_scale;
+          break;
+        case '?':
+          t.width /= k > 0 ? a[0] : s_.thickness_scale;
+          break;
+        case ';':
+          t.angle *= k > 0 ? a[0] : s_.angle_scale;
+          break;
+        case '@':
+          t.angle /= k > 0 ? a[0] : s_.angle_scale;
+          break;
+        case '\'':
+          t.u += k > 0 ? a[0] : s_.uv_increment.x;
+          break;
+        case '#':
+          t.v += k > 0 ? a[0] : s_.uv_increment.y;
+          break;
         case '%': {  // skip to the end of this branch; its ']' then pops as usual
           int depth = 0;
           while (m + 1 < n) {
@@ -282,7 +324,7 @@ class Interpreter {
   }
   std::uint32_t next_shoot() { return shoot_counter_++; }
   void record(const State& t, std::size_t m) {
-    (*states_)[m] = {static_cast<float>(t.pos.x), static_cast<float>(t.pos.y), static_cast<float>(t.pos.z),
+    (*states_)[m] = {static_cast<float>(t.pos.x), static_cast<float>(t.pos.y),  static_cast<float>(t.pos.z),
                      static_cast<float>(t.arc),   static_cast<float>(t.length), static_cast<float>(t.width),
                      static_cast<float>(t.u),     static_cast<float>(t.v)};
   }
@@ -304,12 +346,14 @@ class Interpreter {
   void snap_start(State& t) { snap(t); }
   // Maps the position onto the nearest surface, offset along the direction away from it, and turns the
   // frame so the heading is tangent there (the minimal rotation, so the turtle keeps its roll). The
-  // projection repeats (up to 6 times; a point inside a solid first leaves it along the SDF gradient) until the point is wrap_offset from its nearest surface, which
-  // settles points in concave corners, where the offset from one face can lie inside another.
+  // projection repeats (up to 6 times; a point inside a solid first leaves it along the SDF gradient) until the point
+  // is wrap_offset from its nearest surface, which settles points in concave corners, where the offset from one face
+  // can lie inside another.
   void snap(State& t) {
     glm::dvec3 dir(0.0);
     for (int iter = 0; iter < 6; ++iter) {
-      if (s_.wrap->has_sdf() && s_.wrap->inside(glm::vec3(t.pos))) {  // (e.g. near a face of another mesh): out along the gradient
+      if (s_.wrap->has_sdf() &&
+          s_.wrap->inside(glm::vec3(t.pos))) {  // (e.g. near a face of another mesh): out along the gradient
         const float sd = std::min(0.0f, s_.wrap->signed_distance(glm::vec3(t.pos)));
         t.pos += glm::dvec3(s_.wrap->gradient(glm::vec3(t.pos))) * (static_cast<double>(-sd) + s_.wrap_offset);
         continue;
@@ -321,8 +365,10 @@ class Interpreter {
       const double dist = glm::length(v);
       const auto& solid = s_.wrap->mesh_solid();
       const bool inside = glm::dot(v, nrm) < 0.0 && hit.mesh < solid.size() && solid[hit.mesh];
-      if (!inside && dist > 1e-9) dir = v / dist;
-      else dir = nrm;
+      if (!inside && dist > 1e-9)
+        dir = v / dist;
+      else
+        dir = nrm;
       if (!inside && std::fabs(dist - s_.wrap_offset) <= 1e-6 + 1e-4 * s_.wrap_offset) break;
       t.pos = cp + dir * s_.wrap_offset;
     }

@@ -33,43 +33,58 @@ const AlgorithmInfo kInfo = {
     .name = "spacecol",
     .summary =
         "Runions space colonization: attraction points pull nodes; open or closed venation; free, avoid or cling",
-    .params = {
-        param::choice("venation", "open", {"open", "closed"})
-            .doc("open: each point pulls its nearest node; closed: every node in its relative neighbourhood"),
-        param::choice("points", "auto", {"auto", "envelope", "surface", "file"})
-            .doc("attraction points: in the scene envelope, on the surfaces (area-weighted), or from points_file; "
-                 "auto = surface when surface=cling or the scene has no envelope, else envelope"),
-        param::text("points_file")
-            .doc("text file of attraction points, one 'x y z' (or x,y,z) per line, # comments (points=file)"),
-        param::integer("point_count", 20000).range(1, 5e7).doc("number of attraction points sampled"),
-        param::real("surface_offset", 0.01).range(0, 10).unit("m")
-            .doc("surface-sampled points are lifted this far along the surface normal"),
-        param::real("influence", 0.25).range(1e-4, 1e3).unit("m")
-            .doc("influence radius d_i: points farther from every node are ignored"),
-        param::real("kill", 0.05).range(1e-5, 1e3).unit("m")
-            .doc("kill distance d_k: a point this close to a node is removed"),
-        param::real("step", 0.02).range(1e-5, 1e2).unit("m").doc("step length D between a node and its child"),
-        param::vec3("tropism", glm::dvec3(0.0)).range(-10, 10)
-            .doc("added to each normalised growth direction (e.g. 0,0.2,0 bends growth upward)"),
-        param::real("noise", 0.0).range(0, 10).doc("random unit vector times this is added to each growth direction"),
-        param::choice("surface", "free", {"free", "avoid", "cling"})
-            .doc("free: ignore solids; avoid: push nodes out of solids; cling: hold nodes at cling_distance from the "
-                 "nearest surface (the Hyphae collision vector)"),
-        param::real("cling_distance", 0.01).range(0, 10).unit("m")
-            .doc("distance kept from the surface (cling), minimum clearance (avoid)"),
-        param::real("split", 0.1).range(0, 1)
-            .doc("when the pulls on a node nearly cancel (|sum| < split * count), grow two children toward the two "
-                 "most opposed points instead of stalling (0: such a node stalls)"),
-        param::boolean("seek", true)
-            .doc("while no attraction point is within reach, roots grow along their seed direction"),
-        param::real("tip_radius", 0.002).range(1e-6, 10).unit("m").doc("radius of branch tips (pipe model)"),
-        param::real("pipe_exponent", 2.5).range(1, 4).doc("pipe model exponent n: r^n = sum of children's r^n"),
-        param::choice("leaves", "tips", {"none", "tips", "interval", "both"})
-            .doc("where leaves go: none, at branch tips, every leaf_interval nodes, or both"),
-        param::integer("leaf_interval", 6).range(1, 1000)
-            .doc("a leaf every k nodes along a branch (leaves=interval/both)"),
-        param::real("leaf_size", 0.05).range(0, 10).unit("m").doc("leaf blade length"),
-    },
+    .params =
+        {
+            param::choice("venation", "open", {"open", "closed"})
+                .doc("open: each point pulls its nearest node; closed: every node in its relative neighbourhood"),
+            param::choice("points", "auto", {"auto", "envelope", "surface", "file"})
+                .doc("attraction points: in the scene envelope, on the surfaces (area-weighted), or from points_file; "
+                     "auto = surface when surface=cling or the scene has no envelope, else envelope"),
+            param::text("points_file")
+                .doc("text file of attraction points, one 'x y z' (or x,y,z) per line, # comments (points=file)"),
+            param::integer("point_count", 20000).range(1, 5e7).doc("number of attraction points sampled"),
+            param::real("surface_offset", 0.01)
+                .range(0, 10)
+                .unit("m")
+                .doc("surface-sampled points are lifted this far along the surface normal"),
+            param::real("influence", 0.25)
+                .range(1e-4, 1e3)
+                .unit("m")
+                .doc("influence radius d_i: points farther from every node are ignored"),
+            param::real("kill", 0.05)
+                .range(1e-5, 1e3)
+                .unit("m")
+                .doc("kill distance d_k: a point this close to a node is removed"),
+            param::real("step", 0.02).range(1e-5, 1e2).unit("m").doc("step length D between a node and its child"),
+            param::vec3("tropism", glm::dvec3(0.0))
+                .range(-10, 10)
+                .doc("added to each normalised growth direction (e.g. 0,0.2,0 bends growth upward)"),
+            param::real("noise", 0.0)
+                .range(0, 10)
+                .doc("random unit vector times this is added to each growth direction"),
+            param::choice("surface", "free", {"free", "avoid", "cling"})
+                .doc("free: ignore solids; avoid: push nodes out of solids; cling: hold nodes at cling_distance from "
+                     "the "
+                     "nearest surface (the Hyphae collision vector)"),
+            param::real("cling_distance", 0.01)
+                .range(0, 10)
+                .unit("m")
+                .doc("distance kept from the surface (cling), minimum clearance (avoid)"),
+            param::real("split", 0.1)
+                .range(0, 1)
+                .doc("when the pulls on a node nearly cancel (|sum| < split * count), grow two children toward the two "
+                     "most opposed points instead of stalling (0: such a node stalls)"),
+            param::boolean("seek", true)
+                .doc("while no attraction point is within reach, roots grow along their seed direction"),
+            param::real("tip_radius", 0.002).range(1e-6, 10).unit("m").doc("radius of branch tips (pipe model)"),
+            param::real("pipe_exponent", 2.5).range(1, 4).doc("pipe model exponent n: r^n = sum of children's r^n"),
+            param::choice("leaves", "tips", {"none", "tips", "interval", "both"})
+                .doc("where leaves go: none, at branch tips, every leaf_interval nodes, or both"),
+            param::integer("leaf_interval", 6)
+                .range(1, 1000)
+                .doc("a leaf every k nodes along a branch (leaves=interval/both)"),
+            param::real("leaf_size", 0.05).range(0, 10).unit("m").doc("leaf blade length"),
+        },
     .test_params = {"surface=avoid", "point_count=4000"},
 };
 
@@ -148,7 +163,8 @@ class SpaceColonization final : public GrowthAlgorithm {
     tau_ = std::min(cfg_.influence, std::max(2.0f * cfg_.kill, cfg_.kill + 2.0f * cfg_.step));
     build_trees();
     alive_count_ = pts_.size();
-    if (cfg_.closed) node_tree_ = std::make_unique<NodeTree>(3, node_cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    if (cfg_.closed)
+      node_tree_ = std::make_unique<NodeTree>(3, node_cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(16));
     step_ = 0;
     add_due_roots();
   }
@@ -156,8 +172,10 @@ class SpaceColonization final : public GrowthAlgorithm {
   bool step() override {
     ++step_;
     std::vector<std::int32_t> new_nodes;
-    if (cfg_.closed) grow_closed(new_nodes);
-    else grow_open(new_nodes);
+    if (cfg_.closed)
+      grow_closed(new_nodes);
+    else
+      grow_open(new_nodes);
     if (new_nodes.empty() && cfg_.seek && !ever_influenced_) seek(new_nodes);
     if (!new_nodes.empty()) associate(new_nodes);
     const bool roots_pending = add_due_roots();
@@ -206,7 +224,8 @@ class SpaceColonization final : public GrowthAlgorithm {
     const std::size_t max_tries = 50 * count + 1000;
     std::size_t next = 0;
     while (pts_.size() < count && next < max_tries) {
-      const std::size_t batch = std::min<std::size_t>(max_tries - next, std::max<std::size_t>(4096, 2 * (count - pts_.size())));
+      const std::size_t batch =
+          std::min<std::size_t>(max_tries - next, std::max<std::size_t>(4096, 2 * (count - pts_.size())));
       std::vector<glm::vec3> cand(batch);
       std::vector<std::uint8_t> ok(batch);
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, batch, 1024), [&](const auto& r) {
@@ -220,9 +239,10 @@ class SpaceColonization final : public GrowthAlgorithm {
       next += batch;
     }
     if (pts_.empty())
-      throw InputError(fmt::format("algorithm 'spacecol': no attraction point could be placed {} of scene '{}' "
-                                   "(all candidates fell inside solids or outside the include zones)",
-                                   what, scene_->name));
+      throw InputError(
+          fmt::format("algorithm 'spacecol': no attraction point could be placed {} of scene '{}' "
+                      "(all candidates fell inside solids or outside the include zones)",
+                      what, scene_->name));
   }
 
   void sample_points(const std::string& points_file) {
@@ -234,26 +254,36 @@ class SpaceColonization final : public GrowthAlgorithm {
     pts_.reserve(count);
     if (mode == Points::Envelope) {
       if (!scene_->envelope)
-        throw InputError(fmt::format("algorithm 'spacecol': points=envelope but scene '{}' has no envelope", scene_->name));
+        throw InputError(
+            fmt::format("algorithm 'spacecol': points=envelope but scene '{}' has no envelope", scene_->name));
       const Shape& env = *scene_->envelope;
       const Aabb b = env.bounds();
-      sample_accepted(count, [&](std::size_t i) {
-        Rng rng(seed_, 0xE1u, 4 * i);
-        for (int tries = 0; tries < 64; ++tries) {
-          glm::vec3 q;
-          if (env.kind == Shape::Kind::Sphere) q = env.center + rng.in_unit_ball() * env.radii;
-          else q = b.min + glm::vec3(rng.uniform(), rng.uniform(), rng.uniform()) * b.size();
-          if (env.kind != Shape::Kind::Mesh || query_->inside_shape(env, q)) return q;
-        }
-        return glm::vec3(std::numeric_limits<float>::quiet_NaN());
-      }, "in the envelope");
-      pts_.erase(std::remove_if(pts_.begin(), pts_.end(), [](const glm::vec3& v) { return std::isnan(v.x); }), pts_.end());
+      sample_accepted(
+          count,
+          [&](std::size_t i) {
+            Rng rng(seed_, 0xE1u, 4 * i);
+            for (int tries = 0; tries < 64; ++tries) {
+              glm::vec3 q;
+              if (env.kind == Shape::Kind::Sphere)
+                q = env.center + rng.in_unit_ball() * env.radii;
+              else
+                q = b.min + glm::vec3(rng.uniform(), rng.uniform(), rng.uniform()) * b.size();
+              if (env.kind != Shape::Kind::Mesh || query_->inside_shape(env, q)) return q;
+            }
+            return glm::vec3(std::numeric_limits<float>::quiet_NaN());
+          },
+          "in the envelope");
+      pts_.erase(std::remove_if(pts_.begin(), pts_.end(), [](const glm::vec3& v) { return std::isnan(v.x); }),
+                 pts_.end());
     } else if (mode == Points::Surface) {
       const float off = cfg_.surface_offset;
-      sample_accepted(count, [&](std::size_t i) {
-        const SurfaceSample s = query_->sample_surface(seed_, i);
-        return s.position + off * s.normal;
-      }, "on the surfaces");
+      sample_accepted(
+          count,
+          [&](std::size_t i) {
+            const SurfaceSample s = query_->sample_surface(seed_, i);
+            return s.position + off * s.normal;
+          },
+          "on the surfaces");
     } else {
       read_points_file(points_file);
     }
@@ -302,7 +332,8 @@ class SpaceColonization final : public GrowthAlgorithm {
       std::istringstream ls(line);
       glm::vec3 v;
       std::string extra;
-      if (!(ls >> v.x >> v.y >> v.z) || (ls >> extra) || !std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+      if (!(ls >> v.x >> v.y >> v.z) || (ls >> extra) || !std::isfinite(v.x) || !std::isfinite(v.y) ||
+          !std::isfinite(v.z))
         throw InputError(fmt::format("{}:{}: expected three finite numbers 'x y z'", path, ln));
       pts_.push_back(v);
     }
@@ -392,14 +423,17 @@ class SpaceColonization final : public GrowthAlgorithm {
       const glm::vec3 d = node_pos_[static_cast<std::size_t>(gp)] - pos;
       if (glm::dot(d, d) < 0.25f * cfg_.step * cfg_.step) return true;
     }
-    for (std::int32_t c = first_child_[static_cast<std::size_t>(parent)]; c != kNone; c = next_sibling_[static_cast<std::size_t>(c)]) {
+    for (std::int32_t c = first_child_[static_cast<std::size_t>(parent)]; c != kNone;
+         c = next_sibling_[static_cast<std::size_t>(c)]) {
       const glm::vec3 d = node_pos_[static_cast<std::size_t>(c)] - pos;
       if (glm::dot(d, d) < lim2) return true;
     }
     return false;
   }
 
-  bool cancelling(const Pull& p) const { return cfg_.split > 0.0f && glm::length(p.sum) < cfg_.split * static_cast<float>(p.count); }
+  bool cancelling(const Pull& p) const {
+    return cfg_.split > 0.0f && glm::length(p.sum) < cfg_.split * static_cast<float>(p.count);
+  }
 
   glm::vec3 steer(glm::vec3 dir, std::size_t v, std::uint64_t salt) const {
     dir = safe_normalize(dir + cfg_.tropism, dir);
@@ -421,9 +455,12 @@ class SpaceColonization final : public GrowthAlgorithm {
         const auto v = static_cast<std::size_t>(influenced[k]);
         const Pull& p = pull[k];
         // A node the field's push leaves inside a solid (one thinner than its voxels) does not grow.
-        auto outside = [&](const glm::vec3& c) { return cfg_.surface != Surface::Free && query_->inside(c) ? none : c; };
+        auto outside = [&](const glm::vec3& c) {
+          return cfg_.surface != Surface::Free && query_->inside(c) ? none : c;
+        };
         if (cancelling(p) && p.min_dot < 0.0f) {
-          target[k] = {outside(place(node_pos_[v], steer(p.first, v, 1))), outside(place(node_pos_[v], steer(p.opposite, v, 2)))};
+          target[k] = {outside(place(node_pos_[v], steer(p.first, v, 1))),
+                       outside(place(node_pos_[v], steer(p.opposite, v, 2)))};
           continue;
         }
         const glm::vec3 dir = safe_normalize(p.sum, glm::vec3(0.0f));
@@ -466,7 +503,8 @@ class SpaceColonization final : public GrowthAlgorithm {
     bool any = false;
     for (const auto& p : pull) any = any || cancelling(p);
     if (!any) return;
-    for (std::size_t k = 0; k < influenced.size(); ++k) slot_[static_cast<std::size_t>(influenced[k])] = static_cast<std::int32_t>(k);
+    for (std::size_t k = 0; k < influenced.size(); ++k)
+      slot_[static_cast<std::size_t>(influenced[k])] = static_cast<std::int32_t>(k);
     each([&](std::size_t v, std::uint32_t s) {
       if (slot_[v] == kNone) return;
       Pull& p = pull[static_cast<std::size_t>(slot_[v])];
@@ -588,8 +626,9 @@ class SpaceColonization final : public GrowthAlgorithm {
 
   // Updates nearest nodes, activations and kills for points near the given (new) nodes.
   void associate(const std::vector<std::int32_t>& nodes) {
-    if (cfg_.closed) node_tree_->addPoints(static_cast<std::uint32_t>(node_pos_.size() - nodes.size()),
-                                       static_cast<std::uint32_t>(node_pos_.size() - 1));
+    if (cfg_.closed)
+      node_tree_->addPoints(static_cast<std::uint32_t>(node_pos_.size() - nodes.size()),
+                            static_cast<std::uint32_t>(node_pos_.size() - 1));
     const float r2 = cfg_.influence * cfg_.influence, k2 = cfg_.kill * cfg_.kill;
     std::vector<std::vector<std::pair<std::uint32_t, float>>> found(nodes.size());
     // Only points the new node is nearer to than their current nearest can change (every live point is
@@ -648,7 +687,8 @@ class SpaceColonization final : public GrowthAlgorithm {
     // Dead points, and near points still in the far tree, cost time in every radius query: rebuild the
     // trees when they make up half of the far tree, or dead points half of the near tree (amortised
     // O(n log n) over the whole run).
-    if (alive_count_ > 0 && (2 * far_stale_ > far_ids_.size() || 2 * near_dead_ > near_ids_.size() + 1024)) build_trees();
+    if (alive_count_ > 0 && (2 * far_stale_ > far_ids_.size() || 2 * near_dead_ > near_ids_.size() + 1024))
+      build_trees();
   }
 
   void build_trees() {
@@ -687,7 +727,8 @@ class SpaceColonization final : public GrowthAlgorithm {
       // Upper side faces away from the nearest surface when clinging, otherwise up (toward the sky).
       glm::vec3 up = cfg_.surface == Surface::Free ? glm::vec3(0, 1, 0) : query_->gradient(n.position);
       // Blade: along the branch, tilted away from the axis by a random angle around it.
-      glm::vec3 side = safe_normalize(glm::cross(axis, up), safe_normalize(glm::cross(axis, glm::vec3(1, 0, 0)), glm::vec3(0, 0, 1)));
+      glm::vec3 side = safe_normalize(glm::cross(axis, up),
+                                      safe_normalize(glm::cross(axis, glm::vec3(1, 0, 0)), glm::vec3(0, 0, 1)));
       if (rng.uniform() < 0.5) side = -side;
       glm::vec3 blade = safe_normalize(axis + 0.8f * side, axis);
       glm::vec3 normal = safe_normalize(up - glm::dot(up, blade) * blade, safe_normalize(glm::cross(blade, side), up));
@@ -750,7 +791,7 @@ Config make_config(const Params& p) {
   // Designated initializers: a member left out is a warning (-Wmissing-field-initializers), an error in CI.
   return {
       .closed = p.text("venation") == "closed",
-      .points = points == "envelope" ? Points::Envelope
+      .points = points == "envelope"  ? Points::Envelope
                 : points == "surface" ? Points::Surface
                 : points == "file"    ? Points::File
                                       : Points::Auto,
@@ -761,14 +802,16 @@ Config make_config(const Params& p) {
       .step = static_cast<float>(p.real("step")),
       .tropism = glm::vec3(p.vec3("tropism")),
       .noise = static_cast<float>(p.real("noise")),
-      .surface = surface == "cling" ? Surface::Cling : surface == "avoid" ? Surface::Avoid : Surface::Free,
+      .surface = surface == "cling"   ? Surface::Cling
+                 : surface == "avoid" ? Surface::Avoid
+                                      : Surface::Free,
       .cling_distance = static_cast<float>(p.real("cling_distance")),
       .split = static_cast<float>(p.real("split")),
       .seek = p.boolean("seek"),
       .tip_radius = static_cast<float>(p.real("tip_radius")),
       .pipe_exponent = static_cast<float>(p.real("pipe_exponent")),
-      .leaves = leaves == "none" ? Leaves::None
-                : leaves == "tips" ? Leaves::Tips
+      .leaves = leaves == "none"       ? Leaves::None
+                : leaves == "tips"     ? Leaves::Tips
                 : leaves == "interval" ? Leaves::Interval
                                        : Leaves::Both,
       .leaf_interval = static_cast<int>(p.integer("leaf_interval")),

@@ -32,14 +32,22 @@ void BM_SpacecolEnvelope(benchmark::State& state) {
   }
   state.counters["nodes"] = static_cast<double>(nodes);
   state.counters["steps"] = static_cast<double>(steps);
-  state.counters["points_per_s"] = benchmark::Counter(static_cast<double>(points), benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["points_per_s"] =
+      benchmark::Counter(static_cast<double>(points), benchmark::Counter::kIsIterationInvariantRate);
 }
 BENCHMARK(BM_SpacecolEnvelope)
     ->ArgNames({"points", "threads"})
-    ->Args({10000, 1})->Args({10000, 2})
-    ->Args({100000, 1})->Args({100000, 2})
-    ->Args({1000000, 1})->Args({1000000, 2})
-    ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true);
+    ->Args({10000, 1})
+    ->Args({10000, 2})
+    ->Args({100000, 1})
+    ->Args({100000, 2})
+    ->Args({1000000, 1})
+    ->Args({1000000, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1)
+    ->Repetitions(3)
+    ->ReportAggregatesOnly(true);
 
 }  // namespace
 }  // namespace growbench

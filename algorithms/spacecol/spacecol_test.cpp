@@ -25,8 +25,8 @@ std::string points_file(const std::string& name, const std::string& text) {
 }
 
 std::vector<std::string> exact(const std::string& file, std::vector<std::string> more = {}) {
-  std::vector<std::string> v = {"points=file", "points_file=" + file, "influence=2", "kill=0.05", "step=0.02",
-                                "leaves=none", "seek=false"};
+  std::vector<std::string> v = {"points=file", "points_file=" + file, "influence=2", "kill=0.05",
+                                "step=0.02",   "leaves=none",         "seek=false"};
   v.insert(v.end(), more.begin(), more.end());
   return v;
 }
@@ -97,7 +97,8 @@ TEST(SpaceColonization, OpenAndClosedVenationDiffer) {
   EXPECT_EQ(children_of(closed, 1), 1);
   int tips_near = 0;
   for (std::size_t i = 0; i < closed.nodes.size(); ++i)
-    if (children_of(closed, static_cast<int>(i)) == 0 && glm::length(closed.nodes[i].position - glm::vec3(0, 1, 0)) < 0.05f)
+    if (children_of(closed, static_cast<int>(i)) == 0 &&
+        glm::length(closed.nodes[i].position - glm::vec3(0, 1, 0)) < 0.05f)
       ++tips_near;
   EXPECT_EQ(tips_near, 2);
 }
@@ -169,8 +170,9 @@ TEST(SpaceColonization, ClingStaysOnTheBunny) {
 TEST(SpaceColonization, DeterministicAcrossThreadCountsAndRuns) {
   const Scene s = load_scene("wall");
   SceneQuery q(s);
-  for (const auto& sets : std::vector<std::vector<std::string>>{
-           {"point_count=8000"}, {"point_count=4000", "venation=closed"}, {"point_count=6000", "noise=0.3", "surface=cling"}}) {
+  for (const auto& sets : std::vector<std::vector<std::string>>{{"point_count=8000"},
+                                                                {"point_count=4000", "venation=closed"},
+                                                                {"point_count=6000", "noise=0.3", "surface=cling"}}) {
     const std::string h1 = grow("spacecol", s, q, sets, 1).geometry_hash();
     const std::string h2 = grow("spacecol", s, q, sets, 2).geometry_hash();
     const std::string h2b = grow("spacecol", s, q, sets, 2).geometry_hash();

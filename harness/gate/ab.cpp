@@ -50,7 +50,7 @@ std::string version_of(const std::string& binary, const fs::path& dir) {
 }
 
 json verdict_json(const TimingVerdict& v) {
-  json j = {{"verdict", v.verdict}, {"n_a", v.n_a},         {"n_b", v.n_b},        {"median_a", v.median_a},
+  json j = {{"verdict", v.verdict},   {"n_a", v.n_a},      {"n_b", v.n_b},       {"median_a", v.median_a},
             {"median_b", v.median_b}, {"robust_cv", v.cv}, {"needed", v.needed}, {"paired", v.paired}};
   // Each test: its ratio with the bootstrap interval, its statistic, p, and whether p is exact.
   auto test = [&](const std::string& prefix, const RatioInterval& i, const char* statistic, double value, double p,
@@ -74,15 +74,19 @@ TimingVerdict judge(const Samples& s, const std::string& metric, const AbOptions
 }
 
 // How many pairs `s` holds.
-int count(const Samples& s) { return s[0].empty() ? 0 : static_cast<int>(s[0].begin()->second.size()); }
+int count(const Samples& s) {
+  return s[0].empty() ? 0 : static_cast<int>(s[0].begin()->second.size());
+}
 
 void check_options(const AbOptions& o) {
   for (const auto& b : {o.a_binary, o.b_binary})
-    if (access(b.c_str(), X_OK) != 0) throw InputError(fmt::format("ab: '{}' is not an executable growbench binary", b));
+    if (access(b.c_str(), X_OK) != 0)
+      throw InputError(fmt::format("ab: '{}' is not an executable growbench binary", b));
   if (o.effect <= 1.0) throw InputError(fmt::format("ab: --effect must be above 1, got {}", o.effect));
   if (o.alpha <= 0.0 || o.alpha >= 1.0) throw InputError(fmt::format("ab: --alpha must be in (0, 1), got {}", o.alpha));
   if (o.min_repetitions < 3 || o.max_repetitions < o.min_repetitions)
-    throw InputError(fmt::format("ab: expected 3 <= --min-reps <= --max-reps, got {} and {}", o.min_repetitions, o.max_repetitions));
+    throw InputError(
+        fmt::format("ab: expected 3 <= --min-reps <= --max-reps, got {} and {}", o.min_repetitions, o.max_repetitions));
 }
 
 // One cell per suite config, with the spec file each side's trials read.
@@ -166,8 +170,10 @@ class Trials {
                                       {suite_.timeout_s, suite_.memory_limit_bytes}, (dir / "log.txt").string());
     ++trials_run_;
     std::string why;
-    if (r.timed_out) why = fmt::format("timed out after {} s", suite_.timeout_s);
-    else if (r.signal != 0) why = "killed by " + signal_name(r.signal);
+    if (r.timed_out)
+      why = fmt::format("timed out after {} s", suite_.timeout_s);
+    else if (r.signal != 0)
+      why = "killed by " + signal_name(r.signal);
     else if (r.exit_code != 0 || !fs::exists(dir / "record.json"))
       why = fmt::format("exit code {} (see {})", r.exit_code, (dir / "log.txt").string());
     if (!why.empty()) {
@@ -203,9 +209,12 @@ class Trials {
         if (!cell.error.empty() || count(cell.*which) >= n) continue;
         any = true;
         if (!o_.quiet) {
-          const std::string line = fmt::format("[ab {}] {} pair {}/{}", stage, cell.config->id, count(cell.*which) + 1, n);
-          if (tty_) fmt::print(stderr, "\r{:<100}", line.substr(0, 100));
-          else fmt::print(stderr, "{}\n", line);
+          const std::string line =
+              fmt::format("[ab {}] {} pair {}/{}", stage, cell.config->id, count(cell.*which) + 1, n);
+          if (tty_)
+            fmt::print(stderr, "\r{:<100}", line.substr(0, 100));
+          else
+            fmt::print(stderr, "{}\n", line);
         }
         const int first = (round + static_cast<int>(k)) % 2;
         run_one(cell, first, &(cell.*which));
@@ -246,8 +255,9 @@ json metric_verdict(const Cell& cell, const std::string& m, const TimingVerdict&
     }
   }
   if (final_verdict == "inconclusive" && v.needed > o.max_repetitions)
-    jm["note"] = fmt::format("noise (robust CV {:.1f}%) needs ~{} repetitions per side for a {:.0f}% effect; the cap is {}",
-                             100 * v.cv, v.needed, 100 * (o.effect - 1), o.max_repetitions);
+    jm["note"] =
+        fmt::format("noise (robust CV {:.1f}%) needs ~{} repetitions per side for a {:.0f}% effect; the cap is {}",
+                    100 * v.cv, v.needed, 100 * (o.effect - 1), o.max_repetitions);
   jm["final"] = final_verdict;
   return jm;
 }
@@ -257,7 +267,8 @@ void judge_cell(const Cell& cell, const std::vector<std::string>& metrics, const
   json jc = {{"id", cell.config->id}, {"verdicts", json::object()}};
   for (int s = 0; s < 2; ++s) {
     jc["samples"][kSides[s]] = cell.pilot[static_cast<std::size_t>(s)];
-    if (count(cell.confirmation) > 0) jc["confirmation_samples"][kSides[s]] = cell.confirmation[static_cast<std::size_t>(s)];
+    if (count(cell.confirmation) > 0)
+      jc["confirmation_samples"][kSides[s]] = cell.confirmation[static_cast<std::size_t>(s)];
   }
   if (!cell.error.empty()) {
     jc["error"] = cell.error;
@@ -273,12 +284,12 @@ void judge_cell(const Cell& cell, const std::vector<std::string>& metrics, const
     const std::string final_verdict = jm["final"].get<std::string>();
     ++f.tally[final_verdict];
     if (final_verdict == "regression") f.regression = true;
-    f.table += fmt::format("{:<30} {:<14} {:>3} {:>10} {:>10} {:>22} {:>7.2g} {:>22} {:>7.2g}  {}{}\n",
-                           cell.config->id.substr(0, 30), m, v.n_a, format_seconds(v.median_a), format_seconds(v.median_b),
-                           fmt::format("{:.3f} [{:.3f}, {:.3f}]", v.interval.ratio, v.interval.lo, v.interval.hi), v.test.p,
-                           fmt::format("{:.3f} [{:.3f}, {:.3f}]", v.paired_interval.ratio, v.paired_interval.lo,
-                                       v.paired_interval.hi),
-                           v.paired_test.p, final_verdict, jm.contains("note") ? " (" + jm["note"].get<std::string>() + ")" : "");
+    f.table += fmt::format(
+        "{:<30} {:<14} {:>3} {:>10} {:>10} {:>22} {:>7.2g} {:>22} {:>7.2g}  {}{}\n", cell.config->id.substr(0, 30), m,
+        v.n_a, format_seconds(v.median_a), format_seconds(v.median_b),
+        fmt::format("{:.3f} [{:.3f}, {:.3f}]", v.interval.ratio, v.interval.lo, v.interval.hi), v.test.p,
+        fmt::format("{:.3f} [{:.3f}, {:.3f}]", v.paired_interval.ratio, v.paired_interval.lo, v.paired_interval.hi),
+        v.paired_test.p, final_verdict, jm.contains("note") ? " (" + jm["note"].get<std::string>() + ")" : "");
     jc["verdicts"][m] = jm;
   }
   f.cells.push_back(jc);
@@ -286,15 +297,18 @@ void judge_cell(const Cell& cell, const std::vector<std::string>& metrics, const
 
 // The table: a header, the cells' rows, then how to read it and the tally.
 std::string table_of(const Findings& f, const Binaries& bins, int trials_run, const AbOptions& o) {
-  std::string table = fmt::format("{:<30} {:<14} {:>3} {:>10} {:>10} {:>22} {:>7} {:>22} {:>7}  {}\n", "cell", "metric", "n",
-                                  "A median", "B median", "B/A [95% CI]", "p MW", "pairs B/A [95% CI]", "p pairs", "verdict");
+  std::string table =
+      fmt::format("{:<30} {:<14} {:>3} {:>10} {:>10} {:>22} {:>7} {:>22} {:>7}  {}\n", "cell", "metric", "n",
+                  "A median", "B median", "B/A [95% CI]", "p MW", "pairs B/A [95% CI]", "p pairs", "verdict");
   table += f.table;
   std::string counts;
   for (const auto& [k, n] : f.tally) counts += fmt::format("{}{} {}", counts.empty() ? "" : ", ", n, k);
   table += fmt::format(
       "\nA = {}\nB = {}\n{} trials in pairs, A B and B A alternately. A metric is flagged when p < {} and the median "
-      "ratio is beyond {:.2f} with its bootstrap 95% interval excluding 1, either for the two samples (Mann-Whitney) or for "
-      "the pairs' ratios (Wilcoxon signed-rank; drift that moves both sides of a pair cancels there); a flagged cell is "
+      "ratio is beyond {:.2f} with its bootstrap 95% interval excluding 1, either for the two samples (Mann-Whitney) "
+      "or for "
+      "the pairs' ratios (Wilcoxon signed-rank; drift that moves both sides of a pair cancels there); a flagged cell "
+      "is "
       "rerun and counts only if the rerun flags it again. 'no change': an interval within [1/{:.2f}, {:.2f}].\n{}\n"
       "verdict: {}\n",
       bins[0], bins[1], trials_run, o.alpha, o.effect, o.effect, o.effect, counts,
@@ -308,10 +322,17 @@ json doc_of(Findings&& f, const Suite& suite, const AbOptions& o, const Binaries
   json doc = {{"kind", "growbench-ab"},
               {"schema_version", 1},
               {"suite", {{"name", suite.name}, {"file", suite.file}, {"hash", suite.hash}}},
-              {"binaries", {{"A", {{"path", bins[0]}, {"version", version_of(bins[0], out)}}},
-                            {"B", {{"path", bins[1]}, {"version", version_of(bins[1], out)}}}}},
-              {"options", {{"effect", o.effect}, {"alpha", o.alpha}, {"power", o.power}, {"min_repetitions", o.min_repetitions},
-                           {"max_repetitions", o.max_repetitions}, {"phases", o.phases}, {"confirm", o.confirm}}},
+              {"binaries",
+               {{"A", {{"path", bins[0]}, {"version", version_of(bins[0], out)}}},
+                {"B", {{"path", bins[1]}, {"version", version_of(bins[1], out)}}}}},
+              {"options",
+               {{"effect", o.effect},
+                {"alpha", o.alpha},
+                {"power", o.power},
+                {"min_repetitions", o.min_repetitions},
+                {"max_repetitions", o.max_repetitions},
+                {"phases", o.phases},
+                {"confirm", o.confirm}}},
               {"context", run_context()},
               {"trials_run", trials_run},
               {"cells", std::move(f.cells)}};

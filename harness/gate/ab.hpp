@@ -30,14 +30,14 @@ struct AbOptions {
   int min_repetitions = 6;         // the pilot, per side
   int max_repetitions = 30;        // per side, per batch
   std::vector<std::string> phases = {"growth"};
-  bool confirm = true;             // rerun flagged cells
+  bool confirm = true;  // rerun flagged cells
   bool quiet = false;
 };
 
 struct AbResult {
   nlohmann::json doc;  // what ab.json holds: options, binaries, every sample, every verdict
   bool regression = false;
-  std::string table;   // the readable verdicts
+  std::string table;  // the readable verdicts
 };
 
 AbResult run_ab(const Suite& suite, const AbOptions& options);

@@ -55,29 +55,32 @@ std::string CompareResult::table() const {
     out += fmt::format("{:<{}}  {:<{}}  {:>{}}  {:>{}}  {:>8}  {}\n", "cell", wc, "quantity", wq, "old", wv, "new", wv,
                        "new/old", "verdict");
     for (const auto& c : changes)
-      out += fmt::format("{:<{}}  {:<{}}  {:>{}}  {:>{}}  {:>8}  {}\n", c.cell, wc, c.quantity, wq, c.old_value.substr(0, 24),
-                         wv, c.new_value.substr(0, 24), wv, c.ratio > 0.0 ? fmt::format("{:.4f}", c.ratio) : "-",
-                         c.fails ? "FAIL: " + c.why : c.why);
+      out += fmt::format("{:<{}}  {:<{}}  {:>{}}  {:>{}}  {:>8}  {}\n", c.cell, wc, c.quantity, wq,
+                         c.old_value.substr(0, 24), wv, c.new_value.substr(0, 24), wv,
+                         c.ratio > 0.0 ? fmt::format("{:.4f}", c.ratio) : "-", c.fails ? "FAIL: " + c.why : c.why);
   }
   for (const auto& m : missing_cells) out += fmt::format("{}: in the base, missing from the new results (FAIL)\n", m);
   for (const auto& m : new_cells) out += fmt::format("{}: new cell, not in the base\n", m);
   if (small_changes > 0)
-    out += fmt::format("{} instruction counts moved by less than 0.1% and fewer instructions than the floor (not listed)\n",
-                       small_changes);
+    out += fmt::format(
+        "{} instruction counts moved by less than 0.1% and fewer instructions than the floor (not listed)\n",
+        small_changes);
   if (!timings.empty()) {
     std::size_t wc2 = 4;
     for (const auto& t : timings) wc2 = std::max(wc2, t.cell.size());
-    out += fmt::format("\nTimings (reported, not gated: a flag here is unconfirmed; `growbench ab` reruns and confirms)\n");
-    out += fmt::format("{:<{}}  {:<14}  {:>7}  {:>10}  {:>10}  {:>24}  {:>8}  {}\n", "cell", wc2, "metric", "n", "old median",
-                       "new median", "new/old [95% CI]", "p", "verdict");
+    out += fmt::format(
+        "\nTimings (reported, not gated: a flag here is unconfirmed; `growbench ab` reruns and confirms)\n");
+    out += fmt::format("{:<{}}  {:<14}  {:>7}  {:>10}  {:>10}  {:>24}  {:>8}  {}\n", "cell", wc2, "metric", "n",
+                       "old median", "new median", "new/old [95% CI]", "p", "verdict");
     std::map<std::string, int> tally;
     for (const auto& t : timings) {
       const TimingVerdict& v = t.verdict;
       ++tally[v.verdict];
-      out += fmt::format("{:<{}}  {:<14}  {:>7}  {:>10}  {:>10}  {:>24}  {:>8.2g}  {}\n", t.cell, wc2, t.metric,
-                         fmt::format("{}/{}", v.n_a, v.n_b), format_seconds(v.median_a), format_seconds(v.median_b),
-                         fmt::format("{:.3f} [{:.3f}, {:.3f}]", v.interval.ratio, v.interval.lo, v.interval.hi), v.test.p,
-                         v.verdict == "inconclusive" ? fmt::format("inconclusive (~{} repetitions needed)", v.needed) : v.verdict);
+      out += fmt::format(
+          "{:<{}}  {:<14}  {:>7}  {:>10}  {:>10}  {:>24}  {:>8.2g}  {}\n", t.cell, wc2, t.metric,
+          fmt::format("{}/{}", v.n_a, v.n_b), format_seconds(v.median_a), format_seconds(v.median_b),
+          fmt::format("{:.3f} [{:.3f}, {:.3f}]", v.interval.ratio, v.interval.lo, v.interval.hi), v.test.p,
+          v.verdict == "inconclusive" ? fmt::format("inconclusive (~{} repetitions needed)", v.needed) : v.verdict);
     }
     std::string counts;
     for (const auto& [k, n] : tally) counts += fmt::format("{}{} {}", counts.empty() ? "" : ", ", n, k);
@@ -112,8 +115,10 @@ std::vector<GateCell> gate_cells(const GateFile& f) {
 template <class T>
 std::optional<json> json_of(const std::optional<T>& v) {
   if (!v) return std::nullopt;
-  if constexpr (requires { to_json(*v); }) return to_json(*v);
-  else return json(*v);
+  if constexpr (requires { to_json(*v); })
+    return to_json(*v);
+  else
+    return json(*v);
 }
 
 // The fields compared quantity by quantity ("counts.nodes"), each as JSON (absent: the cell has none).
@@ -152,7 +157,8 @@ void compare_instructions(const std::string& id, const InstructionCounts& base, 
     r.changes.push_back({id, "instructions." + phase, show(v), show(nv), ratio, bad,
                          fmt::format("instructions {:+.2f}%{}", 100.0 * (ratio - 1.0),
                                      bad ? fmt::format(" > +{:g}%", 100.0 * o.instructions_threshold)
-                                     : ratio > 1.0 + o.instructions_threshold ? " (below the floor)" : "")});
+                                     : ratio > 1.0 + o.instructions_threshold ? " (below the floor)"
+                                                                              : "")});
   }
 }
 
@@ -186,7 +192,8 @@ void compare_cell(const GateCell& gb, const GateCell& gn, const CompareOptions& 
     for (const auto& [k, v] : fb) {
       const auto jt = fn.find(k);
       const json nv = jt == fn.end() ? json(nullptr) : jt->second;
-      if (nv != v) r.changes.push_back({id, k, show(v), jt == fn.end() ? "(absent)" : show(nv), ratio_of(v, nv), fails, why});
+      if (nv != v)
+        r.changes.push_back({id, k, show(v), jt == fn.end() ? "(absent)" : show(nv), ratio_of(v, nv), fails, why});
     }
     for (const auto& [k, v] : fn)
       if (!fb.count(k)) r.changes.push_back({id, k, "(absent)", show(v), 0.0, false, "new quantity"});
@@ -206,7 +213,8 @@ void compare_cell(const GateCell& gb, const GateCell& gn, const CompareOptions& 
       const double slack = bytes ? o.alloc_bytes_slack : o.alloc_count_slack;
       if (delta <= slack) {
         c.fails = false;
-        c.why = fmt::format("{} within {:g} (paths differ by checkout)", bytes ? "allocated bytes" : "allocations", slack);
+        c.why =
+            fmt::format("{} within {:g} (paths differ by checkout)", bytes ? "allocated bytes" : "allocations", slack);
       }
     }
   }
@@ -278,9 +286,13 @@ Baseline baseline_of(const ResultsFile& results) {
   return b;
 }
 
-json baseline_of(const json& results) { return to_json(baseline_of(from_json<ResultsFile>(results, "the results"))); }
+json baseline_of(const json& results) {
+  return to_json(baseline_of(from_json<ResultsFile>(results, "the results")));
+}
 
-GateFile read_gate_file(const std::string& path) { return gate_file_from_json(read_json_file(path), path); }
+GateFile read_gate_file(const std::string& path) {
+  return gate_file_from_json(read_json_file(path), path);
+}
 
 json read_results_file(const std::string& path) {
   const GateFile f = read_gate_file(path);

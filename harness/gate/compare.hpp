@@ -36,9 +36,9 @@ struct CompareOptions {
 struct Change {
   std::string cell, quantity;  // e.g. "hadrich/wall/s1", "instructions.growth"
   std::string old_value, new_value;
-  double ratio = 0.0;          // new / old for numbers (0 when not numeric)
+  double ratio = 0.0;  // new / old for numbers (0 when not numeric)
   bool fails = false;
-  std::string why;             // "behaviour", "allocations", "output bytes", "instructions +3.1%", ...
+  std::string why;  // "behaviour", "allocations", "output bytes", "instructions +3.1%", ...
 };
 
 struct TimingComparison {
@@ -48,7 +48,7 @@ struct TimingComparison {
 
 struct CompareResult {
   std::vector<TimingComparison> timings;  // both sides with >= 3 ok repetitions
-  std::vector<Change> changes;  // every changed quantity, failing or not
+  std::vector<Change> changes;            // every changed quantity, failing or not
   std::size_t cells_compared = 0;
   std::vector<std::string> missing_cells, new_cells;
   std::size_t small_changes = 0;  // instruction changes under 0.1% and the floor, counted but not listed
@@ -62,7 +62,8 @@ using GateFile = std::variant<ResultsFile, Baseline>;
 
 CompareResult compare_results(const GateFile& base, const GateFile& now, const CompareOptions& options = {});
 // The same on documents read as JSON (each read with from_json; InputError for what is neither).
-CompareResult compare_results(const nlohmann::json& base, const nlohmann::json& now, const CompareOptions& options = {});
+CompareResult compare_results(const nlohmann::json& base, const nlohmann::json& now,
+                              const CompareOptions& options = {});
 
 // The deterministic part of a results file (no timings, no paths): what a committed baseline holds.
 Baseline baseline_of(const ResultsFile& results);

@@ -15,7 +15,8 @@ namespace growbench {
 namespace fs = std::filesystem;
 
 std::string history_machine(const RunContext& context) {
-  std::string m = fmt::format("{}-{}t", context.cpu_model.empty() ? "unknown-cpu" : context.cpu_model, context.hardware_threads);
+  std::string m =
+      fmt::format("{}-{}t", context.cpu_model.empty() ? "unknown-cpu" : context.cpu_model, context.hardware_threads);
   for (char& c : m) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   m = safe_name(m);
   // Runs of '_' from spaces and parentheses read badly in a path.

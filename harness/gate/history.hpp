@@ -18,8 +18,8 @@ std::string history_machine(const RunContext& context);
 // The per-cell summary of one run that a history keeps.
 HistoryRun history_entry(const ResultsFile& results);
 
-// Appends the results file's run (a results file, not a baseline) to DIR (machine "" : history_machine of its context). Returns the
-// file written. InputError when the results have no commit.
+// Appends the results file's run (a results file, not a baseline) to DIR (machine "" : history_machine of its context).
+// Returns the file written. InputError when the results have no commit.
 std::string history_add(const std::string& results_path, const std::string& dir, const std::string& machine = "");
 
 // Plots DIR into OUT (reports/history.py); returns its exit status.

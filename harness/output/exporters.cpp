@@ -59,25 +59,26 @@ class TextFile {
     const auto tokens = 2 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
     std::vector<fmt::memory_buffer> slots(tokens);
     std::size_t next = 0;
-    tbb::parallel_pipeline(
-        tokens,
-        tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
-                                            [&](tbb::flow_control& fc) -> std::size_t {
-                                              if (next >= n) fc.stop();
-                                              const std::size_t first = next;
-                                              next += kChunk;
-                                              return first;
-                                            }) &
-            tbb::make_filter<std::size_t, fmt::memory_buffer*>(tbb::filter_mode::parallel,
-                                                               [&](std::size_t first) {
-                                                                 fmt::memory_buffer& text = slots[first / kChunk % tokens];
-                                                                 text.clear();
-                                                                 const std::size_t last = std::min(n, first + kChunk);
-                                                                 for (std::size_t i = first; i < last; ++i) format(i, text);
-                                                                 return &text;
-                                                               }) &
-            tbb::make_filter<fmt::memory_buffer*, void>(tbb::filter_mode::serial_in_order,
-                                                        [&](fmt::memory_buffer* text) { file_->bytes(text->data(), text->size()); }));
+    tbb::parallel_pipeline(tokens, tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
+                                                                       [&](tbb::flow_control& fc) -> std::size_t {
+                                                                         if (next >= n) fc.stop();
+                                                                         const std::size_t first = next;
+                                                                         next += kChunk;
+                                                                         return first;
+                                                                       }) &
+                                       tbb::make_filter<std::size_t, fmt::memory_buffer*>(
+                                           tbb::filter_mode::parallel,
+                                           [&](std::size_t first) {
+                                             fmt::memory_buffer& text = slots[first / kChunk % tokens];
+                                             text.clear();
+                                             const std::size_t last = std::min(n, first + kChunk);
+                                             for (std::size_t i = first; i < last; ++i) format(i, text);
+                                             return &text;
+                                           }) &
+                                       tbb::make_filter<fmt::memory_buffer*, void>(
+                                           tbb::filter_mode::serial_in_order, [&](fmt::memory_buffer* text) {
+                                             file_->bytes(text->data(), text->size());
+                                           }));
   }
 
  private:
@@ -96,14 +97,16 @@ std::uint64_t write_obj(const std::string& path, const OutputMesh& m) {
   const std::filesystem::path p(path);
   const std::string mtl_name = p.stem().string() + ".mtl";
   TextFile mtl((p.parent_path() / mtl_name).string());
-  mtl.print("# growbench materials\n"
-            "newmtl bark\nKd 0.36 0.25 0.17\nKa 0 0 0\nKs 0.05 0.05 0.05\nNs 10\n\n"
-            "newmtl leaf\nKd 0.22 0.50 0.16\nKa 0 0 0\nKs 0.1 0.1 0.1\nNs 20\n\n"
-            "newmtl flower\nKd 0.92 0.85 0.95\nKa 0 0 0\nKs 0.1 0.1 0.1\nNs 20\n");
+  mtl.print(
+      "# growbench materials\n"
+      "newmtl bark\nKd 0.36 0.25 0.17\nKa 0 0 0\nKs 0.05 0.05 0.05\nNs 10\n\n"
+      "newmtl leaf\nKd 0.22 0.50 0.16\nKa 0 0 0\nKs 0.1 0.1 0.1\nNs 20\n\n"
+      "newmtl flower\nKd 0.92 0.85 0.95\nKa 0 0 0\nKs 0.1 0.1 0.1\nNs 20\n");
   std::uint64_t bytes = mtl.finish();
 
   TextFile out(path);
-  out.print("# growbench plant: {} vertices, {} triangles\nmtllib {}\n", m.positions.size(), m.triangles.size(), mtl_name);
+  out.print("# growbench plant: {} vertices, {} triangles\nmtllib {}\n", m.positions.size(), m.triangles.size(),
+            mtl_name);
   using Buf = fmt::memory_buffer;
   out.records(m.positions.size(), [&](std::size_t i, Buf& b) {
     const glm::vec3& v = m.positions[i];
@@ -139,23 +142,27 @@ std::uint64_t write_ply(const std::string& path, const OutputMesh& m) {
   }
   for (const auto& t : m.triangles) {
     const std::uint8_t three = 3;
-    const std::int32_t idx[3] = {static_cast<std::int32_t>(t.x), static_cast<std::int32_t>(t.y), static_cast<std::int32_t>(t.z)};
+    const std::int32_t idx[3] = {static_cast<std::int32_t>(t.x), static_cast<std::int32_t>(t.y),
+                                 static_cast<std::int32_t>(t.z)};
     f.bytes(&three, 1);
     f.bytes(idx, sizeof(idx));
   }
   return f.finish();
 }
 
+// Long because tinygltf's model is filled field by field: buffers, views, accessors, materials, then the scene.
 std::uint64_t write_glb(const std::string& path, const OutputMesh& m) {
   tinygltf::Model model;
   model.asset.version = "2.0";
   model.asset.generator = "growbench";
   tinygltf::Buffer buffer;
   // One allocation for the whole binary chunk (positions, normals, indices, each padded to 4 bytes).
-  buffer.data.reserve(2 * m.positions.size() * sizeof(glm::vec3) + m.triangles.size() * sizeof(glm::uvec3) + 4 * (m.groups.size() + 2));
+  buffer.data.reserve(2 * m.positions.size() * sizeof(glm::vec3) + m.triangles.size() * sizeof(glm::uvec3) +
+                      4 * (m.groups.size() + 2));
   auto append = [&](const void* p, std::size_t n) {
     const auto off = buffer.data.size();
-    buffer.data.insert(buffer.data.end(), static_cast<const unsigned char*>(p), static_cast<const unsigned char*>(p) + n);
+    buffer.data.insert(buffer.data.end(), static_cast<const unsigned char*>(p),
+                       static_cast<const unsigned char*>(p) + n);
     while (buffer.data.size() % 4 != 0) buffer.data.push_back(0);
     return off;
   };
@@ -169,8 +176,10 @@ std::uint64_t write_glb(const std::string& path, const OutputMesh& m) {
     return static_cast<int>(model.bufferViews.size() - 1);
   };
   const std::size_t nv = m.positions.size();
-  const int pos_view = view(append(m.positions.data(), nv * sizeof(glm::vec3)), nv * sizeof(glm::vec3), TINYGLTF_TARGET_ARRAY_BUFFER);
-  const int nrm_view = view(append(m.normals.data(), nv * sizeof(glm::vec3)), nv * sizeof(glm::vec3), TINYGLTF_TARGET_ARRAY_BUFFER);
+  const int pos_view =
+      view(append(m.positions.data(), nv * sizeof(glm::vec3)), nv * sizeof(glm::vec3), TINYGLTF_TARGET_ARRAY_BUFFER);
+  const int nrm_view =
+      view(append(m.normals.data(), nv * sizeof(glm::vec3)), nv * sizeof(glm::vec3), TINYGLTF_TARGET_ARRAY_BUFFER);
   Aabb b;
   for (const auto& p : m.positions) b.extend(p);
   tinygltf::Accessor pos;
@@ -194,7 +203,8 @@ std::uint64_t write_glb(const std::string& path, const OutputMesh& m) {
   mesh.name = "plant";
   for (const auto& g : m.groups) {
     const std::size_t bytes = std::size_t{g.triangle_count} * sizeof(glm::uvec3);
-    const int idx_view = view(append(&m.triangles[g.first_triangle], bytes), bytes, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+    const int idx_view =
+        view(append(&m.triangles[g.first_triangle], bytes), bytes, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
     tinygltf::Accessor idx;
     idx.bufferView = idx_view;
     idx.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;

@@ -23,7 +23,8 @@ std::vector<std::vector<std::int32_t>> plant_chains(const Plant& plant) {
     const bool same_shoot = plant.nodes[i].shoot == plant.nodes[static_cast<std::size_t>(p)].shoot;
     if (mc == kNoParent) {
       mc = static_cast<std::int32_t>(i);
-    } else if (same_shoot && plant.nodes[static_cast<std::size_t>(mc)].shoot != plant.nodes[static_cast<std::size_t>(p)].shoot) {
+    } else if (same_shoot &&
+               plant.nodes[static_cast<std::size_t>(mc)].shoot != plant.nodes[static_cast<std::size_t>(p)].shoot) {
       mc = static_cast<std::int32_t>(i);
     }
   }
@@ -34,7 +35,8 @@ std::vector<std::vector<std::int32_t>> plant_chains(const Plant& plant) {
     if (!starts) continue;
     std::vector<std::int32_t> chain;
     if (p != kNoParent) chain.push_back(p);
-    for (auto c = static_cast<std::int32_t>(i); c != kNoParent; c = main_child[static_cast<std::size_t>(c)]) chain.push_back(c);
+    for (auto c = static_cast<std::int32_t>(i); c != kNoParent; c = main_child[static_cast<std::size_t>(c)])
+      chain.push_back(c);
     if (chain.size() >= 2) chains.push_back(std::move(chain));
   }
   return chains;
@@ -103,8 +105,10 @@ void add_tube(OutputMesh& m, const Plant& plant, const std::vector<std::int32_t>
       const std::uint32_t ring = base + static_cast<std::uint32_t>(j) * S;
       for (std::uint32_t s = 0; s < S; ++s) {
         const std::uint32_t a = ring + s, b = ring + (s + 1) % S;
-        if (start) m.triangles.emplace_back(centre, b, a);
-        else m.triangles.emplace_back(centre, a, b);
+        if (start)
+          m.triangles.emplace_back(centre, b, a);
+        else
+          m.triangles.emplace_back(centre, a, b);
       }
     }
   }
@@ -131,7 +135,8 @@ TriangleMesh load_leaf_mesh(const std::string& path) {
   float lo = std::numeric_limits<float>::max(), hi = std::numeric_limits<float>::lowest();
   for (const auto& v : m.vertices) lo = std::min(lo, v.z), hi = std::max(hi, v.z);
   if (!(hi - lo > 1e-6f))
-    throw InputError(fmt::format("{}: the leaf has no length along z; expected its blade along +Z from the stem", path));
+    throw InputError(
+        fmt::format("{}: the leaf has no length along z; expected its blade along +Z from the stem", path));
   for (auto& v : m.vertices) v = glm::vec3(v.x, v.y, v.z - lo) / (hi - lo);
   m.name = "leaf_obj";
   return m;
@@ -189,7 +194,8 @@ OutputMesh mesh_plant(const Plant& plant, const MesherOptions& o) {
         m.positions.push_back(v);
         m.normals.push_back(n);
       }
-      for (std::uint32_t i = 1; i + 1 < poly.vertices.size(); ++i) m.triangles.emplace_back(base, base + i, base + i + 1);
+      for (std::uint32_t i = 1; i + 1 < poly.vertices.size(); ++i)
+        m.triangles.emplace_back(base, base + i, base + i + 1);
     }
   });
   return m;

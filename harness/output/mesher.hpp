@@ -28,12 +28,12 @@ struct OutputMesh {
 };
 
 struct MesherOptions {
-  int sides = 6;              // tube cross-section sides (3..64)
-  bool caps = true;           // close tube ends
-  float min_radius = 0.0f;    // radii below this are raised to it (0: as given; zero-radius nodes get 1e-4 m)
+  int sides = 6;                       // tube cross-section sides (3..64)
+  bool caps = true;                    // close tube ends
+  float min_radius = 0.0f;             // radii below this are raised to it (0: as given; zero-radius nodes get 1e-4 m)
   std::string leaf_shape = "diamond";  // "diamond", "quad"; ignored when leaf_mesh has triangles
-  TriangleMesh leaf_mesh;     // optional instanced leaf: local frame as Organ (+Z blade, +Y up), unit length
-  std::string leaf_obj;       // an OBJ to load into leaf_mesh (load_leaf_mesh) when a trial or render starts
+  TriangleMesh leaf_mesh;              // optional instanced leaf: local frame as Organ (+Z blade, +Y up), unit length
+  std::string leaf_obj;                // an OBJ to load into leaf_mesh (load_leaf_mesh) when a trial or render starts
 };
 
 // A custom leaf from an OBJ file, as every algorithm's leaves and flowers are instanced: authored in the

@@ -35,9 +35,15 @@ double quantile(std::vector<float> v, double q) {
 
 }  // namespace
 
-bool is_leaf(const Organ& o) { return o.kind == OrganKind::Leaf || o.kind == OrganKind::YoungLeaf; }
-glm::vec3 leaf_centre(const Organ& leaf) { return organ_point(leaf, {0.0f, 0.0f, 0.5f}); }
-glm::vec3 leaf_normal(const Organ& leaf) { return glm::mat3_cast(leaf.orientation)[1]; }
+bool is_leaf(const Organ& o) {
+  return o.kind == OrganKind::Leaf || o.kind == OrganKind::YoungLeaf;
+}
+glm::vec3 leaf_centre(const Organ& leaf) {
+  return organ_point(leaf, {0.0f, 0.0f, 0.5f});
+}
+glm::vec3 leaf_normal(const Organ& leaf) {
+  return glm::mat3_cast(leaf.orientation)[1];
+}
 
 float segment_distance(const glm::vec3& p1, const glm::vec3& q1, const glm::vec3& p2, const glm::vec3& q2) {
   const glm::vec3 d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
@@ -97,8 +103,10 @@ class MetricsPass {
   void counts() {
     std::size_t leaves = 0, flowers = 0;
     for (const auto& org : plant.organs) {
-      if (is_leaf(org)) ++leaves;
-      else ++flowers;
+      if (is_leaf(org))
+        ++leaves;
+      else
+        ++flowers;
     }
     m["nodes"] = nodes.size();
     m["segments"] = seg.size();
@@ -201,8 +209,10 @@ class MetricsPass {
     // node, or sit within two segments of each other along the tree, where thick junctions always touch).
     auto up = [&](std::int32_t v) { return v == kNoParent ? kNoParent : nodes[static_cast<std::size_t>(v)].parent; };
     auto neighbours = [&](std::uint32_t x, std::uint32_t y) {
-      const std::int32_t X[3] = {static_cast<std::int32_t>(x), up(static_cast<std::int32_t>(x)), up(up(static_cast<std::int32_t>(x)))};
-      const std::int32_t Y[3] = {static_cast<std::int32_t>(y), up(static_cast<std::int32_t>(y)), up(up(static_cast<std::int32_t>(y)))};
+      const std::int32_t X[3] = {static_cast<std::int32_t>(x), up(static_cast<std::int32_t>(x)),
+                                 up(up(static_cast<std::int32_t>(x)))};
+      const std::int32_t Y[3] = {static_cast<std::int32_t>(y), up(static_cast<std::int32_t>(y)),
+                                 up(up(static_cast<std::int32_t>(y)))};
       for (const auto a : X)
         for (const auto b : Y)
           if (a != kNoParent && a == b) return true;
@@ -212,7 +222,9 @@ class MetricsPass {
     // the lower index): a pair can only meet within the sum of the two reaches, at most twice the larger
     // one. Searching with the plant's largest radius and half length instead made every thin segment near
     // a thick stem visit hundreds of candidates.
-    auto judged_from = [&](std::size_t k, std::size_t l) { return reach[l] < reach[k] || (reach[l] == reach[k] && l > k); };
+    auto judged_from = [&](std::size_t k, std::size_t l) {
+      return reach[l] < reach[k] || (reach[l] == reach[k] && l > k);
+    };
     std::vector<std::uint32_t> pairs_of(seg.size(), 0);
     involved = std::vector<std::atomic<std::uint8_t>>(seg.size());  // zero-initialised; set from either side
     if (tree) {
@@ -244,7 +256,7 @@ class MetricsPass {
   void leaf_metrics() {
     // Leaves: their blades as exported (the organ shape placed by organ_point), and light.
     const TriangleMesh shape = o.organ_shape.triangles.empty() ? organ_shape() : o.organ_shape;
-    auto organ_triangle = [&](const Organ& org, const glm::uvec3& t, glm::vec3 (&v)[3]) {
+    auto organ_triangle = [&](const Organ& org, const glm::uvec3& t, glm::vec3(&v)[3]) {
       for (int k = 0; k < 3; ++k) v[k] = organ_point(org, shape.vertices[t[k]]);
     };
     for (std::uint32_t i = 0; i < plant.organs.size(); ++i)
@@ -289,7 +301,8 @@ class MetricsPass {
       std::vector<Occluder::Capsule> capsules;
       capsules.reserve(seg.size());
       for (const auto s : seg)
-        capsules.push_back({a_of(s), nodes[s].position, std::max(nodes[static_cast<std::size_t>(nodes[s].parent)].radius, 1e-4f),
+        capsules.push_back({a_of(s), nodes[s].position,
+                            std::max(nodes[static_cast<std::size_t>(nodes[s].parent)].radius, 1e-4f),
                             std::max(nodes[s].radius, 1e-4f)});
       std::vector<Occluder::Triangle> tris;
       tris.reserve(plant.organs.size() * shape.triangles.size());
@@ -301,7 +314,8 @@ class MetricsPass {
           tris.push_back(ot);
         }
       for (const auto& poly : plant.polygons)
-        for (std::size_t k = 1; k + 1 < poly.vertices.size(); ++k) tris.push_back({{poly.vertices[0], poly.vertices[k], poly.vertices[k + 1]}});
+        for (std::size_t k = 1; k + 1 < poly.vertices.size(); ++k)
+          tris.push_back({{poly.vertices[0], poly.vertices[k], poly.vertices[k + 1]}});
       const auto occluder = query.occluder(std::move(capsules), std::move(tris));
       tbb::parallel_for(std::size_t{0}, leaf.size(), [&](std::size_t i) {
         // Stops at the first leaf it meets: dense foliage (the wall's ivy has hundreds of leaves within
@@ -331,17 +345,18 @@ class MetricsPass {
   }
 
   void keep(MetricDetails& d) {
-      d.covered = std::move(covered);
-      d.node_distance = std::move(dist);
-      d.node_inside = std::move(inside);
-      d.segments = std::move(seg);
-      d.sample_inside = std::move(sample_inside);
-      d.segment_crossed.resize(involved.size());
-      for (std::size_t k = 0; k < involved.size(); ++k) d.segment_crossed[k] = involved[k].load(std::memory_order_relaxed);
-      d.leaves = std::move(leaf);
-      d.leaf_overlaps = std::move(overlap);
-      d.leaf_lit_scene = std::move(lit_scene);
-      d.leaf_lit = std::move(lit);
+    d.covered = std::move(covered);
+    d.node_distance = std::move(dist);
+    d.node_inside = std::move(inside);
+    d.segments = std::move(seg);
+    d.sample_inside = std::move(sample_inside);
+    d.segment_crossed.resize(involved.size());
+    for (std::size_t k = 0; k < involved.size(); ++k)
+      d.segment_crossed[k] = involved[k].load(std::memory_order_relaxed);
+    d.leaves = std::move(leaf);
+    d.leaf_overlaps = std::move(overlap);
+    d.leaf_lit_scene = std::move(lit_scene);
+    d.leaf_lit = std::move(lit);
   }
 
   const Plant& plant;
@@ -364,7 +379,8 @@ class MetricsPass {
 
 }  // namespace
 
-nlohmann::json compute_metrics(const Plant& plant, const SceneQuery& query, const MetricOptions& o, MetricDetails* details) {
+nlohmann::json compute_metrics(const Plant& plant, const SceneQuery& query, const MetricOptions& o,
+                               MetricDetails* details) {
   return MetricsPass(plant, query, o).run(details);
 }
 

@@ -16,9 +16,9 @@ struct MetricOptions {
   float coverage_distance = 0.05f;  // a surface sample within this of a branch segment is covered (m)
   int coverage_samples = 4000;      // area-weighted samples on the climbable surfaces
   std::uint64_t coverage_seed = 0xC0FE;
-  float attach_distance = 0.02f;    // a node within this of a surface is attached (m)
-  int segment_samples = 3;          // interior points per segment tested for penetration
-  float light_bias = 1e-3f;         // a leaf's light ray leaves from this far above its centre (m)
+  float attach_distance = 0.02f;  // a node within this of a surface is attached (m)
+  int segment_samples = 3;        // interior points per segment tested for penetration
+  float light_bias = 1e-3f;       // a leaf's light ray leaves from this far above its centre (m)
   // The shape leaves and flowers are instanced from (organ_shape() of the trial's mesher options); empty:
   // the mesher's default. Leaf overlap and self-shadowing judge the organs as they are exported.
   TriangleMesh organ_shape;
@@ -26,16 +26,16 @@ struct MetricOptions {
 
 // The verdict on every item behind the figures, for tests that check them one by one.
 struct MetricDetails {
-  std::vector<std::uint8_t> covered;         // per coverage sample
-  std::vector<float> node_distance;          // per node: to the nearest surface (m)
-  std::vector<std::uint8_t> node_inside;     // per node
-  std::vector<std::uint32_t> segments;       // per segment: its child node (the parent is the node's)
-  std::vector<std::uint8_t> sample_inside;   // per segment sample: segment k's j-th at k * segment_samples + j
+  std::vector<std::uint8_t> covered;          // per coverage sample
+  std::vector<float> node_distance;           // per node: to the nearest surface (m)
+  std::vector<std::uint8_t> node_inside;      // per node
+  std::vector<std::uint32_t> segments;        // per segment: its child node (the parent is the node's)
+  std::vector<std::uint8_t> sample_inside;    // per segment sample: segment k's j-th at k * segment_samples + j
   std::vector<std::uint8_t> segment_crossed;  // per segment: in a self-intersecting pair
-  std::vector<std::uint32_t> leaves;         // per leaf: its organ index
-  std::vector<std::uint8_t> leaf_overlaps;   // per leaf: its blade meets another leaf's
-  std::vector<std::uint8_t> leaf_lit_scene;  // per leaf: the scene leaves its light ray free
-  std::vector<std::uint8_t> leaf_lit;        // per leaf: the scene and the plant leave it free
+  std::vector<std::uint32_t> leaves;          // per leaf: its organ index
+  std::vector<std::uint8_t> leaf_overlaps;    // per leaf: its blade meets another leaf's
+  std::vector<std::uint8_t> leaf_lit_scene;   // per leaf: the scene leaves its light ray free
+  std::vector<std::uint8_t> leaf_lit;         // per leaf: the scene and the plant leave it free
 };
 
 // Keys (all present, numbers):

@@ -59,6 +59,8 @@ std::string safe_name(std::string s) {
   return s;
 }
 
-nlohmann::json read_json_file(const std::string& path) { return parse_json_file_text(path, read_text_file(path)); }
+nlohmann::json read_json_file(const std::string& path) {
+  return parse_json_file_text(path, read_text_file(path));
+}
 
 }  // namespace growbench

@@ -1,6 +1,5 @@
 #include "harness/render/render.hpp"
 
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -30,7 +29,9 @@ RenderQuality parse_render_quality(const std::string& text, const std::string& o
   throw InputError(fmt::format("{} '{}': expected preview or paper", option, text));
 }
 
-const char* to_string(RenderQuality q) { return q == RenderQuality::Paper ? "paper" : "preview"; }
+const char* to_string(RenderQuality q) {
+  return q == RenderQuality::Paper ? "paper" : "preview";
+}
 
 int render_width(const RenderOptions& o) {
   return o.width > 0 ? o.width : o.quality == RenderQuality::Paper ? 1600 : 480;
@@ -44,9 +45,13 @@ namespace {
 using Out = std::back_insert_iterator<fmt::memory_buffer>;
 
 // growbench (right-handed) to POV-Ray (left-handed): negate Z.
-glm::vec3 pov(const glm::vec3& v) { return {v.x, v.y, -v.z}; }
+glm::vec3 pov(const glm::vec3& v) {
+  return {v.x, v.y, -v.z};
+}
 
-void vec(Out out, const glm::vec3& v) { fmt::format_to(out, "<{:.6g},{:.6g},{:.6g}>", v.x, v.y, v.z); }
+void vec(Out out, const glm::vec3& v) {
+  fmt::format_to(out, "<{:.6g},{:.6g},{:.6g}>", v.x, v.y, v.z);
+}
 
 // Radii below this are drawn at it: a zero radius is a degenerate POV-Ray primitive.
 constexpr float kMinRadius = 1e-4f;
@@ -99,8 +104,8 @@ void write_mesh2(Out out, const std::vector<glm::vec3>& vertices, const std::vec
   }
   fmt::format_to(out, "  face_indices {{ {}", count);
   for (std::uint32_t t = first; t < first + count; ++t)
-    fmt::format_to(out, "{}<{},{},{}>", (t - first) % 6 == 0 ? ",\n    " : ", ", remap[triangles[t].x], remap[triangles[t].y],
-                   remap[triangles[t].z]);
+    fmt::format_to(out, "{}<{},{},{}>", (t - first) % 6 == 0 ? ",\n    " : ", ", remap[triangles[t].x],
+                   remap[triangles[t].y], remap[triangles[t].z]);
   fmt::format_to(out, "\n  }}\n");
 }
 
@@ -113,8 +118,10 @@ void group(Out out, const char* comment, const std::string& texture, F&& members
   const std::size_t n = members(std::back_inserter(body));
   if (n == 0) return;
   fmt::format_to(out, "// {}: {}\n", comment, n);
-  if (n == 1) fmt::format_to(out, "object {{\n{}  texture {{ {} }}\n}}\n", fmt::to_string(body), texture);
-  else fmt::format_to(out, "union {{\n{}  texture {{ {} }}\n}}\n", fmt::to_string(body), texture);
+  if (n == 1)
+    fmt::format_to(out, "object {{\n{}  texture {{ {} }}\n}}\n", fmt::to_string(body), texture);
+  else
+    fmt::format_to(out, "union {{\n{}  texture {{ {} }}\n}}\n", fmt::to_string(body), texture);
 }
 
 glm::vec3 any_perpendicular(const glm::vec3& d) {
@@ -137,18 +144,23 @@ void write_settings(Out out, const Scene& scene, const Plant& plant, const Rende
   fmt::format_to(out, "}}\n");
   // One material set for every algorithm. Colours are sRGB; with radiosity the sky lights the scene, so
   // ambient is off; in the preview a little ambient stands in for it.
-  fmt::format_to(out,
-                 "#default {{ finish {{ ambient {} diffuse 0.75 }} }}\n"
-                 "#declare GB_Bark = texture {{ pigment {{ srgb <0.40,0.27,0.17> }} finish {{ specular 0.05 roughness 0.1 }} }}\n"
-                 "#declare GB_Leaf = texture {{ pigment {{ srgb <0.24,0.52,0.16> }} finish {{ specular 0.15 roughness 0.04 }} }}\n"
-                 "#declare GB_YoungLeaf = texture {{ pigment {{ srgb <0.52,0.72,0.24> }} finish {{ specular 0.15 roughness 0.04 }} }}\n"
-                 "#declare GB_Flower = texture {{ pigment {{ srgb <0.95,0.80,0.88> }} finish {{ specular 0.1 roughness 0.05 }} }}\n"
-                 "#declare GB_Surface = texture {{ pigment {{ srgb <0.80,0.78,0.74> }} }}\n"
-                 "#declare GB_Ground = texture {{ pigment {{ checker srgb <0.56,0.55,0.52> srgb <0.62,0.61,0.58> scale {:.4g} }} }}\n",
-                 paper ? 0.0 : 0.12, std::max(0.25f, 0.05f * diag));
-  fmt::format_to(out,
-                 "sky_sphere {{ pigment {{ gradient y color_map {{ [0.0 srgb <0.93,0.94,0.95>] [0.5 srgb <0.93,0.94,0.95>]\n"
-                 "  [1.0 srgb <0.50,0.66,0.86>] }} scale 2 translate -1 }} }}\n");
+  fmt::format_to(
+      out,
+      "#default {{ finish {{ ambient {} diffuse 0.75 }} }}\n"
+      "#declare GB_Bark = texture {{ pigment {{ srgb <0.40,0.27,0.17> }} finish {{ specular 0.05 roughness 0.1 }} }}\n"
+      "#declare GB_Leaf = texture {{ pigment {{ srgb <0.24,0.52,0.16> }} finish {{ specular 0.15 roughness 0.04 }} }}\n"
+      "#declare GB_YoungLeaf = texture {{ pigment {{ srgb <0.52,0.72,0.24> }} finish {{ specular 0.15 roughness 0.04 "
+      "}} }}\n"
+      "#declare GB_Flower = texture {{ pigment {{ srgb <0.95,0.80,0.88> }} finish {{ specular 0.1 roughness 0.05 }} "
+      "}}\n"
+      "#declare GB_Surface = texture {{ pigment {{ srgb <0.80,0.78,0.74> }} }}\n"
+      "#declare GB_Ground = texture {{ pigment {{ checker srgb <0.56,0.55,0.52> srgb <0.62,0.61,0.58> scale {:.4g} }} "
+      "}}\n",
+      paper ? 0.0 : 0.12, std::max(0.25f, 0.05f * diag));
+  fmt::format_to(
+      out,
+      "sky_sphere {{ pigment {{ gradient y color_map {{ [0.0 srgb <0.93,0.94,0.95>] [0.5 srgb <0.93,0.94,0.95>]\n"
+      "  [1.0 srgb <0.50,0.66,0.86>] }} scale 2 translate -1 }} }}\n");
 }
 
 // The scene's camera, with its vertical field of view kept at the image's aspect.
@@ -241,7 +253,8 @@ void write_branches(Out out, const Plant& plant, const RenderOptions& o) {
     const OutputMesh tubes = mesh_plant(Plant{plant.nodes, {}, {}, {}, {}}, o.mesher);
     if (!tubes.triangles.empty()) {
       fmt::format_to(out, "// branches: {} nodes as one mesh2\n", plant.nodes.size());
-      write_mesh2(out, tubes.positions, tubes.normals, tubes.triangles, 0, static_cast<std::uint32_t>(tubes.triangles.size()));
+      write_mesh2(out, tubes.positions, tubes.normals, tubes.triangles, 0,
+                  static_cast<std::uint32_t>(tubes.triangles.size()));
       fmt::format_to(out, "  texture {{ GB_Bark }}\n}}\n");
     }
   } else if (o.branches == "cones") {
@@ -267,8 +280,9 @@ void write_organs(Out out, const Plant& plant, const MesherOptions& mesher) {
         if (std::find(kinds.begin(), kinds.end(), organ.kind) == kinds.end() || !(organ.size > 0.0f)) continue;
         const glm::mat3 a = flip * glm::mat3_cast(organ.orientation) * flip * organ.size;
         const glm::vec3 t = pov(organ.position);
-        fmt::format_to(o2, "  object {{ GB_OrganShape matrix <{:.5g},{:.5g},{:.5g}, {:.5g},{:.5g},{:.5g}, "
-                           "{:.5g},{:.5g},{:.5g}, {:.6g},{:.6g},{:.6g}> }}\n",
+        fmt::format_to(o2,
+                       "  object {{ GB_OrganShape matrix <{:.5g},{:.5g},{:.5g}, {:.5g},{:.5g},{:.5g}, "
+                       "{:.5g},{:.5g},{:.5g}, {:.6g},{:.6g},{:.6g}> }}\n",
                        a[0].x, a[0].y, a[0].z, a[1].x, a[1].y, a[1].z, a[2].x, a[2].y, a[2].z, t.x, t.y, t.z);
         ++count;
       }
@@ -328,14 +342,16 @@ std::uint64_t write_pov(const std::string& path, const Scene& scene, const Plant
 }
 
 nlohmann::json RenderResult::to_json() const {
-  nlohmann::json j = {{"status", status}, {"png", png},       {"pov", pov},         {"width", width},
-                      {"height", height}, {"pov_bytes", pov_bytes}, {"write_s", write_s}, {"wall_s", wall_s},
-                      {"cpu_s", cpu_s},   {"warnings", warnings}};
+  nlohmann::json j = {
+      {"status", status},       {"png", png},         {"pov", pov},       {"width", width}, {"height", height},
+      {"pov_bytes", pov_bytes}, {"write_s", write_s}, {"wall_s", wall_s}, {"cpu_s", cpu_s}, {"warnings", warnings}};
   if (!message.empty()) j["message"] = message;
   return j;
 }
 
-std::string find_povray() { return find_program("povray"); }
+std::string find_povray() {
+  return find_program("povray");
+}
 
 std::string povray_version() {
   const std::string bin = find_povray();
@@ -422,14 +438,15 @@ RenderResult run_povray(const std::string& pov_path, const std::string& png_path
   }
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.cpu_s = cr.user_s + cr.system_s;
-  const std::vector<std::string> errors = scan_log(fs::exists(r.log) ? read_text_file(r.log) : std::string(), r.warnings);
+  const std::vector<std::string> errors =
+      scan_log(fs::exists(r.log) ? read_text_file(r.log) : std::string(), r.warnings);
   if (cr.timed_out) {
     r.status = "timeout";
     r.message = fmt::format("POV-Ray was stopped after {:.0f} s", o.timeout_s);
   } else if (cr.exit_code != 0 || cr.signal != 0 || !fs::exists(png_abs)) {
     r.status = "failed";
-    std::string why = cr.signal != 0 ? fmt::format("killed by signal {}", cr.signal)
-                                     : fmt::format("exit status {}", cr.exit_code);
+    std::string why =
+        cr.signal != 0 ? fmt::format("killed by signal {}", cr.signal) : fmt::format("exit status {}", cr.exit_code);
     if (cr.exit_code == 127) why = fmt::format("cannot run {}", bin);
     r.message = fmt::format("POV-Ray failed on {} ({})", pov_path, why);
     for (std::size_t i = 0; i < errors.size() && i < 6; ++i) r.message += "\n  " + errors[i];
@@ -438,8 +455,8 @@ RenderResult run_povray(const std::string& pov_path, const std::string& png_path
   return r;
 }
 
-RenderResult render_plant(const Scene& scene, const Plant& plant, const std::string& pov_path, const std::string& png_path,
-                          const RenderOptions& o) {
+RenderResult render_plant(const Scene& scene, const Plant& plant, const std::string& pov_path,
+                          const std::string& png_path, const RenderOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
   std::uint64_t bytes = 0;
   try {

@@ -36,7 +36,7 @@ struct RenderOptions {
   std::string branches = "cones";
   bool draw_plant = true;  // false: the scene alone (the tests compare renders with and without the plant)
   double timeout_s = 900.0;
-  MesherOptions mesher;    // tube sides (branches=mesh) and the leaf shape
+  MesherOptions mesher;  // tube sides (branches=mesh) and the leaf shape
 };
 
 [[nodiscard]] int render_width(const RenderOptions& o);
@@ -54,8 +54,8 @@ struct RenderResult {
   std::string pov, png, log;          // the files (paths as given)
   int width = 0, height = 0;
   std::uint64_t pov_bytes = 0;
-  double write_s = 0.0;               // writing the .pov file
-  double wall_s = 0.0, cpu_s = 0.0;   // the POV-Ray process (parse + render), apart from the trial's time
+  double write_s = 0.0;              // writing the .pov file
+  double wall_s = 0.0, cpu_s = 0.0;  // the POV-Ray process (parse + render), apart from the trial's time
   [[nodiscard]] bool ok() const { return status == "ok"; }
   [[nodiscard]] nlohmann::json to_json() const;
 };
@@ -70,8 +70,8 @@ std::string povray_version();
 RenderResult run_povray(const std::string& pov_path, const std::string& png_path, const RenderOptions& options);
 
 // write_pov, then run_povray. The .pov file is kept beside the image for inspection.
-RenderResult render_plant(const Scene& scene, const Plant& plant, const std::string& pov_path, const std::string& png_path,
-                          const RenderOptions& options);
+RenderResult render_plant(const Scene& scene, const Plant& plant, const std::string& pov_path,
+                          const std::string& png_path, const RenderOptions& options);
 
 // One labelled image: `cells` is rows x cols PNG paths (an empty path or a missing file draws a grey
 // box with `notes[r][c]`, if given). Throws std::runtime_error naming the file it cannot write.

@@ -25,11 +25,10 @@ namespace growbench {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 
-
 namespace {
 
 struct Job {
-  std::string key;          // trial id ("" for a run directory)
+  std::string key;  // trial id ("" for a run directory)
   fs::path snapshot, pov, png;
   std::string scene_spec;
   std::vector<std::string> scene_params;
@@ -60,9 +59,21 @@ AnimationRecord make_animation(const fs::path& trial_dir, std::size_t frames) {
     a.message = "ffmpeg is not installed: the numbered PNG frames are the animation";
     return a;
   }
-  std::vector<std::string> args = {ffmpeg, "-y", "-loglevel", "error", "-framerate", "12", "-pattern_type", "glob",
-                                   "-i", "frames/step_*.png", "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt",
-                                   "yuv420p", "animation.mp4"};
+  std::vector<std::string> args = {ffmpeg,
+                                   "-y",
+                                   "-loglevel",
+                                   "error",
+                                   "-framerate",
+                                   "12",
+                                   "-pattern_type",
+                                   "glob",
+                                   "-i",
+                                   "frames/step_*.png",
+                                   "-vf",
+                                   "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+                                   "-pix_fmt",
+                                   "yuv420p",
+                                   "animation.mp4"};
   const ChildResult cr = run_program(args, trial_dir.string(), {600.0, 0}, (trial_dir / "animation.log").string());
   if (cr.exit_code == 0 && fs::exists(trial_dir / "animation.mp4")) {
     a.status = "ok";
@@ -79,8 +90,15 @@ AnimationRecord make_animation(const fs::path& trial_dir, std::size_t frames) {
 bool add_trial(std::vector<Job>& jobs, const std::string& key, const fs::path& tdir, const std::string& scene_spec,
                const std::vector<std::string>& scene_params, const std::string& leaf_obj) {
   if (!fs::exists(tdir / "plant.gbplant")) return false;
-  jobs.push_back({key, tdir / "plant.gbplant", tdir / "render.pov", tdir / "render.png", scene_spec, scene_params, leaf_obj,
-                  false, {}});
+  jobs.push_back({key,
+                  tdir / "plant.gbplant",
+                  tdir / "render.pov",
+                  tdir / "render.png",
+                  scene_spec,
+                  scene_params,
+                  leaf_obj,
+                  false,
+                  {}});
   for (const auto& f : frame_snapshots(tdir)) {
     fs::path png = f;
     png.replace_extension(".png");
@@ -132,12 +150,15 @@ void render_jobs(std::vector<Job>& jobs, int workers, const RenderOptions& ro, c
       if (!o.quiet) {
         std::lock_guard lock(print_mutex);
         const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        const std::string what = j.key.empty() ? j.png.filename().string() : j.key + (j.frame ? "/" + j.png.filename().string() : "");
+        const std::string what =
+            j.key.empty() ? j.png.filename().string() : j.key + (j.frame ? "/" + j.png.filename().string() : "");
         const std::string line =
             fmt::format("render [{}/{}] {}: {} ({:.1f} s), ETA {:.0f} s", n, jobs.size(), what, j.result.status,
                         j.result.wall_s, el / static_cast<double>(n) * static_cast<double>(jobs.size() - n));
-        if (tty) fmt::print(stderr, "\r{:<110}", line.substr(0, 110));
-        else fmt::print(stderr, "{}\n", line);
+        if (tty)
+          fmt::print(stderr, "\r{:<110}", line.substr(0, 110));
+        else
+          fmt::print(stderr, "{}\n", line);
         if (!j.result.ok()) fmt::print(stderr, "{}growbench: render failed: {}\n", tty ? "\n" : "", j.result.message);
       }
     }
@@ -145,8 +166,8 @@ void render_jobs(std::vector<Job>& jobs, int workers, const RenderOptions& ro, c
   // Renders report as they finish; say at once how many there are, since the first can take a while.
   std::fflush(stdout);  // what the caller printed (a suite's summary) comes before the progress lines
   if (!o.quiet)
-    fmt::print(stderr, "render: {} image{} at {} quality, {} POV-Ray process{} at once\n", jobs.size(), jobs.size() == 1 ? "" : "s",
-               to_string(o.render.quality), workers, workers == 1 ? "" : "es");
+    fmt::print(stderr, "render: {} image{} at {} quality, {} POV-Ray process{} at once\n", jobs.size(),
+               jobs.size() == 1 ? "" : "s", to_string(o.render.quality), workers, workers == 1 ? "" : "es");
   std::vector<std::thread> pool;
   for (int i = 0; i < workers; ++i) pool.emplace_back(worker);
   for (auto& th : pool) th.join();
@@ -178,22 +199,26 @@ RenderRecord render_record(const Job& j, const RenderOptions& ro, const fs::path
 
 // Where renders and animations are recorded: each trial of a suite's results, or the one run's record.
 struct RenderTargets {
-  ResultsFile* results = nullptr;  // a suite
-  TrialRecord* record = nullptr;   // a run
+  ResultsFile* results = nullptr;                  // a suite
+  TrialRecord* record = nullptr;                   // a run
   std::map<std::string, std::size_t> trial_index;  // id -> index in results->trials
   void set(const std::string& key, RenderRecord r) {
-    if (results) results->trials[trial_index.at(key)].render = std::move(r);
-    else record->render = std::move(r);
+    if (results)
+      results->trials[trial_index.at(key)].render = std::move(r);
+    else
+      record->render = std::move(r);
   }
   void set(const std::string& key, AnimationRecord a) {
-    if (results) results->trials[trial_index.at(key)].animation = std::move(a);
-    else record->animation = std::move(a);
+    if (results)
+      results->trials[trial_index.at(key)].animation = std::move(a);
+    else
+      record->animation = std::move(a);
   }
 };
 
 // Records every render, makes each trial's animation from its frames; the tally into `summary`.
-void record_renders(const std::vector<Job>& jobs, const RenderOptions& ro, const fs::path& dir, const RenderDirOptions& o,
-                    RenderTargets& targets, RenderSummary& summary) {
+void record_renders(const std::vector<Job>& jobs, const RenderOptions& ro, const fs::path& dir,
+                    const RenderDirOptions& o, RenderTargets& targets, RenderSummary& summary) {
   const bool suite = targets.results != nullptr;
   std::map<std::string, std::size_t> frames_of;
   std::map<std::string, std::vector<std::string>> frame_failures;
@@ -234,7 +259,8 @@ void write_grids(const ResultsFile& doc, const fs::path& dir, const RenderOption
     std::string row = t.label.empty() ? t.algorithm : t.label;
     if (t.sweep.is_object() && !t.sweep.empty()) {
       std::vector<std::string> kv;
-      for (const auto& [k, v] : t.sweep.items()) kv.push_back(fmt::format("{}={}", k, v.is_string() ? v.get<std::string>() : v.dump()));
+      for (const auto& [k, v] : t.sweep.items())
+        kv.push_back(fmt::format("{}={}", k, v.is_string() ? v.get<std::string>() : v.dump()));
       row += fmt::format(" {}", fmt::join(kv, " "));
     }
     const std::string& col = t.scene;
@@ -250,18 +276,22 @@ void write_grids(const ResultsFile& doc, const fs::path& dir, const RenderOption
       return std::string();
     }
     const SuiteCell& t = *it->second;
-    if (t.status != "ok") note = t.status;
-    else if (!t.render) note = "no snapshot";
-    else if (t.render->status != "ok") note = "render " + t.render->status;
-    else return (dir / t.render->png).string();
+    if (t.status != "ok")
+      note = t.status;
+    else if (!t.render)
+      note = "no snapshot";
+    else if (t.render->status != "ok")
+      note = "render " + t.render->status;
+    else
+      return (dir / t.render->png).string();
     return std::string();
   };
   std::vector<std::vector<std::string>> cells(rows.size(), std::vector<std::string>(cols.size()));
   std::vector<std::vector<std::string>> notes = cells;
   for (std::size_t i = 0; i < rows.size(); ++i)
     for (std::size_t k = 0; k < cols.size(); ++k) cells[i][k] = cell(rows[i], cols[k], notes[i][k]);
-  const std::string title = fmt::format("growbench suite '{}': algorithm x scene (lowest seed), POV-Ray {}", doc.suite.name,
-                                        to_string(ro.quality));
+  const std::string title = fmt::format("growbench suite '{}': algorithm x scene (lowest seed), POV-Ray {}",
+                                        doc.suite.name, to_string(ro.quality));
   try {
     write_grid((dir / "grid.png").string(), title, rows, cols, cells, notes);
     summary.grid = "grid.png";
@@ -273,7 +303,8 @@ void write_grids(const ResultsFile& doc, const fs::path& dir, const RenderOption
         col_notes[0].push_back(notes[i][k]);
       }
       const std::string name = "grid-" + safe_name(cols[k]) + ".png";
-      write_grid((dir / name).string(), fmt::format("{} (lowest seed)", cols[k]), {cols[k]}, rows, col_cells, col_notes);
+      write_grid((dir / name).string(), fmt::format("{} (lowest seed)", cols[k]), {cols[k]}, rows, col_cells,
+                 col_notes);
       per_scene[cols[k]] = name;
     }
     summary.grid_per_scene = per_scene;
@@ -289,8 +320,8 @@ RenderSummary render_directory_record(const std::string& dir_arg, const RenderDi
   const fs::path dir(dir_arg);
   const bool suite = fs::exists(dir / "results.json");
   if (!suite && !fs::exists(dir / "record.json"))
-    throw InputError(fmt::format("{}: neither a suite results directory (results.json) nor a run directory (record.json)",
-                                 dir_arg));
+    throw InputError(
+        fmt::format("{}: neither a suite results directory (results.json) nor a run directory (record.json)", dir_arg));
   ResultsFile results;
   TrialRecord record;
   RenderTargets targets;
@@ -310,7 +341,8 @@ RenderSummary render_directory_record(const std::string& dir_arg, const RenderDi
     record = read_trial_record((dir / "record.json").string());
     targets.record = &record;
     if (!add_trial(jobs, "", dir, record.scene.spec, record.scene.params, record.leaf_obj.value_or("")))
-      throw InputError(fmt::format("{}: no plant.gbplant to render (written by growbench run and suite trials)", dir_arg));
+      throw InputError(
+          fmt::format("{}: no plant.gbplant to render (written by growbench run and suite trials)", dir_arg));
   }
 
   const int cores = std::max(1u, std::thread::hardware_concurrency());

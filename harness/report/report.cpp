@@ -47,7 +47,8 @@ int run_python(const std::string& script, const std::vector<std::string>& script
 int run_report(const std::string& results, const std::string& out_dir, const std::vector<std::string>& extra) {
   const std::string script = report_script();
   if (!fs::exists(script))
-    throw InputError(fmt::format("report script {} not found (set GROWBENCH_REPORT_SCRIPT to reports/report.py)", script));
+    throw InputError(
+        fmt::format("report script {} not found (set GROWBENCH_REPORT_SCRIPT to reports/report.py)", script));
   if (!fs::exists(results)) throw InputError(fmt::format("{}: no such results file", results));
   std::vector<std::string> args = {results, "--out", out_dir};
   args.insert(args.end(), extra.begin(), extra.end());
@@ -56,7 +57,8 @@ int run_report(const std::string& results, const std::string& out_dir, const std
 
 int run_reports_script(const std::string& name, const std::vector<std::string>& args) {
   const std::string script = (fs::path(report_script()).parent_path() / name).string();
-  if (!fs::exists(script)) throw InputError(fmt::format("script {} not found (it lives beside reports/report.py)", script));
+  if (!fs::exists(script))
+    throw InputError(fmt::format("script {} not found (it lives beside reports/report.py)", script));
   return run_python(script, args);
 }
 

@@ -15,7 +15,9 @@ namespace {
 using nlohmann::json;
 
 // NAN for none: the tables print it as "-".
-double median(std::vector<double> v) { return v.empty() ? NAN : median_of(std::move(v)); }
+double median(std::vector<double> v) {
+  return v.empty() ? NAN : median_of(std::move(v));
+}
 
 std::string si_bytes(double b) {
   if (!std::isfinite(b)) return "-";
@@ -53,29 +55,37 @@ std::string cell_row(const SuiteCell& t, std::vector<std::string>& warnings) {
   bool exact = false;
   const auto [lo, hi] = median_interval(growth, exact);
   const double med = median(growth);
-  const std::string ci = growth.empty() ? "-" : fmt::format("{} [{}{}, {}]", format_seconds(med), exact ? "" : "~", format_seconds(lo), format_seconds(hi));
+  const std::string ci = growth.empty() ? "-"
+                                        : fmt::format("{} [{}{}, {}]", format_seconds(med), exact ? "" : "~",
+                                                      format_seconds(lo), format_seconds(hi));
   const CellResults& r = t.results;
   const json m = r.metrics.value_or(json::object());
-  auto metric = [&](const char* k) { return m.contains(k) ? fmt::format("{:.3f}", m[k].get<double>()) : std::string("-"); };
-  std::string row = fmt::format("{:<40} {:>6} {:>30} {:>10} {:>11} {:>8} {:>9} {:>10} {:>8} {:>8} {:>8}\n", cell.substr(0, 40),
-                                t.status, ci, format_seconds(median(total)), si_bytes(median(rss)),
-                                r.counts ? std::to_string(r.counts->nodes) : "-",
-                                r.total_length_m ? fmt::format("{:.2f}", *r.total_length_m) : "-",
-                                r.output_bytes && r.output_bytes->ply ? si_bytes(static_cast<double>(*r.output_bytes->ply)) : "-",
-                                metric("coverage"), metric("attached_fraction"), metric("penetration_nodes"));
+  auto metric = [&](const char* k) {
+    return m.contains(k) ? fmt::format("{:.3f}", m[k].get<double>()) : std::string("-");
+  };
+  std::string row = fmt::format(
+      "{:<40} {:>6} {:>30} {:>10} {:>11} {:>8} {:>9} {:>10} {:>8} {:>8} {:>8}\n", cell.substr(0, 40), t.status, ci,
+      format_seconds(median(total)), si_bytes(median(rss)), r.counts ? std::to_string(r.counts->nodes) : "-",
+      r.total_length_m ? fmt::format("{:.2f}", *r.total_length_m) : "-",
+      r.output_bytes && r.output_bytes->ply ? si_bytes(static_cast<double>(*r.output_bytes->ply)) : "-",
+      metric("coverage"), metric("attached_fraction"), metric("penetration_nodes"));
   if (growth.size() >= 2) {
     double mean = 0.0, var = 0.0;
     for (const double g : growth) mean += g;
     mean /= static_cast<double>(growth.size());
     for (const double g : growth) var += (g - mean) * (g - mean);
     const double cv = std::sqrt(var / static_cast<double>(growth.size() - 1)) / mean;
-    const double min_v = *std::min_element(growth.begin(), growth.end()), max_v = *std::max_element(growth.begin(), growth.end());
+    const double min_v = *std::min_element(growth.begin(), growth.end()),
+                 max_v = *std::max_element(growth.begin(), growth.end());
     const double far = std::max(med - min_v, max_v - med) / med;
     if (cv > 0.10) warnings.push_back(fmt::format("{} on {}: growth time CV {:.0f}% > 10%", cell, sc, 100 * cv));
-    if (far > 0.50) warnings.push_back(fmt::format("{} on {}: a repetition is {:.0f}% from the median (> 50%)", cell, sc, 100 * far));
+    if (far > 0.50)
+      warnings.push_back(fmt::format("{} on {}: a repetition is {:.0f}% from the median (> 50%)", cell, sc, 100 * far));
   }
-  if (t.nondeterministic.value_or(false)) warnings.push_back(fmt::format("{} on {}: repetitions grew different plants", cell, sc));
-  if (t.status != "ok") warnings.push_back(fmt::format("{} on {}: {} ({})", cell, sc, t.status, t.message.value_or("")));
+  if (t.nondeterministic.value_or(false))
+    warnings.push_back(fmt::format("{} on {}: repetitions grew different plants", cell, sc));
+  if (t.status != "ok")
+    warnings.push_back(fmt::format("{} on {}: {} ({})", cell, sc, t.status, t.message.value_or("")));
   return row;
 }
 
@@ -84,9 +94,12 @@ std::string overhead_line(const ResultsFile& results) {
   std::map<std::string, std::vector<double>> over;
   for (const auto& t : results.trials)
     for (const auto& s : t.samples)
-      for (const auto& [k, v] : {std::pair{"launch_s", &s.launch_s}, {"child_bookkeeping_s", &s.child_bookkeeping_s},
-                                 {"parent_s", &s.parent_s}, {"harness_overhead_s", &s.harness_overhead_s},
-                                 {"teardown_s", &s.teardown_s}, {"outside_phases_s", &s.outside_phases_s}})
+      for (const auto& [k, v] : {std::pair{"launch_s", &s.launch_s},
+                                 {"child_bookkeeping_s", &s.child_bookkeeping_s},
+                                 {"parent_s", &s.parent_s},
+                                 {"harness_overhead_s", &s.harness_overhead_s},
+                                 {"teardown_s", &s.teardown_s},
+                                 {"outside_phases_s", &s.outside_phases_s}})
         if (*v) over[k].push_back(**v);
   if (over["harness_overhead_s"].empty()) return "";
   auto ms = [&](const char* k) { return fmt::format("{:.2f} ms", 1e3 * median(over[k])); };
@@ -103,8 +116,9 @@ std::string overhead_line(const ResultsFile& results) {
 std::string summarize_results(const ResultsFile& results) {
   std::string out;
   const RunContext& ctx = results.context;
-  out += fmt::format("suite {} | commit {}{} | {} | {} hardware threads | {}\n", results.suite.name, ctx.growbench_commit,
-                     ctx.dirty == "true" ? " (dirty)" : "", ctx.cpu_model, ctx.hardware_threads, ctx.date);
+  out +=
+      fmt::format("suite {} | commit {}{} | {} | {} hardware threads | {}\n", results.suite.name, ctx.growbench_commit,
+                  ctx.dirty == "true" ? " (dirty)" : "", ctx.cpu_model, ctx.hardware_threads, ctx.date);
   std::vector<std::string> scene_order;
   std::map<std::string, std::vector<const SuiteCell*>> by_scene;
   for (const auto& t : results.trials) {
@@ -119,7 +133,9 @@ std::string summarize_results(const ResultsFile& results) {
                        "inside");
     for (const SuiteCell* t : by_scene[sc]) out += cell_row(*t, warnings);
   }
-  out += "\nIntervals: distribution-free 95% CI of the median from order statistics ('~': fewer than 6 repetitions, full range shown).\n";
+  out +=
+      "\nIntervals: distribution-free 95% CI of the median from order statistics ('~': fewer than 6 repetitions, full "
+      "range shown).\n";
   out += overhead_line(results);
   if (!warnings.empty()) {
     out += "\nWarnings:\n";
@@ -128,6 +144,8 @@ std::string summarize_results(const ResultsFile& results) {
   return out;
 }
 
-std::string summarize_results(const json& results) { return summarize_results(from_json<ResultsFile>(results, "the results")); }
+std::string summarize_results(const json& results) {
+  return summarize_results(from_json<ResultsFile>(results, "the results"));
+}
 
 }  // namespace growbench

@@ -323,7 +323,8 @@ Spare fork_spare(const Launcher::Prepare& prepare) {
 
 Launcher::Launcher(Prepare prepare) {
   int req[2], rep[2];
-  if (pipe2(req, O_CLOEXEC) != 0) throw std::runtime_error(fmt::format("cannot create a pipe: {}", std::strerror(errno)));
+  if (pipe2(req, O_CLOEXEC) != 0)
+    throw std::runtime_error(fmt::format("cannot create a pipe: {}", std::strerror(errno)));
   if (pipe2(rep, O_CLOEXEC) != 0) {
     close(req[0]), close(req[1]);
     throw std::runtime_error(fmt::format("cannot create a pipe: {}", std::strerror(errno)));
@@ -355,7 +356,7 @@ Launcher::Launcher(Prepare prepare) {
     ChildLimits limits;
     while (read_request(in, description, limits)) {
       try {
-        (void)prepare(description);  // a bad description is an error reply; the child prepares its own
+        (void)prepare(description);     // a bad description is an error reply; the child prepares its own
         limits.die_with_parent = true;  // the launcher is single-threaded
         auto t0 = std::chrono::steady_clock::now();
         auto hand_over = [&](const Spare& c) {

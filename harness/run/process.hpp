@@ -18,10 +18,10 @@ struct ChildLimits {
 };
 
 struct ChildResult {
-  int exit_code = -1;       // when it exited
-  int signal = 0;           // when a signal ended it
-  bool timed_out = false;   // killed by the parent after timeout_s
-  double wall_s = 0.0;      // from spawn to reaping
+  int exit_code = -1;      // when it exited
+  int signal = 0;          // when a signal ended it
+  bool timed_out = false;  // killed by the parent after timeout_s
+  double wall_s = 0.0;     // from spawn to reaping
   // Steady-clock nanoseconds just before the child was started: its fork, or (a Launcher's job) the
   // hand-over of the job to a child forked ahead.
   std::int64_t spawn_ns = 0;

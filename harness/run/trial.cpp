@@ -227,12 +227,16 @@ RunContext run_context_record() {
   // The commit the binary was configured at; the source tree's current state when it is reachable.
   c.growbench_commit = GROWBENCH_GIT_COMMIT;
   if (std::filesystem::exists(std::string(GROWBENCH_SOURCE_DIR) + "/.git")) {
-    const std::string commit = run_command(fmt::format("git -C '{}' rev-parse --short=12 HEAD 2>/dev/null", GROWBENCH_SOURCE_DIR));
+    const std::string commit =
+        run_command(fmt::format("git -C '{}' rev-parse --short=12 HEAD 2>/dev/null", GROWBENCH_SOURCE_DIR));
     if (!commit.empty()) c.growbench_commit = commit;
     // Committer time (Unix seconds): orders a history by commit.
-    const std::string ct = run_command(fmt::format("git -C '{}' show -s --format=%ct HEAD 2>/dev/null", GROWBENCH_SOURCE_DIR));
+    const std::string ct =
+        run_command(fmt::format("git -C '{}' show -s --format=%ct HEAD 2>/dev/null", GROWBENCH_SOURCE_DIR));
     if (!ct.empty() && ct.find_first_not_of("0123456789") == std::string::npos) c.commit_time = std::stoll(ct);
-    c.dirty = run_command(fmt::format("git -C '{}' status --porcelain --untracked-files=no 2>/dev/null", GROWBENCH_SOURCE_DIR)).empty()
+    c.dirty = run_command(
+                  fmt::format("git -C '{}' status --porcelain --untracked-files=no 2>/dev/null", GROWBENCH_SOURCE_DIR))
+                      .empty()
                   ? "false"
                   : "true";
   }
@@ -252,7 +256,9 @@ RunContext run_context_record() {
   return c;
 }
 
-nlohmann::json run_context() { return to_json(run_context_record()); }
+nlohmann::json run_context() {
+  return to_json(run_context_record());
+}
 
 TrialSpecRecord to_record(const TrialSpec& s) {
   TrialSpecRecord r;
@@ -302,7 +308,9 @@ TrialSpec trial_spec_of(const TrialSpecRecord& r) {
   return s;
 }
 
-nlohmann::json to_json(const TrialSpec& s) { return to_json(to_record(s)); }
+nlohmann::json to_json(const TrialSpec& s) {
+  return to_json(to_record(s));
+}
 
 TrialSpec trial_spec_from_json(const nlohmann::json& j) {
   return trial_spec_of(from_json<TrialSpecRecord>(j, "the trial spec"));
@@ -337,7 +345,8 @@ void load_scene_and_query(const TrialSpec& spec, TrialState& st, PhaseTimer& tim
   st.scene = timer.run("scene_load", rec.phases.scene_load, [&] { return load_scene(spec.scene, spec.scene_params); });
   SceneQueryOptions qo;
   qo.voxel_size = spec.voxel_size;
-  st.query = timer.run("query_build", rec.phases.query_build, [&] { return std::make_unique<SceneQuery>(st.scene, qo); });
+  st.query =
+      timer.run("query_build", rec.phases.query_build, [&] { return std::make_unique<SceneQuery>(st.scene, qo); });
   PhaseMeasures& q = *rec.phases.query_build;
   q.bvh_s = st.query->bvh_build_seconds();
   q.sdf_s = st.query->sdf_build_seconds();
@@ -350,8 +359,9 @@ void load_scene_and_query(const TrialSpec& spec, TrialState& st, PhaseTimer& tim
       st.scene.seeds.push_back({h.found ? h.point : p, {0, 1, 0}, 0});
     }
   }
-  rec.scene = {spec.scene, st.scene.name, st.scene.content_hash(), st.scene.triangle_count(), st.scene.seeds.size(),
-               spec.scene_params};
+  rec.scene = {
+      spec.scene,       st.scene.name, st.scene.content_hash(), st.scene.triangle_count(), st.scene.seeds.size(),
+      spec.scene_params};
 }
 
 // Frame capture (growth animations): OUT/frames/step_NNNNNN.gbplant, its cost measured to be taken out of
@@ -455,12 +465,15 @@ void mesh_export_measure(const TrialSpec& spec, const MesherOptions& mesher, Tri
   if (spec.metrics) {
     MetricOptions metric_options;
     metric_options.organ_shape = organ_shape(mesher);
-    rec.metrics = timer.run("metrics", rec.phases.metrics, [&] { return compute_metrics(plant, *st.query, metric_options); });
+    rec.metrics =
+        timer.run("metrics", rec.phases.metrics, [&] { return compute_metrics(plant, *st.query, metric_options); });
   }
   std::size_t segments = 0;
   for (const auto& n : plant.nodes) segments += n.parent != kNoParent ? 1 : 0;
-  rec.counts = {plant.nodes.size(),    segments,          plant.leaf_count(),        plant.organs.size(),
-                plant.polygons.size(), st.mesh.positions.size(), st.mesh.triangles.size()};
+  rec.counts = {plant.nodes.size(),      segments,
+                plant.leaf_count(),      plant.organs.size(),
+                plant.polygons.size(),   st.mesh.positions.size(),
+                st.mesh.triangles.size()};
   rec.total_length_m = plant.total_length();
   rec.geometry_hash = plant.geometry_hash();
   for (const auto& [k, v] : st.algo->stats()) rec.algorithm_stats[k] = v;
@@ -510,11 +523,13 @@ TrialRecord run_trial_record(const TrialSpec& spec, const std::function<void(con
     write_file_atomic(path, json_text(to_json(rec), spec.skip_teardown ? -1 : 2));
   }
   // Deliberately never freed: the process exits next and the kernel reclaims it all at once.
-  if (spec.skip_teardown) [[maybe_unused]] auto* kept = new TrialState{std::move(st)};
+  if (spec.skip_teardown) [[maybe_unused]]
+    auto* kept = new TrialState{std::move(st)};
   return rec;
 }
 
-nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const Progress&)>& progress, Plant* plant_out) {
+nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const Progress&)>& progress,
+                         Plant* plant_out) {
   return to_json(run_trial_record(spec, progress, plant_out));
 }
 

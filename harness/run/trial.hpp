@@ -21,23 +21,23 @@ struct TrialSpec {
   std::vector<std::string> scene_params;  // key=value
   std::vector<std::string> params;        // algorithm key=value (--set)
   std::uint64_t seed = 1;
-  std::vector<glm::vec3> seed_at;         // replaces the scene's seeds, each snapped to the surface
-  int max_steps = 5000;                   // the step cap for every algorithm
-  double time_limit_s = 0.0;              // 0: none; checked between steps
-  int threads = 0;                        // 0: all cores
-  float voxel_size = 0.0f;                // 0: automatic (see SceneQueryOptions)
-  std::string out_dir;                    // empty: measure but write no files
+  std::vector<glm::vec3> seed_at;  // replaces the scene's seeds, each snapped to the surface
+  int max_steps = 5000;            // the step cap for every algorithm
+  double time_limit_s = 0.0;       // 0: none; checked between steps
+  int threads = 0;                 // 0: all cores
+  float voxel_size = 0.0f;         // 0: automatic (see SceneQueryOptions)
+  std::string out_dir;             // empty: measure but write no files
   MesherOptions mesher;
   // Comparable budgets across algorithms: stop once the plant has this many nodes / this much branch
   // length (0: no budget). Checked after every step.
   std::size_t budget_nodes = 0;
   double budget_length_m = 0.0;
-  bool metrics = true;                    // compute the quality metrics (harness/output/metrics.hpp)
+  bool metrics = true;  // compute the quality metrics (harness/output/metrics.hpp)
   // Growth animation: every this many steps (and after the last) the plant is written to
   // OUT/frames/step_NNNNNN.gbplant for `growbench render` (0: no frames). The time this takes is
   // recorded and taken out of the growth phase's wall and CPU time.
   int frame_every = 0;
-  bool context = true;                    // add run_context() to the record (suites record it once instead)
+  bool context = true;  // add run_context() to the record (suites record it once instead)
   // Leave the trial's big objects (scene, query, plant, mesh) allocated at the end: for a forked suite
   // child that exits right after, freeing them would only add time the kernel spends again at exit.
   bool skip_teardown = false;

@@ -17,7 +17,8 @@ std::pair<double, double> median_interval(std::vector<double> v, bool& exact) {
   // P(l <= B(n, 1/2) <= n - l) for l = 1, 2, ...
   auto coverage = [&](std::size_t l) {
     double p = 0.0;
-    for (std::size_t k = l; k + l <= n; ++k) p += std::exp(std::lgamma(n + 1.0) - std::lgamma(k + 1.0) - std::lgamma(n - k + 1.0) - n * std::log(2.0));
+    for (std::size_t k = l; k + l <= n; ++k)
+      p += std::exp(std::lgamma(n + 1.0) - std::lgamma(k + 1.0) - std::lgamma(n - k + 1.0) - n * std::log(2.0));
     return p;
   };
   std::size_t best = 0;
@@ -40,7 +41,9 @@ double median_of(std::vector<double> v) {
 std::string format_seconds(double s) {
   if (!std::isfinite(s)) return "-";
   const double a = std::abs(s);
-  return a >= 1.0 ? fmt::format("{:.3f} s", s) : a >= 1e-3 ? fmt::format("{:.2f} ms", s * 1e3) : fmt::format("{:.1f} us", s * 1e6);
+  return a >= 1.0    ? fmt::format("{:.3f} s", s)
+         : a >= 1e-3 ? fmt::format("{:.2f} ms", s * 1e3)
+                     : fmt::format("{:.1f} us", s * 1e6);
 }
 
 double robust_cv(const std::vector<double>& v) {
@@ -53,7 +56,9 @@ double robust_cv(const std::vector<double>& v) {
 
 namespace {
 
-double normal_upper_tail(double z) { return 0.5 * std::erfc(z / std::sqrt(2.0)); }
+double normal_upper_tail(double z) {
+  return 0.5 * std::erfc(z / std::sqrt(2.0));
+}
 
 // P(U <= u) under the null for sizes n and m without ties: the number of arrangements with a given U
 // satisfies c(n, m, u) = c(n - 1, m, u - m) + c(n, m - 1, u); kept as probabilities, built row by row.

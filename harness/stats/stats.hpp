@@ -37,12 +37,12 @@ MannWhitney mann_whitney(const std::vector<double>& a, const std::vector<double>
 struct SignedRank {
   double w_plus = 0.0;  // the sum of the ranks of |d| over the positive d
   double p = 1.0;
-  bool exact = true;    // exact (no ties among |d|, n <= 40); else normal, tie-corrected
+  bool exact = true;  // exact (no ties among |d|, n <= 40); else normal, tie-corrected
 };
 SignedRank wilcoxon_signed_rank(const std::vector<double>& d);
 
 struct RatioInterval {
-  double ratio = 1.0;        // median(b) / median(a)
+  double ratio = 1.0;         // median(b) / median(a)
   double lo = 1.0, hi = 1.0;  // percentile bootstrap interval
 };
 // Resamples a and b independently `resamples` times; level 0.95 gives the 2.5% and 97.5% percentiles.

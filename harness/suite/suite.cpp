@@ -38,12 +38,17 @@ using nlohmann::json;
 
 namespace {
 
-std::string read_text(const std::string& path) { return read_text_file(path); }
+std::string read_text(const std::string& path) {
+  return read_text_file(path);
+}
 
-void write_atomic(const fs::path& path, const std::string& text) { write_file_atomic(path.string(), text.data(), text.size()); }
+void write_atomic(const fs::path& path, const std::string& text) {
+  write_file_atomic(path.string(), text.data(), text.size());
+}
 
-std::string value_text(const json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); }
-
+std::string value_text(const json& v) {
+  return v.is_string() ? v.get<std::string>() : v.dump();
+}
 
 class SuiteReader : public JsonPathReader {
  public:
@@ -60,7 +65,8 @@ class SuiteReader : public JsonPathReader {
   }
   // Scene specs in suites: mesh:PATH and *.json are relative to the suite file (mesh:NAME is a bundled mesh).
   std::string scene_spec(const std::string& spec) const {
-    if (spec.rfind("mesh:", 0) == 0 && !is_mesh_name(spec.substr(5))) return "mesh:" + relative_to_suite(spec.substr(5));
+    if (spec.rfind("mesh:", 0) == 0 && !is_mesh_name(spec.substr(5)))
+      return "mesh:" + relative_to_suite(spec.substr(5));
     if (spec.size() > 5 && spec.substr(spec.size() - 5) == ".json") return relative_to_suite(spec);
     return spec;
   }
@@ -68,8 +74,9 @@ class SuiteReader : public JsonPathReader {
   Suite read() const {
     const std::string text = read_text(file());
     const json j = parse_json_file_text(file(), text);
-    only_keys(j, "", {"schema_version", "name", "description", "repetitions", "warmup", "threads", "timeout_s",
-                      "memory_limit_mb", "max_steps", "seeds", "budget", "scenes", "algorithms"});
+    only_keys(j, "",
+              {"schema_version", "name", "description", "repetitions", "warmup", "threads", "timeout_s",
+               "memory_limit_mb", "max_steps", "seeds", "budget", "scenes", "algorithms"});
     if (!j.contains("schema_version") || j["schema_version"] != 1) fail("/schema_version", "expected 1");
     Suite s;
     s.file = file();
@@ -113,7 +120,8 @@ class SuiteReader : public JsonPathReader {
     if (j.contains("warmup")) s.warmup = static_cast<int>(number(j["warmup"], "/warmup", 0, 100));
     if (j.contains("timeout_s")) s.timeout_s = number(j["timeout_s"], "/timeout_s", 0.001, 1e6);
     if (j.contains("memory_limit_mb"))
-      s.memory_limit_bytes = static_cast<std::uint64_t>(number(j["memory_limit_mb"], "/memory_limit_mb", 64, 1e7)) << 20;
+      s.memory_limit_bytes = static_cast<std::uint64_t>(number(j["memory_limit_mb"], "/memory_limit_mb", 64, 1e7))
+                             << 20;
     Common c;
     if (j.contains("threads")) c.threads = static_cast<int>(number(j["threads"], "/threads", 0, 1024));
     if (j.contains("max_steps")) c.max_steps = static_cast<int>(number(j["max_steps"], "/max_steps", 0, 1e9));
@@ -125,15 +133,18 @@ class SuiteReader : public JsonPathReader {
     }
     if (j.contains("budget")) {
       only_keys(j["budget"], "/budget", {"nodes", "length_m"});
-      if (j["budget"].contains("nodes")) c.budget_nodes = static_cast<std::size_t>(number(j["budget"]["nodes"], "/budget/nodes", 0, 1e12));
-      if (j["budget"].contains("length_m")) c.budget_length = number(j["budget"]["length_m"], "/budget/length_m", 0, 1e12);
+      if (j["budget"].contains("nodes"))
+        c.budget_nodes = static_cast<std::size_t>(number(j["budget"]["nodes"], "/budget/nodes", 0, 1e12));
+      if (j["budget"].contains("length_m"))
+        c.budget_length = number(j["budget"]["length_m"], "/budget/length_m", 0, 1e12);
     }
     return c;
   }
 
   std::vector<SceneEntry> read_scenes(const json& j) const {
     std::vector<SceneEntry> scenes;
-    if (!j.contains("scenes") || !j["scenes"].is_array() || j["scenes"].empty()) fail("/scenes", "expected a non-empty array of scenes");
+    if (!j.contains("scenes") || !j["scenes"].is_array() || j["scenes"].empty())
+      fail("/scenes", "expected a non-empty array of scenes");
     for (std::size_t i = 0; i < j["scenes"].size(); ++i) {
       const auto& e = j["scenes"][i];
       const std::string path = fmt::format("/scenes/{}", i);
@@ -200,7 +211,8 @@ class SuiteReader : public JsonPathReader {
       fail(path + "/name", err.what());
     }
     if (a.label.empty()) a.label = a.name;
-    if (!labels.insert(a.label).second) fail(path + "/label", fmt::format("label '{}' is used twice; give each entry its own", a.label));
+    if (!labels.insert(a.label).second)
+      fail(path + "/label", fmt::format("label '{}' is used twice; give each entry its own", a.label));
     Params p = default_params(*entry);
     if (e.is_object() && e.contains("params")) {
       if (!e["params"].is_object()) fail(path + "/params", "expected an object of parameters");
@@ -340,16 +352,16 @@ std::string results_csv(const ResultsFile& results) {
     head.push_back(ph + "_peak_rss_bytes");
     head.push_back(ph + "_alloc_count");
   }
-  for (const auto& k : {"child_wall_s", "child_max_rss_bytes", "harness_overhead_s", "nodes", "leaves", "total_length_m",
-                        "obj_bytes", "ply_bytes", "glb_bytes", "coverage", "attached_fraction", "penetration_nodes",
-                        "geometry_hash"})
+  for (const auto& k :
+       {"child_wall_s", "child_max_rss_bytes", "harness_overhead_s", "nodes", "leaves", "total_length_m", "obj_bytes",
+        "ply_bytes", "glb_bytes", "coverage", "attached_fraction", "penetration_nodes", "geometry_hash"})
     head.emplace_back(k);
   std::string out = csv_row(head) + "\n";
   for (const auto& t : results.trials) {
     const CellResults& c = t.results;
     for (const auto& s : t.samples) {
-      std::vector<std::string> row = {t.id, t.label, t.algorithm, t.scene, num(t.seed), t.sweep.dump(), num(s.repetition),
-                                      s.status};
+      std::vector<std::string> row = {t.id,        t.label,        t.algorithm,       t.scene,
+                                      num(t.seed), t.sweep.dump(), num(s.repetition), s.status};
       for (const auto& ph : kPhases) {
         const PhaseMeasures* p = s.phases ? s.phases->find(ph) : nullptr;
         row.push_back(p ? num(p->wall_s) : "");
@@ -429,7 +441,9 @@ CellResults cell_results_of(const TrialRecord& rec, bool first, const std::optio
   c.threads = rec.threads;
   c.scene_hash = rec.scene.hash;
   AllocByPhase alloc;
-  rec.phases.each([&](std::string_view k, const PhaseMeasures& p) { alloc[std::string(k)] = {p.alloc_count, p.alloc_bytes}; });
+  rec.phases.each([&](std::string_view k, const PhaseMeasures& p) {
+    alloc[std::string(k)] = {p.alloc_count, p.alloc_bytes};
+  });
   c.alloc = alloc;
   c.instructions = instructions;
   return c;
@@ -493,8 +507,10 @@ void apply_sample(SuiteCell& t, const SuiteSample& sample, const std::optional<C
       if (s.status != "ok" && s.message) t.message = s.message;
   // The growth time's median and interval, so that reports read them instead of computing them again.
   const std::vector<double> growth = growth_times(t);
-  if (growth.empty()) t.summary.reset();
-  else t.summary = CellSummary{median_summary(growth)};
+  if (growth.empty())
+    t.summary.reset();
+  else
+    t.summary = CellSummary{median_summary(growth)};
 }
 
 // The growth time over the seeds of each algorithm entry (and sweep point) on each scene: every ok cell's
@@ -558,10 +574,13 @@ std::vector<std::size_t> shard_slots(const std::vector<ResultsFile>& shards, con
       throw InputError(fmt::format("{}: a shard of another suite (suite_hash {} vs {} in {})", names[k], s.suite_hash,
                                    first.suite_hash, names[0]));
     if (s.repetitions != first.repetitions)
-      throw InputError(fmt::format("{}: {} repetitions, but {} has {}", names[k], s.repetitions, names[0], first.repetitions));
-    if (s.mode != first.mode) throw InputError(fmt::format("{}: mode '{}' differs from {}'s", names[k], s.mode, names[0]));
+      throw InputError(
+          fmt::format("{}: {} repetitions, but {} has {}", names[k], s.repetitions, names[0], first.repetitions));
+    if (s.mode != first.mode)
+      throw InputError(fmt::format("{}: mode '{}' differs from {}'s", names[k], s.mode, names[0]));
     const int n = s.shard.count, i = s.shard.index;
-    if (n != count) throw InputError(fmt::format("{}: shard of {} but {} is a shard of {}", names[k], n, names[0], count));
+    if (n != count)
+      throw InputError(fmt::format("{}: shard of {} but {} is a shard of {}", names[k], n, names[0], count));
     if (i < 0 || i >= n) throw InputError(fmt::format("{}: shard index {} outside 0..{}", names[k], i, n - 1));
     if (slot[static_cast<std::size_t>(i)] != shards.size())
       throw InputError(fmt::format("{}: shard {}/{} given twice", names[k], i, n));
@@ -584,14 +603,17 @@ ResultsFile merge_results(const std::vector<ResultsFile>& shards, const std::vec
     const auto keys = machine_keys(shards[k].context);
     for (std::size_t m = 0; m < keys.size(); ++m)
       if (keys[m].second != keys0[m].second)
-        differ.push_back(fmt::format("{} {} in {} vs {} in {}", keys[m].first, keys[m].second, names[k], keys0[m].second, names[0]));
+        differ.push_back(
+            fmt::format("{} {} in {} vs {} in {}", keys[m].first, keys[m].second, names[k], keys0[m].second, names[0]));
   }
   if (!differ.empty() && !mixed_machines)
-    throw InputError(fmt::format("merge: the shards ran on different machines or builds, so their timings cannot be compared "
-                                 "({}); run every shard on identical nodes, or pass --mixed-machines to merge them marked as mixed",
-                                 fmt::join(differ, "; ")));
+    throw InputError(
+        fmt::format("merge: the shards ran on different machines or builds, so their timings cannot be compared "
+                    "({}); run every shard on identical nodes, or pass --mixed-machines to merge them marked as mixed",
+                    fmt::join(differ, "; ")));
   for (int i = 0; i < count; ++i)
-    if (slot[static_cast<std::size_t>(i)] == shards.size()) throw InputError(fmt::format("merge: shard {}/{} is missing", i, count));
+    if (slot[static_cast<std::size_t>(i)] == shards.size())
+      throw InputError(fmt::format("merge: shard {}/{} is missing", i, count));
   // Cell k of the suite ran in shard k % count, as its (k / count)-th cell.
   ResultsFile merged = first;
   merged.shard = {0, 1};
@@ -606,11 +628,12 @@ ResultsFile merge_results(const std::vector<ResultsFile>& shards, const std::vec
   for (std::size_t k = 0; k < total; ++k) {
     const std::vector<SuiteCell>& trials = shards[slot[k % static_cast<std::size_t>(count)]].trials;
     const std::size_t at = k / static_cast<std::size_t>(count);
-    if (at >= trials.size()) throw InputError(fmt::format("merge: shard {} has fewer cells than its suite gives it", k % count));
+    if (at >= trials.size())
+      throw InputError(fmt::format("merge: shard {} has fewer cells than its suite gives it", k % count));
     merged.trials.push_back(trials[at]);
   }
   if (!differ.empty()) merged.context.mixed_machines = true;
-  merged.renders.reset();  // per-shard render summaries do not describe the merged grid
+  merged.renders.reset();                           // per-shard render summaries do not describe the merged grid
   merged.summary = results_summary(merged.trials);  // seeds of one entry and scene may have run in different shards
   return merged;
 }
@@ -700,7 +723,8 @@ class SuiteRun {
       suite_.warmup = 0;
       for (auto& c : suite_.configs) c.spec.threads = 1;
       valgrind_ = find_program("valgrind");
-      if (valgrind_.empty()) throw InputError("--instructions needs valgrind (Debian's valgrind package; scripts/install-deps)");
+      if (valgrind_.empty())
+        throw InputError("--instructions needs valgrind (Debian's valgrind package; scripts/install-deps)");
       self_exe_ = fs::read_symlink("/proc/self/exe").string();
     }
     out_ = o.out_dir.empty() ? fs::path("out/suites") / suite_.name : fs::path(o.out_dir);
@@ -758,8 +782,9 @@ class SuiteRun {
   // The results of an earlier run (--resume) or fresh ones; the context is taken now, before any trial.
   void open_results() {
     if (!o_.resume && fs::exists(journal_path_) && !fs::exists(results_path_))
-      throw InputError(fmt::format("{} holds a journal of an interrupted run: pass --resume to continue it, or another --out",
-                                   journal_path_.string()));
+      throw InputError(
+          fmt::format("{} holds a journal of an interrupted run: pass --resume to continue it, or another --out",
+                      journal_path_.string()));
     if (fs::exists(results_path_)) {
       if (!o_.resume)
         throw InputError(fmt::format("{} already holds results: pass --resume to continue that run, or another --out",
@@ -767,11 +792,12 @@ class SuiteRun {
       try {
         results_ = read_results(results_path_.string());
       } catch (const InputError& e) {
-        throw InputError(fmt::format("{}: cannot resume, the file is not valid results JSON ({})", results_path_.string(), e.what()));
+        throw InputError(fmt::format("{}: cannot resume, the file is not valid results JSON ({})",
+                                     results_path_.string(), e.what()));
       }
       if (results_.suite_hash != suite_.hash)
-        throw InputError(fmt::format("{}: cannot resume, it was written for a different version of {}", results_path_.string(),
-                                     suite_.file));
+        throw InputError(fmt::format("{}: cannot resume, it was written for a different version of {}",
+                                     results_path_.string(), suite_.file));
       if (results_.repetitions != suite_.repetitions)
         throw InputError(fmt::format("{}: cannot resume, it ran {} repetitions per cell and this run asks {}",
                                      results_path_.string(), results_.repetitions, suite_.repetitions));
@@ -841,11 +867,14 @@ class SuiteRun {
     const Job& job = jobs[jn];
     const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
     const double eta = jn > 0 ? el / static_cast<double>(jn) * static_cast<double>(jobs.size() - jn) : 0.0;
-    const std::string what = job.repetition < 0 ? "warm-up" : fmt::format("rep {}/{}", job.repetition + 1, suite_.repetitions);
+    const std::string what =
+        job.repetition < 0 ? "warm-up" : fmt::format("rep {}/{}", job.repetition + 1, suite_.repetitions);
     const std::string line = fmt::format("[{}/{}] {} ({}){}", jn + 1, jobs.size(), job.cell->id, what,
                                          jn > 0 ? fmt::format(", ETA {:.0f} s", eta) : std::string());
-    if (tty) fmt::print(stderr, "\r{:<100}", line.substr(0, 100));
-    else fmt::print(stderr, "{}\n", line);
+    if (tty)
+      fmt::print(stderr, "\r{:<100}", line.substr(0, 100));
+    else
+      fmt::print(stderr, "{}\n", line);
   }
 
   // Runs the cell's trial in its own process: forked by the launcher, or under callgrind as `growbench trial`.
@@ -869,7 +898,8 @@ class SuiteRun {
       write_atomic(dir / "spec.json", json_text(trial_job(c, dir.string()), -1));
       for (const auto& e : fs::directory_iterator(dir))
         if (e.path().filename().string().rfind("callgrind.out", 0) == 0) fs::remove(e.path());
-      std::vector<std::string> args = {valgrind_, "--tool=callgrind", "--callgrind-out-file=" + (dir / "callgrind.out").string(),
+      std::vector<std::string> args = {valgrind_, "--tool=callgrind",
+                                       "--callgrind-out-file=" + (dir / "callgrind.out").string(),
                                        // Ir do not depend on the cache model; it is pinned anyway, so a
                                        // run with --cache-sim=yes would be comparable across hosts.
                                        "--cache-sim=no", "--I1=32768,8,64", "--D1=32768,8,64", "--LL=8388608,16,64",
@@ -912,7 +942,9 @@ class SuiteRun {
       }
     } else {
       message = fs::exists(err_path) ? read_text(err_path.string()) : fmt::format("exit code {}", cr.exit_code);
-      sample.status = cr.exit_code == kExitInvalid ? "invalid_input" : cr.exit_code == kExitOom ? "out_of_memory" : "crashed";
+      sample.status = cr.exit_code == kExitInvalid ? "invalid_input"
+                      : cr.exit_code == kExitOom   ? "out_of_memory"
+                                                   : "crashed";
     }
     if (!message.empty()) sample.message = message;
   }
@@ -925,8 +957,11 @@ class SuiteRun {
     const auto now = std::chrono::steady_clock::now();
     sample.outside_phases_s = std::chrono::duration<double>(now - p.t0).count() - inside;
     if (p.started_ns <= 0) return;
-    const auto secs = [](std::chrono::steady_clock::time_point tp) { return std::chrono::duration<double>(tp.time_since_epoch()).count(); };
-    const double started = 1e-9 * static_cast<double>(p.started_ns), finished = 1e-9 * static_cast<double>(p.finished_ns);
+    const auto secs = [](std::chrono::steady_clock::time_point tp) {
+      return std::chrono::duration<double>(tp.time_since_epoch()).count();
+    };
+    const double started = 1e-9 * static_cast<double>(p.started_ns),
+                 finished = 1e-9 * static_cast<double>(p.finished_ns);
     const double launch = started - secs(p.t0), bookkeeping = finished - started - inside;
     const double parent = p.read_record_s + std::chrono::duration<double>(now - p.t_reaped).count();
     sample.launch_s = launch;
@@ -994,6 +1029,8 @@ class SuiteRun {
 
 }  // namespace
 
-std::string run_suite(const Suite& suite, const SuiteRunOptions& options) { return SuiteRun(suite, options).run(); }
+std::string run_suite(const Suite& suite, const SuiteRunOptions& options) {
+  return SuiteRun(suite, options).run();
+}
 
 }  // namespace growbench

@@ -17,9 +17,9 @@
 
 namespace growbench {
 
-struct SuiteConfig {  // one cell of the matrix (run `repetitions` times)
-  std::string id;     // label/scene/seed/sweep, unique in the suite; also the trial's folder name
-  std::string label;  // the algorithm entry's label (the algorithm's name unless the suite gives one)
+struct SuiteConfig {       // one cell of the matrix (run `repetitions` times)
+  std::string id;          // label/scene/seed/sweep, unique in the suite; also the trial's folder name
+  std::string label;       // the algorithm entry's label (the algorithm's name unless the suite gives one)
   std::string scene_name;  // the scene's display name (its own name unless the suite gives one)
   nlohmann::json sweep = nlohmann::json::object();  // the swept parameters' values for this cell
   TrialSpec spec;
@@ -33,7 +33,6 @@ struct Suite {
   std::uint64_t memory_limit_bytes = 16ull << 30;
   std::vector<SuiteConfig> configs;  // in run order: interleaved across algorithm entries
 };
-
 
 // Reads and validates a suite file: every algorithm, scene and parameter (and every swept value) is
 // checked before anything runs; an error names the file and the JSON path.

@@ -17,7 +17,8 @@ inline Plant grow(const std::string& algorithm, const Scene& scene, const SceneQ
                   std::vector<std::pair<std::string, double>>* stats = nullptr) {
   std::unique_ptr<tbb::global_control> gc;
   if (threads > 0)
-    gc = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+    gc = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                               static_cast<std::size_t>(threads));
   const AlgorithmEntry& e = find_algorithm(algorithm);
   Params p = default_params(e);
   for (const auto& s : sets) p.set_assignment(s);

@@ -12,7 +12,9 @@
 namespace growbench {
 namespace {
 
-test::CommandResult growbench(const std::string& args) { return test::run_growbench(args); }
+test::CommandResult growbench(const std::string& args) {
+  return test::run_growbench(args);
+}
 
 TEST(Cli, HelpAndLists) {
   auto r = growbench("--help");
@@ -41,7 +43,8 @@ TEST(Cli, ListOneAlgorithmAsTextOrMarkdown) {
   EXPECT_EQ(r.out.find("lsystem"), std::string::npos) << r.out;
   r = growbench("list --markdown ivy");
   EXPECT_EQ(r.status, 0);
-  EXPECT_EQ(r.out.rfind("| name | type | default | allowed | unit | doc |\n|---|---|---|---|---|---|\n", 0), 0u) << r.out;
+  EXPECT_EQ(r.out.rfind("| name | type | default | allowed | unit | doc |\n|---|---|---|---|---|---|\n", 0), 0u)
+      << r.out;
   EXPECT_NE(r.out.find("| `preset` | choice | `luft` | `luft`, `blender` |"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("- `blender`: `units=absolute`"), std::string::npos) << r.out;
   // A pipe in a doc would end its cell.
@@ -118,8 +121,9 @@ TEST(Cli, CustomLeafObjForHadrich) {
   // The same climbing plant with the default leaf and with a three-triangle leaf from an OBJ: the plant
   // is the same; each leaf adds one triangle to the mesh. A bad leaf file is invalid input (exit 2).
   const auto dir = test::temp_dir("cli_leaf");
-  const std::string leaf = test::write_text(dir / "leaf.obj", "v 0 0 0\nv 0.3 0 0.5\nv 0 0 1\nv -0.3 0 0.5\nv 0 0.1 0.5\n"
-                                                                 "f 1 2 3\nf 1 3 4\nf 1 5 3\n");
+  const std::string leaf = test::write_text(dir / "leaf.obj",
+                                            "v 0 0 0\nv 0.3 0 0.5\nv 0 0 1\nv -0.3 0 0.5\nv 0 0.1 0.5\n"
+                                            "f 1 2 3\nf 1 3 4\nf 1 5 3\n");
   const std::string common = "run -q -a hadrich -s wall --set max_particles=400 --max-steps 300 -j 1 -o ";
   auto r = growbench(common + (dir / "plain").string());
   ASSERT_EQ(r.status, 0) << r.out;
@@ -142,7 +146,9 @@ TEST(Cli, CustomLeafObjForHadrich) {
 
 TEST(Cli, SeedAtSnapsToTheSurface) {
   const auto dir = test::temp_dir("cli_seedat");
-  const auto r = growbench("run -q -a spacecol -s mesh:suzanne --seed-at 0,5,0 --set surface=cling --set point_count=2000 -o " + dir.string());
+  const auto r =
+      growbench("run -q -a spacecol -s mesh:suzanne --seed-at 0,5,0 --set surface=cling --set point_count=2000 -o " +
+                dir.string());
   ASSERT_EQ(r.status, 0) << r.out;
   std::ifstream in(dir / "skeleton.obj");
   std::string line;

@@ -40,9 +40,10 @@ TEST(Compare, IdenticalResultsPass) {
 
 TEST(Compare, AnyBehaviourChangeFails) {
   const json a = results({cell("a/wall/s1")});
-  for (const auto& [path, value] : std::vector<std::pair<std::string, json>>{
-           {"/geometry_hash", "fedcba9876543210"}, {"/counts/nodes", 101}, {"/metrics/coverage", 0.2500001},
-           {"/status", "timeout"}}) {
+  for (const auto& [path, value] : std::vector<std::pair<std::string, json>>{{"/geometry_hash", "fedcba9876543210"},
+                                                                             {"/counts/nodes", 101},
+                                                                             {"/metrics/coverage", 0.2500001},
+                                                                             {"/status", "timeout"}}) {
     json b = a;
     b["trials"][0][json::json_pointer(path)] = value;
     const auto r = compare_results(a, b);
@@ -60,7 +61,8 @@ TEST(Compare, TimingsAreJudgedAndReportedButNeverFail) {
     c["samples"] = json::array();
     for (int r = 0; r < 10; ++r) {
       const double t = centre * (1.0 + 0.01 * ((r * 7) % 10 - 4.5) / 4.5);
-      c["samples"].push_back({{"repetition", r}, {"status", "ok"}, {"phases", {{"growth", {{"wall_s", t}, {"cpu_s", t}}}}}});
+      c["samples"].push_back(
+          {{"repetition", r}, {"status", "ok"}, {"phases", {{"growth", {{"wall_s", t}, {"cpu_s", t}}}}}});
     }
     return c;
   };
@@ -156,7 +158,6 @@ TEST(Compare, BaselineKeepsWhatTheGateComparesAndDropsTimings) {
   EXPECT_TRUE(compare_results(base, a).changes.empty());
 }
 
-
 // The gate end to end, under the real callgrind: an unchanged rerun passes; a planted slowdown of about
 // 5% in one algorithm's growth phase (the test-only fault slow:N, which leaves the plant alone) fails.
 TEST(RegressionGate, CatchesAPlantedFivePercentSlowdownAndNotAnUnchangedRerun) {
@@ -164,12 +165,13 @@ TEST(RegressionGate, CatchesAPlantedFivePercentSlowdownAndNotAnUnchangedRerun) {
   auto suite = [&](const std::string& name, const std::string& fault) {
     nlohmann::json entry = {{"name", "spacecol"}, {"label", "spacecol"}, {"params", {{"point_count", 400}}}};
     if (!fault.empty()) entry["fault"] = fault;
-    const nlohmann::json s = {{"schema_version", 1}, {"name", name},      {"seeds", {1}},
-                              {"scenes", {"wall"}},  {"algorithms", {entry}}};
+    const nlohmann::json s = {
+        {"schema_version", 1}, {"name", name}, {"seeds", {1}}, {"scenes", {"wall"}}, {"algorithms", {entry}}};
     return test::write_text(dir / (name + ".json"), s.dump());
   };
   auto run = [&](const std::string& name, const std::string& fault) {
-    const auto r = test::run_growbench("suite -q --instructions " + suite(name, fault) + " --out " + (dir / name).string());
+    const auto r =
+        test::run_growbench("suite -q --instructions " + suite(name, fault) + " --out " + (dir / name).string());
     EXPECT_EQ(r.status, 0) << r.out;
     return (dir / name / "results.json").string();
   };

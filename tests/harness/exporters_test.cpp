@@ -18,7 +18,9 @@ namespace {
 
 Plant y_plant() {
   Plant p;
-  p.nodes = {{{0, 0, 0}, 0.05f, kNoParent, 0, 0, 0}, {{0, 1, 0}, 0.04f, 0, 0, 0, 1}, {{0, 2, 0}, 0.02f, 1, 0, 0, 2},
+  p.nodes = {{{0, 0, 0}, 0.05f, kNoParent, 0, 0, 0},
+             {{0, 1, 0}, 0.04f, 0, 0, 0, 1},
+             {{0, 2, 0}, 0.02f, 1, 0, 0, 2},
              {{1, 2, 0}, 0.02f, 1, 1, 1, 2}};
   p.organs = {{{0, 2, 0}, {1, 0, 0, 0}, 0.1f, OrganKind::Leaf, 2}, {{1, 2, 0}, {1, 0, 0, 0}, 0.1f, OrganKind::Leaf, 3}};
   return p;
@@ -89,10 +91,12 @@ TEST(Mesher, CustomLeafFromObj) {
 TEST(Exporters, LargeObjIsTheSerialTextOnAnyThreadCount) {
   OutputMesh m;
   for (std::uint32_t i = 0; i < 20000; ++i) {
-    m.positions.emplace_back(0.001f * static_cast<float>(i), std::sin(static_cast<float>(i)), -1e-7f * static_cast<float>(i));
+    m.positions.emplace_back(0.001f * static_cast<float>(i), std::sin(static_cast<float>(i)),
+                             -1e-7f * static_cast<float>(i));
     m.normals.push_back(glm::normalize(glm::vec3(1.0f, std::cos(static_cast<float>(i)), 0.5f)));
   }
-  for (std::uint32_t t = 0; t < 30001; ++t) m.triangles.emplace_back(t % 20000, (7 * t + 1) % 20000, (13 * t + 2) % 20000);
+  for (std::uint32_t t = 0; t < 30001; ++t)
+    m.triangles.emplace_back(t % 20000, (7 * t + 1) % 20000, (13 * t + 2) % 20000);
   m.groups = {{"branches", "bark", 0, 17000}, {"leaves", "leaf", 17000, 13001}};
   std::string expected = "# growbench plant: 20000 vertices, 30001 triangles\nmtllib plant.mtl\n";
   for (const auto& v : m.positions) expected += fmt::format("v {:.6g} {:.6g} {:.6g}\n", v.x, v.y, v.z);
@@ -171,7 +175,8 @@ TEST(Exporters, GlbReadsBackWithTinyGltf) {
   const auto& pos = model.accessors[static_cast<std::size_t>(model.meshes[0].primitives[0].attributes.at("POSITION"))];
   EXPECT_EQ(pos.count, m.positions.size());
   std::size_t indices = 0;
-  for (const auto& p : model.meshes[0].primitives) indices += model.accessors[static_cast<std::size_t>(p.indices)].count;
+  for (const auto& p : model.meshes[0].primitives)
+    indices += model.accessors[static_cast<std::size_t>(p.indices)].count;
   EXPECT_EQ(indices, 3 * m.triangles.size());
   EXPECT_EQ(model.materials[0].name, "bark");
   // The first vertex survives the round trip bit for bit.

@@ -52,10 +52,11 @@ double point_triangle(const dvec3& p, const dvec3& a, const dvec3& b, const dvec
 
 // The minimum over the unit square of |p(s) - q(t)|: the interior stationary point, or an edge of it.
 double segment_segment(const dvec3& p0, const dvec3& p1, const dvec3& q0, const dvec3& q1) {
-  double best = std::min({point_segment(p0, q0, q1), point_segment(p1, q0, q1), point_segment(q0, p0, p1),
-                          point_segment(q1, p0, p1)});
+  double best = std::min(
+      {point_segment(p0, q0, q1), point_segment(p1, q0, q1), point_segment(q0, p0, p1), point_segment(q1, p0, p1)});
   const dvec3 d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
-  const double a = glm::dot(d1, d1), e = glm::dot(d2, d2), b = glm::dot(d1, d2), c = glm::dot(d1, r), f = glm::dot(d2, r);
+  const double a = glm::dot(d1, d1), e = glm::dot(d2, d2), b = glm::dot(d1, d2), c = glm::dot(d1, r),
+               f = glm::dot(d2, r);
   const double den = a * e - b * b;
   if (den > 1e-18 * a * e) {
     const double s = (b * f - c * e) / den, t = (a * f - b * c) / den;
@@ -80,7 +81,8 @@ double winding(const TriangleMesh& m, const dvec3& p) {
 
 double distance_to_mesh(const TriangleMesh& m, const dvec3& p) {
   double best = std::numeric_limits<double>::infinity();
-  for (const auto& t : m.triangles) best = std::min(best, point_triangle(p, m.vertices[t.x], m.vertices[t.y], m.vertices[t.z]));
+  for (const auto& t : m.triangles)
+    best = std::min(best, point_triangle(p, m.vertices[t.x], m.vertices[t.y], m.vertices[t.z]));
   return best;
 }
 
@@ -105,7 +107,8 @@ bool pierces(const dvec3& p, const dvec3& q, const dvec3 (&t)[3], double margin)
   const double scale = glm::length(d) * glm::length(e1) * glm::length(e2);
   if (std::abs(det) <= 1e-9 * scale) return false;  // parallel: the coplanar test decides
   const dvec3 s = p - t[0];
-  const double u = glm::dot(s, h) / det, v = glm::dot(d, glm::cross(s, e1)) / det, w = glm::dot(e2, glm::cross(s, e1)) / det;
+  const double u = glm::dot(s, h) / det, v = glm::dot(d, glm::cross(s, e1)) / det,
+               w = glm::dot(e2, glm::cross(s, e1)) / det;
   return u > margin && v > margin && u + v < 1.0 - margin && w > margin && w < 1.0 - margin;
 }
 
@@ -128,14 +131,17 @@ double shared_area_2d(std::array<glm::dvec2, 3> a, std::array<glm::dvec2, 3> b) 
         continue;
       }
       const double r = f0 / (f0 - f1);  // where the value crosses zero
-      if (f1 > f0) t0 = std::max(t0, r);
-      else t1 = std::min(t1, r);
+      if (f1 > f0)
+        t0 = std::max(t0, r);
+      else
+        t1 = std::min(t1, r);
     }
     if (!(t1 > t0)) return 0.0;
     return 0.5 * cross2(p + t0 * (q - p), p + t1 * (q - p));
   };
   double area = 0.0;
-  for (int i = 0; i < 3; ++i) area += inside_part(a[i], a[(i + 1) % 3], b, false) + inside_part(b[i], b[(i + 1) % 3], a, true);
+  for (int i = 0; i < 3; ++i)
+    area += inside_part(a[i], a[(i + 1) % 3], b, false) + inside_part(b[i], b[(i + 1) % 3], a, true);
   return area;
 }
 
@@ -160,7 +166,9 @@ int reference_overlap(const dvec3 (&a)[3], const dvec3 (&b)[3]) {
   }
   const dvec3 an = glm::abs(n);
   const int drop = an.x >= an.y && an.x >= an.z ? 0 : (an.y >= an.z ? 1 : 2);
-  auto flat = [&](const dvec3& v) { return drop == 0 ? glm::dvec2(v.y, v.z) : drop == 1 ? glm::dvec2(v.x, v.z) : glm::dvec2(v.x, v.y); };
+  auto flat = [&](const dvec3& v) {
+    return drop == 0 ? glm::dvec2(v.y, v.z) : drop == 1 ? glm::dvec2(v.x, v.z) : glm::dvec2(v.x, v.y);
+  };
   const double area = shared_area_2d({flat(a[0]), flat(a[1]), flat(a[2])}, {flat(b[0]), flat(b[1]), flat(b[2])});
   const double threshold = tolerance * size;
   if (std::abs(area - threshold) < 0.1 * threshold) return 2;
@@ -184,7 +192,8 @@ std::vector<std::size_t> sample(std::size_t size, std::size_t n, std::uint64_t s
     return v;
   }
   Rng rng(99, stream);
-  for (std::size_t i = 0; i < n; ++i) v.push_back(static_cast<std::size_t>(rng.uniform() * static_cast<double>(size)) % size);
+  for (std::size_t i = 0; i < n; ++i)
+    v.push_back(static_cast<std::size_t>(rng.uniform() * static_cast<double>(size)) % size);
   std::sort(v.begin(), v.end());
   v.erase(std::unique(v.begin(), v.end()), v.end());
   return v;
@@ -212,7 +221,8 @@ struct Reference {
   std::size_t parent_of(std::size_t k) const { return static_cast<std::size_t>(plant.nodes[d.segments[k]].parent); }
   void leaf_triangle(const Organ& org, const glm::uvec3& t, dvec3 (&v)[3]) const {
     const glm::dmat3 r = glm::dmat3(glm::mat3_cast(org.orientation));
-    for (int c = 0; c < 3; ++c) v[c] = dvec3(org.position) + r * (dvec3(shape.vertices[t[c]]) * static_cast<double>(org.size));
+    for (int c = 0; c < 3; ++c)
+      v[c] = dvec3(org.position) + r * (dvec3(shape.vertices[t[c]]) * static_cast<double>(org.size));
   }
 
   void means() {
@@ -227,7 +237,8 @@ struct Reference {
     EXPECT_DOUBLE_EQ(m["leaf_overlap"].get<double>(), mean(d.leaf_overlaps));
     EXPECT_DOUBLE_EQ(m["leaf_light_exposure"].get<double>(), mean(d.leaf_lit));
     EXPECT_DOUBLE_EQ(m["leaf_light_exposure_scene"].get<double>(), mean(d.leaf_lit_scene));
-    for (std::size_t i = 0; i < d.leaf_lit.size(); ++i) EXPECT_LE(d.leaf_lit[i], d.leaf_lit_scene[i]) << "the plant only adds shade";
+    for (std::size_t i = 0; i < d.leaf_lit.size(); ++i)
+      EXPECT_LE(d.leaf_lit[i], d.leaf_lit_scene[i]) << "the plant only adds shade";
   }
 
   void coverage() {
@@ -236,7 +247,8 @@ struct Reference {
     for (const auto i : sample(d.covered.size(), 400, 1)) {
       const dvec3 p(q.sample_surface(o.coverage_seed, i).position);
       double best = std::numeric_limits<double>::infinity();
-      for (std::size_t k = 0; k < d.segments.size(); ++k) best = std::min(best, point_segment(p, pos(parent_of(k)), pos(d.segments[k])));
+      for (std::size_t k = 0; k < d.segments.size(); ++k)
+        best = std::min(best, point_segment(p, pos(parent_of(k)), pos(d.segments[k])));
       if (std::abs(best - D) < 1e-6) {
         ++borderline;
         continue;
@@ -282,8 +294,8 @@ struct Reference {
         continue;
       }
       ++checked;
-      EXPECT_EQ(d.node_inside[i] == 1, ref) << "node " << i << " at " << nodes[i].position.x << "," << nodes[i].position.y
-                                            << "," << nodes[i].position.z;
+      EXPECT_EQ(d.node_inside[i] == 1, ref)
+          << "node " << i << " at " << nodes[i].position.x << "," << nodes[i].position.y << "," << nodes[i].position.z;
     }
     const auto ss = static_cast<std::size_t>(o.segment_samples);
     for (const auto s : sample(d.sample_inside.size(), 150, 4)) {
@@ -318,10 +330,13 @@ struct Reference {
       for (std::size_t l = 0; l < d.segments.size() && !crossed; ++l) {
         const auto nl = static_cast<std::int32_t>(d.segments[l]);
         if (l == k || neighbours(nk, nl)) continue;
-        const double dist = segment_segment(pos(parent_of(k)), pos(d.segments[k]), pos(parent_of(l)), pos(d.segments[l]));
+        const double dist =
+            segment_segment(pos(parent_of(k)), pos(d.segments[k]), pos(parent_of(l)), pos(d.segments[l]));
         const double r = static_cast<double>(nodes[d.segments[k]].radius) + nodes[d.segments[l]].radius;
-        if (std::abs(dist - r) < 1e-6) close_call = true;
-        else if (dist < r) crossed = true;
+        if (std::abs(dist - r) < 1e-6)
+          close_call = true;
+        else if (dist < r)
+          crossed = true;
       }
       if (close_call && !crossed) {
         ++borderline;
@@ -382,9 +397,12 @@ struct Reference {
         const float ra = std::max(nodes[parent_of(k)].radius, 1e-4f), rb = std::max(nodes[d.segments[k]].radius, 1e-4f);
         const double dist = segment_segment(from, from + far * dir, pos(parent_of(k)), pos(d.segments[k]));
         const double start = point_segment(from, pos(parent_of(k)), pos(d.segments[k]));
-        if (start <= std::max(ra, rb) + 1e-6) close_call = true;  // leaves from inside or at a tube
-        else if (dist < std::min(ra, rb) - 1e-6) plant_hit = true;
-        else if (dist <= std::max(ra, rb) + 1e-6) close_call = true;
+        if (start <= std::max(ra, rb) + 1e-6)
+          close_call = true;  // leaves from inside or at a tube
+        else if (dist < std::min(ra, rb) - 1e-6)
+          plant_hit = true;
+        else if (dist <= std::max(ra, rb) + 1e-6)
+          close_call = true;
       }
       for (std::size_t j = 0; j < plant.organs.size() && !plant_hit; ++j) {
         if (j == d.leaves[i]) continue;
@@ -409,7 +427,6 @@ struct Reference {
       }
     }
   }
-
 };
 
 TEST_P(MetricsReference, EveryVerdictMatchesBruteForce) {
@@ -452,7 +469,8 @@ std::vector<Case> cases() {
 
 std::string case_name(const ::testing::TestParamInfo<Case>& info) {
   std::string s = std::get<1>(info.param);
-  std::replace_if(s.begin(), s.end(), [](char c) { return !std::isalnum(static_cast<unsigned char>(c)); }, '_');
+  std::replace_if(
+      s.begin(), s.end(), [](char c) { return !std::isalnum(static_cast<unsigned char>(c)); }, '_');
   return std::get<0>(info.param) + "_" + s;
 }
 
@@ -514,8 +532,11 @@ std::vector<SuiteCase> suite_cases() {
 INSTANTIATE_TEST_SUITE_P(StandardSuite, MetricsResolution, ::testing::ValuesIn(suite_cases()),
                          [](const ::testing::TestParamInfo<SuiteCase>& info) {
                            const auto entry = standard_suite()["algorithms"].at(std::get<0>(info.param));
-                           std::string s = entry.value("label", entry["name"].get<std::string>()) + "_" + std::get<1>(info.param);
-                           std::replace_if(s.begin(), s.end(), [](char c) { return !std::isalnum(static_cast<unsigned char>(c)); }, '_');
+                           std::string s =
+                               entry.value("label", entry["name"].get<std::string>()) + "_" + std::get<1>(info.param);
+                           std::replace_if(
+                               s.begin(), s.end(), [](char c) { return !std::isalnum(static_cast<unsigned char>(c)); },
+                               '_');
                            return s;
                          });
 

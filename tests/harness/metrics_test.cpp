@@ -32,9 +32,10 @@ Plant chain(std::vector<glm::vec3> pts, float radius = 0.01f) {
 }
 
 TEST(Metrics, SegmentDistance) {
-  EXPECT_NEAR(segment_distance({0, 0, 0}, {1, 0, 0}, {0.5f, 1, -1}, {0.5f, 1, 1}), 1.0f, 1e-6f);  // skew, crossing above
-  EXPECT_NEAR(segment_distance({0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0}), 1.0f, 1e-6f);         // collinear gap
-  EXPECT_NEAR(segment_distance({0, 0, 0}, {1, 0, 0}, {0, 0.5f, 0}, {1, 0.5f, 0}), 0.5f, 1e-6f);   // parallel
+  EXPECT_NEAR(segment_distance({0, 0, 0}, {1, 0, 0}, {0.5f, 1, -1}, {0.5f, 1, 1}), 1.0f,
+              1e-6f);                                                                            // skew, crossing above
+  EXPECT_NEAR(segment_distance({0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0}), 1.0f, 1e-6f);        // collinear gap
+  EXPECT_NEAR(segment_distance({0, 0, 0}, {1, 0, 0}, {0, 0.5f, 0}, {1, 0.5f, 0}), 0.5f, 1e-6f);  // parallel
   EXPECT_NEAR(segment_distance({0, 0, 0}, {0, 0, 0}, {1, 1, 0}, {1, 1, 0}), std::sqrt(2.0f), 1e-6f);
 }
 
@@ -95,7 +96,9 @@ TEST(Metrics, SelfIntersectionOfCrossingBranches) {
   m = compute_metrics(p, q);
   EXPECT_EQ(m["self_intersections"], 0);
   // A straight chain never intersects itself (neighbours are excluded even at a thick radius).
-  EXPECT_EQ(compute_metrics(chain({{0, 0, 0}, {0, 0.01f, 0}, {0, 0.02f, 0}, {0, 0.03f, 0}}, 0.5f), q)["self_intersections"], 0);
+  EXPECT_EQ(
+      compute_metrics(chain({{0, 0, 0}, {0, 0.01f, 0}, {0, 0.02f, 0}, {0, 0.03f, 0}}, 0.5f), q)["self_intersections"],
+      0);
 }
 
 // A tangle with thin and thick segments of mixed lengths, and leaves of mixed sizes: the kd-tree searches
@@ -113,13 +116,15 @@ TEST(Metrics, SelfIntersectionAndLeafOverlapMatchAllPairs) {
     const glm::vec3 dir = glm::normalize(glm::vec3(u(rng) - 0.5f, u(rng) - 0.5f, u(rng) - 0.5f) + glm::vec3(1e-3f));
     const float len = u(rng) < 0.1f ? 0.25f : 0.02f + 0.05f * u(rng);
     const float r = u(rng) < 0.05f ? 0.06f : 0.001f + 0.004f * u(rng);
-    glm::vec3 pos = glm::clamp(p.nodes[static_cast<std::size_t>(parent)].position + len * dir, glm::vec3(0.0f), glm::vec3(1.0f));
+    glm::vec3 pos =
+        glm::clamp(p.nodes[static_cast<std::size_t>(parent)].position + len * dir, glm::vec3(0.0f), glm::vec3(1.0f));
     p.nodes.push_back({pos, r, parent, 0, 0, 0});
   }
   for (int i = 0; i < 400; ++i) {
     const glm::vec3 axis = glm::normalize(glm::vec3(u(rng) - 0.5f, u(rng) - 0.5f, u(rng) - 0.5f) + glm::vec3(1e-3f));
     const glm::quat turn = glm::angleAxis(6.2831853f * u(rng), axis);
-    p.organs.push_back({{u(rng), u(rng), u(rng)}, turn, u(rng) < 0.1f ? 0.3f : 0.05f + 0.1f * u(rng), OrganKind::Leaf, 0});
+    p.organs.push_back(
+        {{u(rng), u(rng), u(rng)}, turn, u(rng) < 0.1f ? 0.3f : 0.05f + 0.1f * u(rng), OrganKind::Leaf, 0});
   }
 
   const auto& n = p.nodes;
@@ -171,8 +176,10 @@ TEST(Metrics, SelfIntersectionAndLeafOverlapMatchAllPairs) {
   const auto m = compute_metrics(p, q);
   EXPECT_EQ(m["self_intersections"], pairs);
   EXPECT_NEAR(m["self_intersection_fraction"].get<double>(),
-              static_cast<double>(std::count(involved.begin(), involved.end(), 1)) / static_cast<double>(n.size() - 1), 1e-12);
-  EXPECT_NEAR(m["leaf_overlap"].get<double>(), static_cast<double>(overlapping) / static_cast<double>(p.organs.size()), 1e-12);
+              static_cast<double>(std::count(involved.begin(), involved.end(), 1)) / static_cast<double>(n.size() - 1),
+              1e-12);
+  EXPECT_NEAR(m["leaf_overlap"].get<double>(), static_cast<double>(overlapping) / static_cast<double>(p.organs.size()),
+              1e-12);
 }
 
 TEST(Metrics, LeafOverlapAndLightExposure) {
@@ -181,8 +188,8 @@ TEST(Metrics, LeafOverlapAndLightExposure) {
   Plant p = chain({{0, 0.5f, 0.3f}, {0, 1, 0.3f}});
   const glm::quat up(1, 0, 0, 0);
   p.organs = {{{0, 1, 0.3f}, up, 0.1f, OrganKind::Leaf, 1},
-              {{0, 1, 0.32f}, up, 0.1f, OrganKind::Leaf, 1},     // overlaps the first
-              {{0, 1, -0.4f}, up, 0.1f, OrganKind::Leaf, 1}};    // behind the wall: shaded, alone
+              {{0, 1, 0.32f}, up, 0.1f, OrganKind::Leaf, 1},   // overlaps the first
+              {{0, 1, -0.4f}, up, 0.1f, OrganKind::Leaf, 1}};  // behind the wall: shaded, alone
   const auto m = compute_metrics(p, q);
   EXPECT_NEAR(m["leaf_overlap"].get<double>(), 2.0 / 3.0, 1e-9);
   EXPECT_NEAR(m["leaf_light_exposure"].get<double>(), 2.0 / 3.0, 1e-9);

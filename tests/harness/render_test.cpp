@@ -126,10 +126,13 @@ TEST(PlantSnapshot, BadFilesAreClearErrors) {
   write_plant_snapshot(path, tiny_plant());
   std::string data = read_file(path);
   test::write_text(dir / "cut.gbplant", data.substr(0, data.size() / 2));
-  EXPECT_NE(test::error_of([&] { read_plant_snapshot((dir / "cut.gbplant").string()); }).find("cut.gbplant: plant snapshot"),
-            std::string::npos);
+  EXPECT_NE(
+      test::error_of([&] { read_plant_snapshot((dir / "cut.gbplant").string()); }).find("cut.gbplant: plant snapshot"),
+      std::string::npos);
   test::write_text(dir / "obj.gbplant", "v 0 0 0\n");
-  EXPECT_NE(test::error_of([&] { read_plant_snapshot((dir / "obj.gbplant").string()); }).find("not a growbench plant snapshot"),
+  EXPECT_NE(test::error_of([&] {
+              read_plant_snapshot((dir / "obj.gbplant").string());
+            }).find("not a growbench plant snapshot"),
             std::string::npos);
   // A parent index past the node itself: the forest's invariant, checked on reading.
   std::string bad = data;
@@ -149,9 +152,9 @@ TEST(PovWriter, WritesEveryPartInPovRayHandedness) {
   EXPECT_EQ(bytes, pov.size());
   EXPECT_NE(pov.find("#version 3.7;"), std::string::npos);
   EXPECT_NE(pov.find("assumed_gamma 1.0"), std::string::npos);
-  EXPECT_EQ(count_of(pov, "\n  cone {"), p.nodes.size() - 1);  // one per segment
-  EXPECT_EQ(count_of(pov, "\n  sphere {"), p.nodes.size());  // every joint and tip, and the root (it has children)
-  EXPECT_EQ(count_of(pov, "#declare GB_OrganShape"), 1u);        // one declared leaf mesh ...
+  EXPECT_EQ(count_of(pov, "\n  cone {"), p.nodes.size() - 1);     // one per segment
+  EXPECT_EQ(count_of(pov, "\n  sphere {"), p.nodes.size());       // every joint and tip, and the root (it has children)
+  EXPECT_EQ(count_of(pov, "#declare GB_OrganShape"), 1u);         // one declared leaf mesh ...
   EXPECT_EQ(count_of(pov, "object { GB_OrganShape matrix"), 5u);  // ... instanced per organ
   EXPECT_NE(pov.find("texture { GB_Flower }"), std::string::npos);
   // Right-handed to left-handed: z negated. The root at (0, 0.1, 0.2) and the camera at z = 4.
@@ -164,8 +167,9 @@ TEST(PovWriter, WritesEveryPartInPovRayHandedness) {
   EXPECT_EQ(count_of(mesh, "cone {"), 0u);
   EXPECT_EQ(count_of(mesh, "mesh2 {"), count_of(pov, "mesh2 {") + 1);
   o.branches = "tubes";
-  EXPECT_NE(test::error_of([&] { write_pov((dir / "x.pov").string(), tiny_scene(), p, o); }).find("expected cones or mesh"),
-            std::string::npos);
+  EXPECT_NE(
+      test::error_of([&] { write_pov((dir / "x.pov").string(), tiny_scene(), p, o); }).find("expected cones or mesh"),
+      std::string::npos);
 }
 
 TEST(PovRender, TinySceneRendersWithThePlantInFrameAndNoWarnings) {
@@ -174,7 +178,8 @@ TEST(PovRender, TinySceneRendersWithThePlantInFrameAndNoWarnings) {
   RenderOptions o;
   o.width = 160;
   o.height = 120;
-  const RenderResult with = render_plant(tiny_scene(), tiny_plant(), (dir / "with.pov").string(), (dir / "with.png").string(), o);
+  const RenderResult with =
+      render_plant(tiny_scene(), tiny_plant(), (dir / "with.pov").string(), (dir / "with.png").string(), o);
   ASSERT_TRUE(with.ok()) << with.message;
   EXPECT_TRUE(with.warnings.empty()) << with.warnings.front();
   EXPECT_GT(with.wall_s, 0.0);
@@ -228,7 +233,8 @@ TEST(RenderGrid, LabelsCellsAndMarksMissingOnes) {
   RenderOptions o;
   o.width = 80;
   o.height = 60;
-  const RenderResult r = render_plant(tiny_scene(), tiny_plant(), (dir / "a.pov").string(), (dir / "a.png").string(), o);
+  const RenderResult r =
+      render_plant(tiny_scene(), tiny_plant(), (dir / "a.pov").string(), (dir / "a.png").string(), o);
   ASSERT_TRUE(r.ok()) << r.message;
   write_grid((dir / "grid.png").string(), "title", {"alpha", "beta"}, {"s1", "s2", "s3"},
              {{r.png, r.png, ""}, {r.png, "", (dir / "missing.png").string()}}, {{"", "", "timeout"}}, 100);
@@ -240,8 +246,10 @@ TEST(RenderGrid, LabelsCellsAndMarksMissingOnes) {
 
 TEST(RenderCli, RunRendersThePlantAndItsGrowthFrames) {
   const auto dir = test::temp_dir("cli_render");
-  const auto r = test::run_growbench("run -q -a spacecol -s wall --set point_count=800 --max-steps 30 --frames 10 "
-                                     "--render preview -o " + dir.string());
+  const auto r = test::run_growbench(
+      "run -q -a spacecol -s wall --set point_count=800 --max-steps 30 --frames 10 "
+      "--render preview -o " +
+      dir.string());
   ASSERT_EQ(r.status, 0) << r.out;
   std::ifstream in(dir / "record.json");
   const auto rec = nlohmann::json::parse(in);

@@ -22,7 +22,9 @@ namespace {
 
 using nlohmann::json;
 
-test::CommandResult growbench(const std::string& args) { return test::run_growbench(args); }
+test::CommandResult growbench(const std::string& args) {
+  return test::run_growbench(args);
+}
 
 json read_json(const std::filesystem::path& p) {
   std::ifstream in(p);
@@ -30,8 +32,8 @@ json read_json(const std::filesystem::path& p) {
 }
 
 std::string suite_file(const std::filesystem::path& dir, const json& extra) {
-  json s = {{"schema_version", 1}, {"name", "t"}, {"repetitions", 1}, {"warmup", 0}, {"threads", 2},
-            {"scenes", {"column"}}};
+  json s = {{"schema_version", 1}, {"name", "t"},  {"repetitions", 1},
+            {"warmup", 0},         {"threads", 2}, {"scenes", {"column"}}};
   s.update(extra);
   return test::write_text(dir / "suite.json", s.dump(2));
 }
@@ -44,14 +46,16 @@ TEST(Suite, ValidationNamesFileAndPathBeforeAnythingRuns) {
     json algorithms;
     const char* expect;
   } cases[] = {
-      {json::array({{{"name", "spacecl"}}}), "at /algorithms/0/name: unknown algorithm 'spacecl' (did you mean 'spacecol'?)"},
+      {json::array({{{"name", "spacecl"}}}),
+       "at /algorithms/0/name: unknown algorithm 'spacecl' (did you mean 'spacecol'?)"},
       {json::array({{{"name", "spacecol"}, {"params", {{"point_cont", 5}}}}}),
        "at /algorithms/0/params/point_cont: unknown parameter 'point_cont'"},
       {json::array({{{"name", "spacecol"}, {"sweep", {{"step", {0.01, -1}}}}}}), "at /algorithms/0/sweep/step/1:"},
       {json::array({{{"name", "spacecol"}, {"parms", json::object()}}}), "did you mean 'params'"},
   };
   for (const auto& c : cases) {
-    const auto r = growbench("suite -q -o " + (dir / "out").string() + " " + suite_file(dir, {{"algorithms", c.algorithms}}));
+    const auto r =
+        growbench("suite -q -o " + (dir / "out").string() + " " + suite_file(dir, {{"algorithms", c.algorithms}}));
     EXPECT_EQ(r.status, 2) << r.out;
     EXPECT_NE(r.out.find(c.expect), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("suite.json"), std::string::npos) << r.out;
@@ -63,10 +67,15 @@ TEST(Suite, ValidationNamesFileAndPathBeforeAnythingRuns) {
 
 TEST(Suite, SweepsMakeOneCellPerPoint) {
   const auto dir = test::temp_dir("suite_sweep");
-  const json algos = json::array({{{"name", "spacecol"}, {"label", "grid"}, {"params", kSmall},
-                                   {"sweep", {{"step", {0.02, 0.04}}, {"kill", {0.05, 0.08}}}}},
-                                  {{"name", "spacecol"}, {"label", "list"}, {"params", kSmall},
-                                   {"sweep", json::array({{{"step", 0.02}, {"kill", 0.05}}, {{"step", 0.04}, {"kill", 0.1}}})}}});
+  const json algos =
+      json::array({{{"name", "spacecol"},
+                    {"label", "grid"},
+                    {"params", kSmall},
+                    {"sweep", {{"step", {0.02, 0.04}}, {"kill", {0.05, 0.08}}}}},
+                   {{"name", "spacecol"},
+                    {"label", "list"},
+                    {"params", kSmall},
+                    {"sweep", json::array({{{"step", 0.02}, {"kill", 0.05}}, {{"step", 0.04}, {"kill", 0.1}}})}}});
   const auto r = growbench("suite -q -o " + (dir / "out").string() + " " + suite_file(dir, {{"algorithms", algos}}));
   ASSERT_EQ(r.status, 0) << r.out;
   const json res = read_json(dir / "out" / "results.json");
@@ -103,14 +112,16 @@ TEST(Suite, CrashHangMemoryHogAndInvalidInputAreRecordedWhileOthersSucceed) {
   EXPECT_EQ(by_label["hang"]["status"], "timeout");
   EXPECT_EQ(by_label["hog"]["status"], "out_of_memory");
   EXPECT_EQ(by_label["bad"]["status"], "invalid_input");
-  EXPECT_NE(by_label["bad"]["message"].get<std::string>().find("kill (0.5) must be smaller than influence"), std::string::npos);
+  EXPECT_NE(by_label["bad"]["message"].get<std::string>().find("kill (0.5) must be smaller than influence"),
+            std::string::npos);
   EXPECT_NE(r.out.find("Warnings"), std::string::npos);  // the summary says so
 }
 
 TEST(Suite, AllocationCountsAndPlantsRepeatAcrossRuns) {
   const auto dir = test::temp_dir("suite_alloc");
-  const auto r = growbench("suite -q -o " + (dir / "out").string() + " " +
-                           suite_file(dir, {{"repetitions", 3}, {"algorithms", {{{"name", "spacecol"}, {"params", kSmall}}}}}));
+  const auto r =
+      growbench("suite -q -o " + (dir / "out").string() + " " +
+                suite_file(dir, {{"repetitions", 3}, {"algorithms", {{{"name", "spacecol"}, {"params", kSmall}}}}}));
   ASSERT_EQ(r.status, 0) << r.out;
   const json t = read_json(dir / "out" / "results.json")["trials"][0];
   ASSERT_EQ(t["samples"].size(), 3u);
@@ -133,7 +144,7 @@ TEST(Suite, AllocationCountsAndPlantsRepeatAcrossRuns) {
 TEST(Suite, ResumeAfterKillLosesNothing) {
   const auto dir = test::temp_dir("suite_resume");
   const json algos = json::array({{{"name", "spacecol"}, {"label", "a"}, {"params", kSmall}},
-                                   {{"name", "spacecol"}, {"label", "b"}, {"params", kSmall}}});
+                                  {{"name", "spacecol"}, {"label", "b"}, {"params", kSmall}}});
   const std::string file = suite_file(dir, {{"repetitions", 4}, {"algorithms", algos}, {"scenes", {"column", "wall"}}});
   const std::string out = (dir / "out").string();
   std::vector<std::string> args = {GROWBENCH_BINARY, "suite", "-q", "-o", out, file};
@@ -213,14 +224,15 @@ TEST(Suite, QuickSuiteEndToEndAndSummary) {
   ASSERT_EQ(r.status, 0) << r.out;
   const json res = read_json(dir / "out" / "results.json");
   EXPECT_EQ(res["schema_version"], 1);
-  for (const char* k : {"growbench_commit", "dirty", "compiler", "cxx_flags", "build_type", "cpu_model", "hardware_threads",
-                        "dependencies", "date", "suite_file_hash"})
+  for (const char* k : {"growbench_commit", "dirty", "compiler", "cxx_flags", "build_type", "cpu_model",
+                        "hardware_threads", "dependencies", "date", "suite_file_hash"})
     EXPECT_TRUE(res["context"].contains(k)) << k;
   EXPECT_EQ(res["context"]["parent_threads_at_fork"], 1) << "trials must be forked from a single-threaded process";
   ASSERT_GE(res["trials"].size(), 3u);
   for (const auto& t : res["trials"]) {
     for (const auto& s : t["samples"])
-      for (const char* k : {"launch_s", "child_bookkeeping_s", "teardown_s", "parent_s", "harness_overhead_s", "outside_phases_s"}) {
+      for (const char* k :
+           {"launch_s", "child_bookkeeping_s", "teardown_s", "parent_s", "harness_overhead_s", "outside_phases_s"}) {
         EXPECT_TRUE(s.contains(k)) << k;
         if (s.contains(k)) {
           EXPECT_GE(s[k].get<double>(), 0.0) << k;
@@ -240,10 +252,16 @@ TEST(Suite, QuickSuiteEndToEndAndSummary) {
 
 TEST(Suite, ShardsMergeIntoTheUnshardedRun) {
   const auto dir = test::temp_dir("suite_merge");
-  const nlohmann::json suite = {
-      {"schema_version", 1}, {"name", "merge"}, {"repetitions", 1}, {"warmup", 0}, {"threads", 1}, {"seeds", {1, 2}},
-      {"scenes", {"wall", "column"}},
-      {"algorithms", {{{"name", "spacecol"}, {"params", {{"point_count", 300}}}}, {{"name", "lsystem"}, {"params", {{"generations", 3}}}}}}};
+  const nlohmann::json suite = {{"schema_version", 1},
+                                {"name", "merge"},
+                                {"repetitions", 1},
+                                {"warmup", 0},
+                                {"threads", 1},
+                                {"seeds", {1, 2}},
+                                {"scenes", {"wall", "column"}},
+                                {"algorithms",
+                                 {{{"name", "spacecol"}, {"params", {{"point_count", 300}}}},
+                                  {{"name", "lsystem"}, {"params", {{"generations", 3}}}}}}};
   const std::string file = test::write_text(dir / "merge.json", suite.dump());
   // Equal-length output paths (allocations include them): "full", "sh_0", "sh_1", "sh_2".
   ASSERT_EQ(growbench("suite -q " + file + " --out " + (dir / "full").string()).status, 0);
@@ -263,10 +281,12 @@ TEST(Suite, ShardsMergeIntoTheUnshardedRun) {
     const auto& x = a["trials"][k];
     const auto& y = b["trials"][k];
     EXPECT_EQ(x["id"], y["id"]) << k;
-    for (const char* f : {"geometry_hash", "counts", "metrics", "output_bytes", "alloc", "spec", "status"}) EXPECT_EQ(x[f], y[f]) << k << " " << f;
+    for (const char* f : {"geometry_hash", "counts", "metrics", "output_bytes", "alloc", "spec", "status"})
+      EXPECT_EQ(x[f], y[f]) << k << " " << f;
   }
   EXPECT_EQ(b["shards"].size(), 3u);
-  const auto cmp = growbench("compare " + (dir / "full" / "results.json").string() + " " + (dir / "merged.json").string());
+  const auto cmp =
+      growbench("compare " + (dir / "full" / "results.json").string() + " " + (dir / "merged.json").string());
   EXPECT_EQ(cmp.status, 0) << cmp.out;
   // A shard given twice, or one missing: clear errors.
   const std::string s0 = (dir / "sh_0" / "results.json").string(), s1 = (dir / "sh_1" / "results.json").string();

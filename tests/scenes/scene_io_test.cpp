@@ -60,7 +60,8 @@ TEST(MeshScene, FittedToStandardSizeOnAGroundWithSeedAtTheFootOfItsLitSide) {
   std::size_t at = 0;
   for (std::size_t i = 0; i < m.vertices.size(); ++i) {
     const float len = glm::length(normal[i]);
-    if (len > 0.0f && std::abs(normal[i].y) <= 0.5f * len && glm::dot(normal[i], light) > 0.0f && m.vertices[i].y < lowest) {
+    if (len > 0.0f && std::abs(normal[i].y) <= 0.5f * len && glm::dot(normal[i], light) > 0.0f &&
+        m.vertices[i].y < lowest) {
       lowest = m.vertices[i].y;
       at = i;
     }
@@ -69,7 +70,7 @@ TEST(MeshScene, FittedToStandardSizeOnAGroundWithSeedAtTheFootOfItsLitSide) {
   EXPECT_LT(s.seeds[0].position.y, 0.05f);  // at the foot, not up the side
   const glm::vec3 n = glm::normalize(normal[at]);
   EXPECT_NEAR(glm::dot(s.seeds[0].direction, n), 0.0f, 1e-5f);  // along the surface
-  EXPECT_GT(s.seeds[0].direction.y, 0.9f);                       // and up
+  EXPECT_GT(s.seeds[0].direction.y, 0.9f);                      // and up
   EXPECT_NEAR(glm::length(s.seeds[0].direction), 1.0f, 1e-5f);
   const Scene raw = load_scene("mesh:stanford-bunny", {"size=0"});
   EXPECT_NEAR(raw.meshes[0].bounds().max.y, 0.187321f, 1e-5f);  // the file's own units
@@ -142,7 +143,8 @@ TEST(JsonScene, LoadsMeshesSeedsLightEnvelopeZonesCamera) {
   EXPECT_EQ(s.zones[0].kind, Zone::Kind::Exclude);
   EXPECT_EQ(s.camera.fov_deg, 40.0f);
 
-  const std::string based = test::write_text(dir / "b.json", R"({"schema_version": 1, "base": "wall", "base_params": {"width": 4}})");
+  const std::string based =
+      test::write_text(dir / "b.json", R"({"schema_version": 1, "base": "wall", "base_params": {"width": 4}})");
   EXPECT_EQ(load_scene(based).content_hash().size(), 16u);
   EXPECT_NEAR(load_scene(based).meshes[1].bounds().size().x, 4.0f, 1e-5f);
 }
@@ -157,9 +159,11 @@ TEST(JsonScene, ErrorsNameFileAndJsonPath) {
       {R"({"schema_version": 1, "meshes": [{"box": {"min": [0,0,0], "max": [1,"a",1]}}], "seeds": [{"position": [0,0,0]}]})",
        "at /meshes/0/box/max/1: expected a number"},
       {R"({"schema_version": 1, "meshes": [{"bx": {}}]})", "at /meshes/0/bx: unknown key 'bx' (did you mean 'box'?)"},
-      {R"({"schema_version": 1, "meshes": [{"box": {"min": [0,0,0], "max": [1,1,1]}}]})", "at /seeds: a scene needs at least one seed"},
+      {R"({"schema_version": 1, "meshes": [{"box": {"min": [0,0,0], "max": [1,1,1]}}]})",
+       "at /seeds: a scene needs at least one seed"},
       {R"({"schema_version": 1, "meshes": [{"box": {"min": [0,0,0], "max": [1,1,1]}}], "seeds": [{"position": [0,0,0]}],
-          "light": {"type": "moon"}})", "at /light/type: unknown light type 'moon'"},
+          "light": {"type": "moon"}})",
+       "at /light/type: unknown light type 'moon'"},
       {R"({"schema_version": 1, "meshes": [{"obj": "nope.obj"}]})", "at /meshes/0/obj:"},
       {"{\n  \"schema_version\": 1,\n  \"meshes\": [,]\n}", "s.json:3:"},
   };

@@ -20,8 +20,8 @@ float brute_distance(const Scene& s, const glm::vec3& p) {
   double best = std::numeric_limits<double>::infinity();
   for (const auto& m : s.meshes)
     for (const auto& t : m.triangles) {
-      const auto c = geom::closest_feature_on_triangle(glm::dvec3(p), glm::dvec3(m.vertices[t.x]), glm::dvec3(m.vertices[t.y]),
-                                                       glm::dvec3(m.vertices[t.z]));
+      const auto c = geom::closest_feature_on_triangle(glm::dvec3(p), glm::dvec3(m.vertices[t.x]),
+                                                       glm::dvec3(m.vertices[t.y]), glm::dvec3(m.vertices[t.z]));
       best = std::min(best, glm::length(c.point - glm::dvec3(p)));
     }
   return static_cast<float>(best);
@@ -52,9 +52,9 @@ TEST(Geometry, ClosestPointOnTriangleRegions) {
   const glm::vec3 a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
   const glm::vec3 f = geom::closest_point_on_triangle({0.2f, 0.2f, 5}, a, b, c);  // face
   EXPECT_NEAR(glm::length(f - glm::vec3(0.2f, 0.2f, 0)), 0.0f, 1e-6f);
-  EXPECT_EQ(geom::closest_point_on_triangle({-1, -1, 0}, a, b, c), a);                             // vertex
-  EXPECT_EQ(geom::closest_point_on_triangle({0.5f, -2, 1}, a, b, c), glm::vec3(0.5f, 0, 0));       // edge
-  const glm::vec3 q = geom::closest_point_on_triangle({1, 1, 0}, a, b, c);                          // hypotenuse
+  EXPECT_EQ(geom::closest_point_on_triangle({-1, -1, 0}, a, b, c), a);                        // vertex
+  EXPECT_EQ(geom::closest_point_on_triangle({0.5f, -2, 1}, a, b, c), glm::vec3(0.5f, 0, 0));  // edge
+  const glm::vec3 q = geom::closest_point_on_triangle({1, 1, 0}, a, b, c);                    // hypotenuse
   EXPECT_NEAR(q.x, 0.5f, 1e-6f);
   EXPECT_NEAR(q.y, 0.5f, 1e-6f);
 }
@@ -68,20 +68,21 @@ TEST(Geometry, TrianglesOverlapWhenTheyShareMoreThanAPoint) {
     return geom::triangles_overlap(a, bb);
   };
   EXPECT_TRUE(overlap(t({0.2f, 0.2f, -1}, {0.2f, 0.2f, 1}, {0.6f, 0.2f, 0})));  // pierces it
-  EXPECT_FALSE(overlap(t({2, 0, -1}, {2, 0, 1}, {3, 0, 0})));                  // beside it
-  EXPECT_FALSE(overlap(t({0, 0, 0}, {-1, 0, 1}, {0, -1, 1})));                 // one shared vertex: a touch
-  EXPECT_FALSE(overlap(t({0, 0, 0}, {0, 0, 1}, {-1, -1, 1})));                 // two leaves on one petiole
-  EXPECT_TRUE(overlap(t({0, 0, 0}, {1, 0, 0}, {0, 0, 1})));                    // hinged on a shared edge
-  EXPECT_FALSE(overlap(t({0, 0, 0.01f}, {1, 0, 0.01f}, {0, 1, 0.01f})));       // parallel, a centimetre apart
-  EXPECT_TRUE(overlap(t({0.1f, 0.1f, 0}, {2, 0.1f, 0}, {0.1f, 2, 0})));        // coplanar, sharing area
-  EXPECT_TRUE(overlap(t({0, 0, 0}, {1, 0, 0}, {0, 1, 0})));                    // the same triangle
-  EXPECT_FALSE(overlap(t({1, 0, 0}, {0, 1, 0}, {1, 1, 0})));                   // coplanar, sharing an edge only
+  EXPECT_FALSE(overlap(t({2, 0, -1}, {2, 0, 1}, {3, 0, 0})));                   // beside it
+  EXPECT_FALSE(overlap(t({0, 0, 0}, {-1, 0, 1}, {0, -1, 1})));                  // one shared vertex: a touch
+  EXPECT_FALSE(overlap(t({0, 0, 0}, {0, 0, 1}, {-1, -1, 1})));                  // two leaves on one petiole
+  EXPECT_TRUE(overlap(t({0, 0, 0}, {1, 0, 0}, {0, 0, 1})));                     // hinged on a shared edge
+  EXPECT_FALSE(overlap(t({0, 0, 0.01f}, {1, 0, 0.01f}, {0, 1, 0.01f})));        // parallel, a centimetre apart
+  EXPECT_TRUE(overlap(t({0.1f, 0.1f, 0}, {2, 0.1f, 0}, {0.1f, 2, 0})));         // coplanar, sharing area
+  EXPECT_TRUE(overlap(t({0, 0, 0}, {1, 0, 0}, {0, 1, 0})));                     // the same triangle
+  EXPECT_FALSE(overlap(t({1, 0, 0}, {0, 1, 0}, {1, 1, 0})));                    // coplanar, sharing an edge only
   EXPECT_TRUE(overlap(t({0.1f, 0.1f, 1e-9f}, {0.5f, 0.1f, -1e-9f}, {0.1f, 0.5f, 0})));  // coplanar within rounding
 }
 
 TEST(Geometry, PrimitivesAreClosedAndOutward) {
-  for (const auto& m : {geom::make_box("b", {0, 0, 0}, {1, 2, 3}), geom::make_cylinder("c", {0, 0, 0}, {0, 2, 0}, 0.5f, 0.3f, 16),
-                        geom::make_icosphere("s", {0, 0, 0}, 1.0f, 3)}) {
+  for (const auto& m :
+       {geom::make_box("b", {0, 0, 0}, {1, 2, 3}), geom::make_cylinder("c", {0, 0, 0}, {0, 2, 0}, 0.5f, 0.3f, 16),
+        geom::make_icosphere("s", {0, 0, 0}, 1.0f, 3)}) {
     EXPECT_TRUE(m.is_closed()) << m.name;
     Shape s;
     s.kind = Shape::Kind::Mesh;
@@ -121,7 +122,8 @@ std::vector<Aabb> random_boxes(Rng& rng, float half, bool with_empty) {
   std::vector<Aabb> boxes(2000);
   for (std::size_t i = 0; i < boxes.size(); ++i) {
     if (with_empty && i % 7 == 0) continue;
-    const glm::vec3 c(u() * 4 - 2, u() * 4 - 2, u() * 4 - 2), h(u() * half, u() * half, (u() * 0.02f + u() * 0.6f) * half);
+    const glm::vec3 c(u() * 4 - 2, u() * 4 - 2, u() * 4 - 2),
+        h(u() * half, u() * half, (u() * 0.02f + u() * 0.6f) * half);
     boxes[i].extend(c - h);
     boxes[i].extend(c + h);
   }
@@ -199,7 +201,8 @@ TEST(SceneQuery, BoxIndexVisitsEveryBoxTheSegmentPassesThrough) {
         t1 = std::min(t1, std::max(ta, tb));
       }
       if (t1 - t0 > 1e-4) {
-        EXPECT_TRUE(std::binary_search(seen.begin(), seen.end(), id)) << "segment " << k << " passes through box " << id;
+        EXPECT_TRUE(std::binary_search(seen.begin(), seen.end(), id))
+            << "segment " << k << " passes through box " << id;
         ++through;
       }
     }
@@ -207,7 +210,9 @@ TEST(SceneQuery, BoxIndexVisitsEveryBoxTheSegmentPassesThrough) {
   EXPECT_GT(through, 200u);
   // Stopping at the first box: one visit.
   int visits = 0;
-  index->visit_segment(glm::vec3(-2.0f), glm::vec3(4.0f), [](void* user, std::uint32_t) { return ++*static_cast<int*>(user) > 0; }, &visits);
+  index->visit_segment(
+      glm::vec3(-2.0f), glm::vec3(4.0f), [](void* user, std::uint32_t) { return ++*static_cast<int*>(user) > 0; },
+      &visits);
   EXPECT_EQ(visits, 1);
 }
 
@@ -242,7 +247,8 @@ TEST(SceneQuery, SphereDistancesMatchAnalyticWithinAVoxel) {
   const float sagitta = r * (1.0f - std::cos(0.5f * 0.0275f));  // icosphere level 5 flattening
   Rng rng(4, 0);
   for (int i = 0; i < 2000; ++i) {
-    const glm::vec3 p = glm::vec3(0.5f, 0.2f, -0.3f) + glm::vec3(rng.uniform(-1.5, 1.5), rng.uniform(-1.5, 1.5), rng.uniform(-1.5, 1.5));
+    const glm::vec3 p = glm::vec3(0.5f, 0.2f, -0.3f) +
+                        glm::vec3(rng.uniform(-1.5, 1.5), rng.uniform(-1.5, 1.5), rng.uniform(-1.5, 1.5));
     const float analytic = glm::length(p - glm::vec3(0.5f, 0.2f, -0.3f)) - r;
     EXPECT_NEAR(q.signed_distance(p), analytic, q.voxel_size() + sagitta);
     if (std::abs(analytic) > q.voxel_size() + sagitta) {
@@ -306,9 +312,8 @@ TEST(SceneQuery, ConcurrentQueriesAgreeWithSerial) {
   for (auto& p : pts) p = glm::vec3(rng.uniform(-2, 2), rng.uniform(0, 2), rng.uniform(-2, 2));
   std::vector<float> serial(pts.size()), parallel(pts.size());
   for (std::size_t i = 0; i < pts.size(); ++i) serial[i] = q.signed_distance(pts[i]) + q.closest_point(pts[i]).distance;
-  tbb::parallel_for(std::size_t{0}, pts.size(), [&](std::size_t i) {
-    parallel[i] = q.signed_distance(pts[i]) + q.closest_point(pts[i]).distance;
-  });
+  tbb::parallel_for(std::size_t{0}, pts.size(),
+                    [&](std::size_t i) { parallel[i] = q.signed_distance(pts[i]) + q.closest_point(pts[i]).distance; });
   EXPECT_EQ(serial, parallel);
 }
 
@@ -329,7 +334,8 @@ TEST(SceneQuery, OcclusionBehindAWall) {
 
 // The scan is sealed when it is loaded: Embree, the distance field and the inside test see one solid.
 TEST(SceneQuery, InsideOutsideOfTheSealedBunnyMatchesRayParity) {
-  EXPECT_FALSE(load_obj(mesh_path("stanford-bunny")).is_closed()) << "the scan has five small holes (223 boundary edges)";
+  EXPECT_FALSE(load_obj(mesh_path("stanford-bunny")).is_closed())
+      << "the scan has five small holes (223 boundary edges)";
   const Scene s = load_scene("mesh:stanford-bunny");
   ASSERT_TRUE(s.meshes[0].is_closed()) << "sealed by load_scene_obj";
   SceneQuery q(s);
@@ -367,7 +373,8 @@ TEST(SceneQuery, InsideIsExactInCreasesWhereTheFieldIsNot) {
     int checked = 0;
     for (int i = 0; i < 4000; ++i) {
       const SurfaceSample ss = q.sample_surface(5, static_cast<std::uint64_t>(i));
-      const glm::vec3 dir = glm::normalize(glm::vec3(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5) + glm::vec3(1e-3f));
+      const glm::vec3 dir =
+          glm::normalize(glm::vec3(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5) + glm::vec3(1e-3f));
       const glm::vec3 p = ss.position + static_cast<float>(rng.uniform() * 0.03) * dir;
       bool in = false, on_face = false;
       for (const auto& m : s.meshes) {
@@ -395,11 +402,11 @@ TEST(SceneQuery, InsideAtEdgesAndVerticesOfACube) {
   for (const bool field : {true, false}) {
     SceneQuery q(s, {.build_sdf = field});
     for (const float e : {1e-4f, 1e-2f, 0.3f}) {
-      EXPECT_FALSE(q.inside({1 + e, 1 + e, 0})) << e;        // beyond an edge
-      EXPECT_FALSE(q.inside({1 + e, 1 + e, 1 + e})) << e;    // beyond a vertex
+      EXPECT_FALSE(q.inside({1 + e, 1 + e, 0})) << e;      // beyond an edge
+      EXPECT_FALSE(q.inside({1 + e, 1 + e, 1 + e})) << e;  // beyond a vertex
       EXPECT_FALSE(q.inside({1 + e, 1 - e * 0.5f, 0.2f})) << e;
-      EXPECT_TRUE(q.inside({1 - e, 1 - e, 0})) << e;         // within an edge
-      EXPECT_TRUE(q.inside({1 - e, 1 - e, 1 - e})) << e;     // within a vertex
+      EXPECT_TRUE(q.inside({1 - e, 1 - e, 0})) << e;      // within an edge
+      EXPECT_TRUE(q.inside({1 - e, 1 - e, 1 - e})) << e;  // within a vertex
       EXPECT_TRUE(q.inside_mesh(0, {1 - e, 1 - e * 2, 1 - e})) << e;
     }
     EXPECT_FALSE(q.inside({1, 0.5f, 0.5f}));  // on the surface: outside
