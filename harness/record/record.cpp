@@ -31,7 +31,9 @@ struct Node {
     return {j.at(std::string(k)), source, path.empty() ? std::string(k) : fmt::format("{}.{}", path, k)};
   }
   [[nodiscard]] Node index(std::size_t i) const { return {j[i], source, fmt::format("{}[{}]", path, i)}; }
-  [[nodiscard]] std::string got() const { return fmt::format("got {}", j.is_string() ? j.dump() : std::string(j.type_name())); }
+  [[nodiscard]] std::string got() const {
+    return fmt::format("got {}", j.is_string() ? j.dump() : std::string(j.type_name()));
+  }
 };
 
 void read(const Node& n, double& v) {
@@ -41,17 +43,19 @@ void read(const Node& n, double& v) {
 
 // Integers: JSON integers, and whole numbers written as floats (1e6 from Python), in range.
 template <class T>
-  requires std::is_integral_v<T>
+requires std::is_integral_v<T>
 void read(const Node& n, T& v) {
   const char* what = std::is_signed_v<T> ? "an integer" : "a non-negative integer";
   if (n.j.is_number_unsigned()) {
     const auto u = n.j.get<std::uint64_t>();
-    if (u > static_cast<std::uint64_t>(std::numeric_limits<T>::max())) n.fail(fmt::format("expected {}, {} is too large", what, u));
+    if (u > static_cast<std::uint64_t>(std::numeric_limits<T>::max()))
+      n.fail(fmt::format("expected {}, {} is too large", what, u));
     v = static_cast<T>(u);
   } else if (n.j.is_number_integer()) {
     const auto s = n.j.get<std::int64_t>();
-    if ((std::is_unsigned_v<T> && s < 0) || (std::is_signed_v<T> && (s < static_cast<std::int64_t>(std::numeric_limits<T>::min()) ||
-                                                                      s > static_cast<std::int64_t>(std::numeric_limits<T>::max()))))
+    if ((std::is_unsigned_v<T> && s < 0) ||
+        (std::is_signed_v<T> && (s < static_cast<std::int64_t>(std::numeric_limits<T>::min()) ||
+                                 s > static_cast<std::int64_t>(std::numeric_limits<T>::max()))))
       n.fail(fmt::format("expected {}, got {}", what, s));
     v = static_cast<T>(s);
   } else if (n.j.is_number_float()) {
@@ -119,7 +123,8 @@ class Fields {
     for (const auto& [k, v] : n_.j.items()) {
       if (std::find(named_.begin(), named_.end(), k) != named_.end()) continue;
       const std::string near = closest_match(k, named_);
-      n_.key(k).fail(fmt::format("unknown field '{}'{}", k, near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near)));
+      n_.key(k).fail(
+          fmt::format("unknown field '{}'{}", k, near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near)));
     }
   }
   [[nodiscard]] const Node& node() const { return n_; }
@@ -154,8 +159,10 @@ void read(const Node& n, std::array<T, N>& v) {
 
 template <class T>
 json to_json_value(const T& v) {
-  if constexpr (requires { to_json(v); }) return to_json(v);
-  else return json(v);
+  if constexpr (requires { to_json(v); })
+    return to_json(v);
+  else
+    return json(v);
 }
 
 template <class T>
@@ -193,7 +200,9 @@ void put_nullable(json& j, const char* key, const std::optional<T>& v) {
 
 // ---------------------------------------------------------------- the structs, each written and read once
 
-const PhaseMeasures* Phases::find(std::string_view name) const { return const_cast<Phases*>(this)->find(name); }
+const PhaseMeasures* Phases::find(std::string_view name) const {
+  return const_cast<Phases*>(this)->find(name);
+}
 
 PhaseMeasures* Phases::find(std::string_view name) {
   std::optional<PhaseMeasures>* p = name == "scene_load"    ? &scene_load
@@ -207,9 +216,12 @@ PhaseMeasures* Phases::find(std::string_view name) {
 }
 
 json to_json(const PhaseMeasures& v) {
-  json j = {{"wall_s", v.wall_s},       {"cpu_s", v.cpu_s},
-            {"peak_rss_bytes", v.peak_rss_bytes}, {"peak_rss_reset", v.peak_rss_reset},
-            {"alloc_count", v.alloc_count}, {"alloc_bytes", v.alloc_bytes}};
+  json j = {{"wall_s", v.wall_s},
+            {"cpu_s", v.cpu_s},
+            {"peak_rss_bytes", v.peak_rss_bytes},
+            {"peak_rss_reset", v.peak_rss_reset},
+            {"alloc_count", v.alloc_count},
+            {"alloc_bytes", v.alloc_bytes}};
   put(j, "bvh_s", v.bvh_s);
   put(j, "sdf_s", v.sdf_s);
   put(j, "sdf_active_voxels", v.sdf_active_voxels);
@@ -252,8 +264,12 @@ void read(const Node& n, Phases& v) {
 }
 
 json to_json(const Counts& v) {
-  return {{"nodes", v.nodes},       {"segments", v.segments},           {"leaves", v.leaves},
-          {"organs", v.organs},     {"polygons", v.polygons},           {"mesh_vertices", v.mesh_vertices},
+  return {{"nodes", v.nodes},
+          {"segments", v.segments},
+          {"leaves", v.leaves},
+          {"organs", v.organs},
+          {"polygons", v.polygons},
+          {"mesh_vertices", v.mesh_vertices},
           {"mesh_triangles", v.mesh_triangles}};
 }
 void read(const Node& n, Counts& v) {
@@ -299,7 +315,7 @@ void read(const Node& n, Curve& v) {
 }
 
 json to_json(const SceneInfo& v) {
-  return {{"spec", v.spec},   {"name", v.name},   {"hash", v.hash},
+  return {{"spec", v.spec},           {"name", v.name},   {"hash", v.hash},
           {"triangles", v.triangles}, {"seeds", v.seeds}, {"params", v.params}};
 }
 void read(const Node& n, SceneInfo& v) {
@@ -313,7 +329,9 @@ void read(const Node& n, SceneInfo& v) {
   f.done();
 }
 
-json to_json(const FramesInfo& v) { return {{"every", v.every}, {"count", v.count}, {"dir", v.dir}}; }
+json to_json(const FramesInfo& v) {
+  return {{"every", v.every}, {"count", v.count}, {"dir", v.dir}};
+}
 void read(const Node& n, FramesInfo& v) {
   Fields f(n);
   f.field("every", v.every);
@@ -363,9 +381,9 @@ void read(const Node& n, RunContext& v) {
 }
 
 json to_json(const RenderRecord& v) {
-  json j = {{"status", v.status},     {"warnings", v.warnings}, {"png", v.png},         {"pov", v.pov},
-            {"log", v.log},           {"width", v.width},       {"height", v.height},   {"pov_bytes", v.pov_bytes},
-            {"write_s", v.write_s},   {"wall_s", v.wall_s},     {"cpu_s", v.cpu_s},     {"quality", v.quality},
+  json j = {{"status", v.status},     {"warnings", v.warnings}, {"png", v.png},       {"pov", v.pov},
+            {"log", v.log},           {"width", v.width},       {"height", v.height}, {"pov_bytes", v.pov_bytes},
+            {"write_s", v.write_s},   {"wall_s", v.wall_s},     {"cpu_s", v.cpu_s},   {"quality", v.quality},
             {"branches", v.branches}, {"threads", v.threads}};
   put(j, "message", v.message);
   return j;
@@ -517,7 +535,9 @@ void read(const Node& n, TrialSpecRecord& v) {
   f.done();
 }
 
-json to_json(const AllocCount& v) { return {{"count", v.count}, {"bytes", v.bytes}}; }
+json to_json(const AllocCount& v) {
+  return {{"count", v.count}, {"bytes", v.bytes}};
+}
 void read(const Node& n, AllocCount& v) {
   Fields f(n);
   f.field("count", v.count);
@@ -526,8 +546,8 @@ void read(const Node& n, AllocCount& v) {
 }
 
 json to_json(const SuiteSample& v) {
-  json j = {{"repetition", v.repetition},       {"status", v.status},
-            {"child_wall_s", v.child_wall_s},   {"child_user_s", v.child_user_s},
+  json j = {{"repetition", v.repetition},         {"status", v.status},
+            {"child_wall_s", v.child_wall_s},     {"child_user_s", v.child_user_s},
             {"child_system_s", v.child_system_s}, {"child_max_rss_bytes", v.child_max_rss_bytes}};
   put(j, "message", v.message);
   put(j, "phases", v.phases);
@@ -688,7 +708,9 @@ void read(const Node& n, SuiteCell& v) {
   f.done();
 }
 
-json to_json(const SuiteInfo& v) { return {{"name", v.name}, {"file", v.file}, {"description", v.description}}; }
+json to_json(const SuiteInfo& v) {
+  return {{"name", v.name}, {"file", v.file}, {"description", v.description}};
+}
 void read(const Node& n, SuiteInfo& v) {
   Fields f(n);
   f.field("name", v.name);
@@ -697,7 +719,9 @@ void read(const Node& n, SuiteInfo& v) {
   f.done();
 }
 
-json to_json(const ShardInfo& v) { return {{"index", v.index}, {"count", v.count}}; }
+json to_json(const ShardInfo& v) {
+  return {{"index", v.index}, {"count", v.count}};
+}
 void read(const Node& n, ShardInfo& v) {
   Fields f(n);
   f.field("index", v.index);
@@ -705,7 +729,9 @@ void read(const Node& n, ShardInfo& v) {
   f.done();
 }
 
-json to_json(const ShardRecord& v) { return {{"index", v.index}, {"file", v.file}, {"context", to_json(v.context)}}; }
+json to_json(const ShardRecord& v) {
+  return {{"index", v.index}, {"file", v.file}, {"context", to_json(v.context)}};
+}
 void read(const Node& n, ShardRecord& v) {
   Fields f(n);
   f.field("index", v.index);
@@ -757,7 +783,11 @@ void read(const Node& n, RenderSummary& v) {
 }
 
 json to_json(const PooledSummary& v) {
-  return {{"label", v.label}, {"scene", v.scene}, {"sweep", v.sweep}, {"cells", v.cells}, {"growth_s", to_json(v.growth_s)}};
+  return {{"label", v.label},
+          {"scene", v.scene},
+          {"sweep", v.sweep},
+          {"cells", v.cells},
+          {"growth_s", to_json(v.growth_s)}};
 }
 void read(const Node& n, PooledSummary& v) {
   Fields f(n);
@@ -769,7 +799,9 @@ void read(const Node& n, PooledSummary& v) {
   f.done();
 }
 
-json to_json(const ResultsSummary& v) { return {{"growth_s_over_seeds", to_json_value(v.growth_s_over_seeds)}}; }
+json to_json(const ResultsSummary& v) {
+  return {{"growth_s_over_seeds", to_json_value(v.growth_s_over_seeds)}};
+}
 void read(const Node& n, ResultsSummary& v) {
   Fields f(n);
   f.field("growth_s_over_seeds", v.growth_s_over_seeds);
@@ -809,8 +841,12 @@ void read(const Node& n, ResultsFile& v) {
 }
 
 json to_json(const BaselineContext& v) {
-  return {{"growbench_commit", v.growbench_commit}, {"dirty", v.dirty},           {"compiler", v.compiler},
-          {"cxx_flags", v.cxx_flags},               {"build_type", v.build_type}, {"dependencies", v.dependencies}};
+  return {{"growbench_commit", v.growbench_commit},
+          {"dirty", v.dirty},
+          {"compiler", v.compiler},
+          {"cxx_flags", v.cxx_flags},
+          {"build_type", v.build_type},
+          {"dependencies", v.dependencies}};
 }
 void read(const Node& n, BaselineContext& v) {
   Fields f(n);
@@ -824,7 +860,7 @@ void read(const Node& n, BaselineContext& v) {
 }
 
 json to_json(const BaselineCell& v) {
-  json j = {{"id", v.id},     {"label", v.label}, {"algorithm", v.algorithm},
+  json j = {{"id", v.id},       {"label", v.label}, {"algorithm", v.algorithm},
             {"scene", v.scene}, {"seed", v.seed},   {"status", v.status}};
   put(j, "threads", v.threads);
   put(j, "geometry_hash", v.geometry_hash);
@@ -854,8 +890,12 @@ void read(const Node& n, BaselineCell& v) {
 }
 
 json to_json(const Baseline& v) {
-  return {{"schema_version", v.schema_version}, {"kind", v.kind},       {"mode", v.mode},
-          {"suite", to_json(v.suite)},          {"suite_hash", v.suite_hash}, {"context", to_json(v.context)},
+  return {{"schema_version", v.schema_version},
+          {"kind", v.kind},
+          {"mode", v.mode},
+          {"suite", to_json(v.suite)},
+          {"suite_hash", v.suite_hash},
+          {"context", to_json(v.context)},
           {"trials", to_json_value(v.trials)}};
 }
 void read(const Node& n, Baseline& v) {
@@ -903,7 +943,10 @@ void read(const Node& n, HistoryCell& v) {
 }
 
 json to_json(const HistoryRun& v) {
-  return {{"date", v.date}, {"mode", v.mode}, {"dirty", v.dirty}, {"build_type", v.build_type},
+  return {{"date", v.date},
+          {"mode", v.mode},
+          {"dirty", v.dirty},
+          {"build_type", v.build_type},
           {"cells", to_json_value(v.cells)}};
 }
 void read(const Node& n, HistoryRun& v) {
@@ -983,7 +1026,9 @@ GROWBENCH_RECORD_TYPE(HistoryFile)
 
 namespace {
 
-json parse_file(const std::string& path) { return parse_json_file_text(path, read_text_file(path)); }
+json parse_file(const std::string& path) {
+  return parse_json_file_text(path, read_text_file(path));
+}
 
 void check_version(int version, const std::string& path) {
   if (version > kSchemaVersion)
@@ -992,7 +1037,8 @@ void check_version(int version, const std::string& path) {
 }
 
 void check_kind(const json& j, std::string_view kind, const std::string& path, const char* what) {
-  const std::string k = j.is_object() && j.contains("kind") && j["kind"].is_string() ? j["kind"].get<std::string>() : "";
+  const std::string k =
+      j.is_object() && j.contains("kind") && j["kind"].is_string() ? j["kind"].get<std::string>() : "";
   if (k != kind) throw InputError(fmt::format("{}: not a {} (kind '{}', expected '{}')", path, what, k, kind));
 }
 
@@ -1045,6 +1091,8 @@ std::vector<JournalEntry> read_journal(const std::string& path) {
   return out;
 }
 
-std::string json_text(const json& j, int indent) { return j.dump(indent) + "\n"; }
+std::string json_text(const json& j, int indent) {
+  return j.dump(indent) + "\n";
+}
 
 }  // namespace growbench

@@ -64,7 +64,7 @@ struct Phases {
       if (const PhaseMeasures* p = find(name)) f(name, *p);
   }
   static constexpr std::array<std::string_view, 6> kNames = {"export",  "growth",      "meshing",
-                                                              "metrics", "query_build", "scene_load"};
+                                                             "metrics", "query_build", "scene_load"};
 };
 
 struct Counts {
@@ -97,11 +97,11 @@ struct FramesInfo {
   std::string dir;  // relative to the trial's directory
 };
 
-// The build and machine a run used (run_context() in harness/run/trial.hpp).
+// The build and machine a run used (run_context_record() in harness/run/trial.hpp).
 struct RunContext {
   std::string growbench_commit = "unknown";
-  std::string dirty = "unknown";             // "true", "false" or "unknown"
-  std::optional<std::int64_t> commit_time;   // committer time (Unix seconds); written as null when unknown
+  std::string dirty = "unknown";            // "true", "false" or "unknown"
+  std::optional<std::int64_t> commit_time;  // committer time (Unix seconds); written as null when unknown
   std::string configured_commit, build_type, compiler, cxx_flags, binary_hash, cpu_model, date;
   std::uint64_t hardware_threads = 0;
   bool alloc_counting = false;
@@ -157,8 +157,8 @@ struct TrialRecord {
   OutputBytes output_bytes;
   std::string geometry_hash;
   std::map<std::string, double> algorithm_stats;
-  std::uint64_t peak_rss_bytes = 0;  // the whole process's, never reset
-  std::optional<RunContext> context;  // absent in a suite's trials (the suite records it once)
+  std::uint64_t peak_rss_bytes = 0;    // the whole process's, never reset
+  std::optional<RunContext> context;   // absent in a suite's trials (the suite records it once)
   std::optional<RenderRecord> render;  // added by growbench render
   std::optional<AnimationRecord> animation;
 };

@@ -43,7 +43,9 @@ ResultsFile small_results() {
   return r;
 }
 
-json results_json() { return to_json(small_results()); }
+json results_json() {
+  return to_json(small_results());
+}
 
 std::string error_of(const json& j) {
   try {
@@ -75,8 +77,9 @@ TEST(Record, ErrorsNameTheFileAndThePath) {
   EXPECT_EQ(error_of(j), "results.json: at trials[0].samples[0].phases.growth.wall_s: expected a number, got \"fast\"");
   j = results_json();
   j["trials"][0]["samples"][0]["phases"]["growth"]["wal_s"] = 0.1;
-  EXPECT_EQ(error_of(j),
-            "results.json: at trials[0].samples[0].phases.growth.wal_s: unknown field 'wal_s' (did you mean 'wall_s'?)");
+  EXPECT_EQ(
+      error_of(j),
+      "results.json: at trials[0].samples[0].phases.growth.wal_s: unknown field 'wal_s' (did you mean 'wall_s'?)");
   j = results_json();
   j["trials"][0]["counts"]["nodes"] = -1;
   EXPECT_EQ(error_of(j), "results.json: at trials[0].counts.nodes: expected a non-negative integer, got -1");
@@ -92,8 +95,9 @@ TEST(Record, ErrorsNameTheFileAndThePath) {
 
 TEST(Record, PartialFilesReadWithDefaults) {
   // Hand-written files (tests, other tools) may leave fields out; a whole number written as a float is an integer.
-  const json j = {{"kind", "growbench-results"},
-                  {"trials", {{{"id", "a"}, {"samples", {{{"phases", {{"growth", {{"wall_s", 1}, {"peak_rss_bytes", 1e6}}}}}}}}}}}};
+  const json j = {
+      {"kind", "growbench-results"},
+      {"trials", {{{"id", "a"}, {"samples", {{{"phases", {{"growth", {{"wall_s", 1}, {"peak_rss_bytes", 1e6}}}}}}}}}}}};
   const ResultsFile r = from_json<ResultsFile>(j, "partial.json");
   ASSERT_EQ(r.trials.size(), 1u);
   const PhaseMeasures* g = r.trials[0].samples[0].phases->find("growth");
