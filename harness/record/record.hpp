@@ -97,7 +97,7 @@ struct FramesInfo {
   std::string dir;  // relative to the trial's directory
 };
 
-// The build and machine a run used (run_context() in harness/run/trial.hpp).
+// The build and machine a run used (run_context_record() in harness/run/trial.hpp).
 struct RunContext {
   std::string growbench_commit = "unknown";
   std::string dirty = "unknown";            // "true", "false" or "unknown"

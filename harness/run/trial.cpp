@@ -365,12 +365,13 @@ void load_scene_and_query(const TrialSpec& spec, TrialState& st, PhaseTimer& tim
 }
 
 // Frame capture (growth animations): OUT/frames/step_NNNNNN.gbplant, its cost measured to be taken out of
-// the growth phase.
+// the growth phase. It takes the algorithm, not its plant: some algorithms build their plant on demand,
+// and that must not happen inside the growth phase unless a frame is kept.
 struct FrameCapture {
   const TrialSpec& spec;
   int frames = 0, last_frame = -1;
   double wall_s = 0.0, cpu_s = 0.0;
-  void capture(int step, const Plant& plant) {
+  void capture(int step, const GrowthAlgorithm& algo) {
     if (spec.frame_every <= 0 || step == last_frame) return;
     const auto w0 = std::chrono::steady_clock::now();
     const double c0 = cpu_seconds();
@@ -379,7 +380,7 @@ struct FrameCapture {
       std::filesystem::remove_all(d);
       std::filesystem::create_directories(d);
     }
-    write_plant_snapshot((d / fmt::format("step_{:06d}.gbplant", step)).string(), plant);
+    write_plant_snapshot((d / fmt::format("step_{:06d}.gbplant", step)).string(), algo.plant());
     ++frames;
     last_frame = step;
     wall_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
@@ -423,11 +424,11 @@ void grow(const TrialSpec& spec, const Params& params, TrialState& st, PhaseTime
       const double t = elapsed();
       curve.add(steps, algo.node_count(), algo.organ_count(), t);
       if (progress) progress({steps, algo.node_count(), t});
-      if (spec.frame_every > 0 && steps % spec.frame_every == 0 && more) frames.capture(steps, algo.plant());
+      if (spec.frame_every > 0 && steps % spec.frame_every == 0 && more) frames.capture(steps, algo);
       if (!more) break;
     }
     algo.finish();
-    frames.capture(steps, algo.plant());
+    frames.capture(steps, algo);
   });
   if (spec.frame_every > 0) {
     PhaseMeasures& g = *rec.phases.growth;

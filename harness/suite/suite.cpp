@@ -505,12 +505,6 @@ void apply_sample(SuiteCell& t, const SuiteSample& sample, const std::optional<C
   if (st != "ok")
     for (const auto& s : t.samples)
       if (s.status != "ok" && s.message) t.message = s.message;
-  // The growth time's median and interval, so that reports read them instead of computing them again.
-  const std::vector<double> growth = growth_times(t);
-  if (growth.empty())
-    t.summary.reset();
-  else
-    t.summary = CellSummary{median_summary(growth)};
 }
 
 // The growth time over the seeds of each algorithm entry (and sweep point) on each scene: every ok cell's
@@ -537,9 +531,22 @@ ResultsSummary results_summary(const std::vector<SuiteCell>& trials) {
   return out;
 }
 
-// results.json as written: its pooled summary brought up to date first.
-std::string results_text(ResultsFile& results) {
+// The growth time's median and interval of every cell, and over each entry's seeds, so that reports read
+// them instead of computing them again. From the samples, whatever an earlier (resumed) file held.
+void update_summaries(ResultsFile& results) {
+  for (auto& t : results.trials) {
+    const std::vector<double> growth = growth_times(t);
+    if (growth.empty())
+      t.summary.reset();
+    else
+      t.summary = CellSummary{median_summary(growth)};
+  }
   results.summary = results_summary(results.trials);
+}
+
+// results.json as written: its summaries brought up to date first.
+std::string results_text(ResultsFile& results) {
+  update_summaries(results);
   return json_text(to_json(results), 1);
 }
 
@@ -633,8 +640,8 @@ ResultsFile merge_results(const std::vector<ResultsFile>& shards, const std::vec
     merged.trials.push_back(trials[at]);
   }
   if (!differ.empty()) merged.context.mixed_machines = true;
-  merged.renders.reset();                           // per-shard render summaries do not describe the merged grid
-  merged.summary = results_summary(merged.trials);  // seeds of one entry and scene may have run in different shards
+  merged.renders.reset();    // per-shard render summaries do not describe the merged grid
+  update_summaries(merged);  // the seeds of one entry and scene may have run in different shards
   return merged;
 }
 
