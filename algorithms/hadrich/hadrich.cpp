@@ -1,7 +1,7 @@
-// Hädrich et al. 2017 climbing plants (ALGORITHMS.md section 2; seeds/hadrich-climbing-plants-houdini.txt).
+// Hädrich et al. 2017 climbing plants (README.md beside this file).
 //
-// Where the paper gives no formula, the choice is written beside its parameter below and in
-// CONTRIBUTING.md. In short:
+// Where the paper gives no formula, the choice is written beside its parameter below and in the
+// README. In short:
 //  * Tropisms turn the growing tips only; a tip's rest orientation follows it while it grows, so the
 //    plant's rest shape is the shape it grew into and the physics holds that shape (stiffness).
 //  * Surface adaptation uses the paper's rotation (axis v_s x v_f, angle (v_s . v_f) tau dt), whose

@@ -1,11 +1,11 @@
-// Luft-style ivy. The growth rules are Luft's (ALGORITHMS.md section 1); what changes is the cost:
+// Luft-style ivy. The growth rules are Luft's (README.md beside this file); what changes is the cost:
 //
 //  * Luft loops over every scene triangle for each node's adhesion and again for its collision test.
 //    Here Embree queries find the same answers from a few triangles: in `luft` adhesion mode a point
 //    query on an index of the triangles' adhesion prisms (see EmbreeGeometry), in `closest` mode
 //    growing ball queries. For the collision: his first pass can only mirror at a triangle the
 //    segment itself crosses, so when his rule finds no triangle crossed by the segment the loop ends
-//    (three nodes in four on the bunny). That is asked of an index of the triangles' boxes (swept a
+//    (most nodes). That is asked of an index of the triangles' boxes (swept a
 //    few steps along the normal for the adhesion lookup, and padded past the inside test's
 //    tolerance), traversed along the segment: every triangle the rule can call crossed has a box the
 //    segment passes through, and the rule itself decides. Otherwise every position the loop can

@@ -1,4 +1,4 @@
-// L-systems in the Houdini L-system SOP dialect (seeds/houdini-lsystem-reference.txt): parametric,
+// L-systems in the Houdini L-system SOP dialect (SideFX's reference; README.md beside this file): parametric,
 // stochastic, context-sensitive rules with conditions, a full 3D turtle, leaf/flower instancing, in()
 // against the scene, and a surface-wrap mode (the Hyphae notes' wrapped L-systems).
 //

@@ -1,8 +1,9 @@
 // Runions space colonization: open venation (Runions et al. 2005, trees 2007) and closed venation
 // (relative neighbourhood, 2005), in a volume, on surfaces, or held on them (the Hyphae variant).
 //
-// Cost model. Attraction points sit in a static nanoflann kd-tree built once. Each point keeps its
-// nearest node within the influence radius; nodes are only ever added, so after a step only the points
+// Cost model. Attraction points sit in two nanoflann kd-trees (far and near points), rebuilt only when
+// dead points crowd them (compact_active). Each point keeps its nearest node within the influence
+// radius; nodes are only ever added, so after a step only the points
 // within the influence radius of the *new* nodes can change their nearest node or die. One radius
 // query per new node (in parallel) does all the updating; there is never a rebuild plus re-query of
 // every point per step. Points that have a node in range form the `active` list, the only points a
