@@ -33,7 +33,8 @@ void DirectQueries::inside_shape(int shape, std::span<const glm::vec3> p, std::s
   const Scene& s = q_.scene();
   const Shape* sh = nullptr;
   if (shape == kEnvelopeShape && s.envelope) sh = &*s.envelope;
-  if (shape >= 0 && static_cast<std::size_t>(shape) < s.zones.size()) sh = &s.zones[static_cast<std::size_t>(shape)].shape;
+  if (shape >= 0 && static_cast<std::size_t>(shape) < s.zones.size())
+    sh = &s.zones[static_cast<std::size_t>(shape)].shape;
   for (std::size_t i = 0; i < p.size(); ++i) out[i] = sh && q_.inside_shape(*sh, p[i]) ? 1 : 0;
 }
 

@@ -26,9 +26,15 @@ const AlgorithmEntry& builtin() {
   return e;
 }
 
-glm::vec3 glm_of(const growbench_vec3& v) { return {v.x, v.y, v.z}; }
-growbench_vec3 abi(const glm::vec3& v) { return {v.x, v.y, v.z}; }
-const growbench_vec3* abi(const glm::vec3* p) { return reinterpret_cast<const growbench_vec3*>(p); }
+glm::vec3 glm_of(const growbench_vec3& v) {
+  return {v.x, v.y, v.z};
+}
+growbench_vec3 abi(const glm::vec3& v) {
+  return {v.x, v.y, v.z};
+}
+const growbench_vec3* abi(const glm::vec3* p) {
+  return reinterpret_cast<const growbench_vec3*>(p);
+}
 
 TriangleMesh mesh_of(const growbench_mesh& m) {
   TriangleMesh t;
@@ -42,7 +48,7 @@ TriangleMesh mesh_of(const growbench_mesh& m) {
 
 Shape shape_of(const growbench_shape& s) {
   Shape r;
-  r.kind = s.kind == GROWBENCH_SHAPE_BOX       ? Shape::Kind::Box
+  r.kind = s.kind == GROWBENCH_SHAPE_BOX         ? Shape::Kind::Box
            : s.kind == GROWBENCH_SHAPE_ELLIPSOID ? Shape::Kind::Sphere
                                                  : Shape::Kind::Mesh;
   r.min = glm_of(s.min);
@@ -78,8 +84,8 @@ class TableQueries final : public HostQueries {
     std::vector<growbench_closest_hit> hits(p.size());
     h_.closest_points(h_.context, abi(p.data()), p.size(), max_distance, climbable_only ? 1 : 0, hits.data());
     for (std::size_t i = 0; i < p.size(); ++i)
-      out[i] = {hits[i].found != 0, glm_of(hits[i].point), glm_of(hits[i].normal), hits[i].distance, hits[i].mesh,
-                hits[i].triangle};
+      out[i] = {hits[i].found != 0, glm_of(hits[i].point), glm_of(hits[i].normal),
+                hits[i].distance,   hits[i].mesh,          hits[i].triangle};
   }
   static std::vector<growbench_ray> abi_rays(std::span<const Ray> r) {
     std::vector<growbench_ray> v(r.size());
@@ -91,8 +97,8 @@ class TableQueries final : public HostQueries {
     std::vector<growbench_ray_hit> hits(r.size());
     h_.rays(h_.context, rays.data(), rays.size(), hits.data());
     for (std::size_t i = 0; i < r.size(); ++i)
-      out[i] = {hits[i].hit != 0, hits[i].t, glm_of(hits[i].point), glm_of(hits[i].normal), hits[i].mesh,
-                hits[i].triangle};
+      out[i] = {hits[i].hit != 0,       hits[i].t,    glm_of(hits[i].point),
+                glm_of(hits[i].normal), hits[i].mesh, hits[i].triangle};
   }
   void occluded(std::span<const Ray> r, std::span<std::uint8_t> out) const override {
     const auto rays = abi_rays(r);
@@ -128,14 +134,18 @@ class TableQueries final : public HostQueries {
 sdk::Param row_of(const ParamSpec& s) {
   auto ranged = [&](sdk::Param p) { return std::move(p).range(s.min, s.max).unit(s.unit).doc(s.doc); };
   switch (s.type) {
-    case ParamType::Int: return ranged(sdk::integer(s.name, std::get<std::int64_t>(s.default_value)));
-    case ParamType::Real: return ranged(sdk::real(s.name, std::get<double>(s.default_value)));
+    case ParamType::Int:
+      return ranged(sdk::integer(s.name, std::get<std::int64_t>(s.default_value)));
+    case ParamType::Real:
+      return ranged(sdk::real(s.name, std::get<double>(s.default_value)));
     case ParamType::Vec3: {
       const glm::dvec3 d = std::get<glm::dvec3>(s.default_value);
       return ranged(sdk::vector3(s.name, d.x, d.y, d.z));
     }
-    case ParamType::Bool: return sdk::boolean(s.name, std::get<bool>(s.default_value)).unit(s.unit).doc(s.doc);
-    case ParamType::String: return sdk::text(s.name, std::get<std::string>(s.default_value)).unit(s.unit).doc(s.doc);
+    case ParamType::Bool:
+      return sdk::boolean(s.name, std::get<bool>(s.default_value)).unit(s.unit).doc(s.doc);
+    case ParamType::String:
+      return sdk::text(s.name, std::get<std::string>(s.default_value)).unit(s.unit).doc(s.doc);
     case ParamType::Choice:
       return sdk::choice(s.name, std::get<std::string>(s.default_value), s.choices).unit(s.unit).doc(s.doc);
   }
@@ -147,12 +157,22 @@ Params params_of(const AlgorithmInfo& info, const sdk::Params& given) {
   Params p(fmt::format("algorithm '{}'", GROWBENCH_PLUGIN_NAME), info.params);
   for (const ParamSpec& s : info.params) {
     switch (s.type) {
-      case ParamType::Int: p.set_json(s.name, given.integer(s.name)); break;
-      case ParamType::Real: p.set_json(s.name, given.real(s.name)); break;
-      case ParamType::Bool: p.set_json(s.name, given.boolean(s.name)); break;
+      case ParamType::Int:
+        p.set_json(s.name, given.integer(s.name));
+        break;
+      case ParamType::Real:
+        p.set_json(s.name, given.real(s.name));
+        break;
+      case ParamType::Bool:
+        p.set_json(s.name, given.boolean(s.name));
+        break;
       case ParamType::String:
-      case ParamType::Choice: p.set_json(s.name, given.text(s.name)); break;
-      case ParamType::Vec3: p.set_json(s.name, given.vector3(s.name)); break;
+      case ParamType::Choice:
+        p.set_json(s.name, given.text(s.name));
+        break;
+      case ParamType::Vec3:
+        p.set_json(s.name, given.vector3(s.name));
+        break;
     }
   }
   return p;
@@ -164,7 +184,8 @@ class Builtin final : public sdk::Algorithm {
     const AlgorithmInfo& i = builtin().info();
     std::vector<sdk::Param> rows;
     for (const ParamSpec& s : i.params) rows.push_back(row_of(s));
-    return {GROWBENCH_PLUGIN_NAME, i.summary + " (the built-in, as a plugin)", "builtin", std::move(rows), i.test_params};
+    return {GROWBENCH_PLUGIN_NAME, i.summary + " (the built-in, as a plugin)", "builtin", std::move(rows),
+            i.test_params};
   }
 
   void start(const sdk::Context& c) override {

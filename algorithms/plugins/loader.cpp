@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdlib>
 #include <deque>
 #include <filesystem>
@@ -40,7 +41,9 @@ bool valid_name(const char* s) {
   return true;
 }
 
-std::string text_or_empty(const char* s) { return s ? s : ""; }
+std::string text_or_empty(const char* s) {
+  return s ? s : "";
+}
 
 // One row of the plugin's table as a ParamSpec; throws std::invalid_argument saying what is wrong.
 ParamSpec read_row(const growbench_param& r) {
@@ -97,8 +100,7 @@ ParamSpec read_row(const growbench_param& r) {
         s.choices.emplace_back(r.choices[k]);
       }
       const std::string d = text_or_empty(r.default_value.text);
-      if (!seen.count(d))
-        throw std::invalid_argument(fmt::format("its default '{}' is not one of its choices", d));
+      if (!seen.count(d)) throw std::invalid_argument(fmt::format("its default '{}' is not one of its choices", d));
       s.default_value = d;
       break;
     }
@@ -108,14 +110,17 @@ ParamSpec read_row(const growbench_param& r) {
   return s;
 }
 
+// The table as ABI 1 first defined it, through `destroy`: members added later come after it, so a plugin
+// built before them still loads (and the host reads no member beyond its struct_size).
+constexpr std::size_t kTableSizeV1 = offsetof(growbench_plugin, destroy) + sizeof(growbench_plugin::destroy);
+
 // The plugin's descriptive members as an AlgorithmInfo; InputError naming the file for what is malformed.
 AlgorithmInfo read_table(const std::string& path, const growbench_plugin& t) {
   auto bad = [&](const std::string& what) {
     return InputError(fmt::format("{}: malformed plugin table: {}", path, what));
   };
-  if (t.struct_size < sizeof(growbench_plugin))
-    throw bad(fmt::format("struct_size {} is smaller than ABI {}'s {}", t.struct_size, t.abi_version,
-                          sizeof(growbench_plugin)));
+  if (t.struct_size < kTableSizeV1)
+    throw bad(fmt::format("struct_size {} is smaller than ABI {}'s {}", t.struct_size, t.abi_version, kTableSizeV1));
   if (!valid_name(t.name)) throw bad("its name must be non-empty and of a-z, 0-9 and _");
   if (!t.create || !t.start || !t.step || !t.finish || !t.plant || !t.destroy)
     throw bad("create, start, step, finish, plant and destroy must all be set");
@@ -168,9 +173,10 @@ const growbench_plugin* open_plugin(const std::string& path) {
   const growbench_plugin* t = entry();
   if (!t) throw InputError(fmt::format("{}: {}() returned NULL", path, GROWBENCH_PLUGIN_ENTRY_SYMBOL));
   if (t->abi_version != GROWBENCH_PLUGIN_ABI_VERSION)
-    throw InputError(fmt::format("{}: built for plugin ABI version {}, but this growbench speaks version {}; rebuild "
-                                 "it against this growbench's SDK",
-                                 path, t->abi_version, GROWBENCH_PLUGIN_ABI_VERSION));
+    throw InputError(
+        fmt::format("{}: built for plugin ABI version {}, but this growbench speaks version {}; rebuild "
+                    "it against this growbench's SDK",
+                    path, t->abi_version, GROWBENCH_PLUGIN_ABI_VERSION));
   return t;
 }
 
@@ -200,7 +206,9 @@ const AlgorithmEntry& load_plugin(const std::string& given) {
   Loaded& l = loaded().emplace_back(Loaded{path, std::move(info), {}});
   const AlgorithmInfo* ip = &l.info;
   l.entry = AlgorithmEntry{[ip]() -> const AlgorithmInfo& { return *ip; },
-                           [t, ip]() { return make_plugin_algorithm(t, *ip); }, {}, std::move(origin)};
+                           [t, ip]() { return make_plugin_algorithm(t, *ip); },
+                           {},
+                           std::move(origin)};
   return l.entry;
 }
 

@@ -20,20 +20,23 @@ namespace {
 static_assert(sizeof(glm::vec3) == sizeof(growbench_vec3) && std::is_standard_layout_v<glm::vec3>);
 static_assert(sizeof(glm::uvec3) == 3 * sizeof(std::uint32_t));
 
-const growbench_vec3* abi(const glm::vec3* p) { return reinterpret_cast<const growbench_vec3*>(p); }
-growbench_vec3 abi(const glm::vec3& p) { return {p.x, p.y, p.z}; }
-glm::vec3 glm_of(const growbench_vec3& p) { return {p.x, p.y, p.z}; }
+const growbench_vec3* abi(const glm::vec3* p) {
+  return reinterpret_cast<const growbench_vec3*>(p);
+}
+growbench_vec3 abi(const glm::vec3& p) {
+  return {p.x, p.y, p.z};
+}
+glm::vec3 glm_of(const growbench_vec3& p) {
+  return {p.x, p.y, p.z};
+}
 std::span<const glm::vec3> points(const growbench_vec3* p, std::uint64_t n) {
   return {reinterpret_cast<const glm::vec3*>(p), static_cast<std::size_t>(n)};
 }
 
 growbench_mesh mesh_view(const TriangleMesh& m, bool solid) {
-  return {m.name.c_str(),
-          abi(m.vertices.data()),
-          m.vertices.size(),
-          reinterpret_cast<const std::uint32_t*>(m.triangles.data()),
-          m.triangles.size(),
-          m.climbable ? 1 : 0,
+  return {m.name.c_str(),     abi(m.vertices.data()),
+          m.vertices.size(),  reinterpret_cast<const std::uint32_t*>(m.triangles.data()),
+          m.triangles.size(), m.climbable ? 1 : 0,
           solid ? 1 : 0};
 }
 
@@ -123,18 +126,21 @@ class PluginAlgorithm final : public GrowthAlgorithm {
   // The scene as arrays that point into `scene`, which outlives the algorithm.
   void describe_scene(const Scene& scene, const SceneQuery& query) {
     meshes_.clear();
-    for (std::size_t i = 0; i < scene.meshes.size(); ++i) meshes_.push_back(mesh_view(scene.meshes[i], query.mesh_solid()[i]));
+    for (std::size_t i = 0; i < scene.meshes.size(); ++i)
+      meshes_.push_back(mesh_view(scene.meshes[i], query.mesh_solid()[i]));
     seeds_.clear();
     for (const auto& s : scene.seeds) seeds_.push_back({abi(s.position), abi(s.direction), s.start_step});
     zones_.clear();
-    for (const auto& z : scene.zones) zones_.push_back({static_cast<std::int32_t>(z.kind), shape_view(z.shape), z.strength});
+    for (const auto& z : scene.zones)
+      zones_.push_back({static_cast<std::int32_t>(z.kind), shape_view(z.shape), z.strength});
     scene_ = {};
     scene_.name = scene.name.c_str();
     scene_.meshes = meshes_.data();
     scene_.mesh_count = static_cast<std::uint32_t>(meshes_.size());
     scene_.seeds = seeds_.data();
     scene_.seed_count = static_cast<std::uint32_t>(seeds_.size());
-    scene_.light = {scene.light.kind == Light::Kind::Point ? 1 : 0, abi(scene.light.direction), abi(scene.light.position)};
+    scene_.light = {scene.light.kind == Light::Kind::Point ? 1 : 0, abi(scene.light.direction),
+                    abi(scene.light.position)};
     scene_.has_envelope = scene.envelope ? 1 : 0;
     if (scene.envelope) scene_.envelope = shape_view(*scene.envelope);
     scene_.zones = zones_.data();
@@ -157,11 +163,19 @@ class PluginAlgorithm final : public GrowthAlgorithm {
     for (const ParamSpec& s : params.specs()) {
       growbench_value x{};
       switch (s.type) {
-        case ParamType::Int: x.integer = params.integer(s.name); break;
-        case ParamType::Real: x.real = params.real(s.name); break;
-        case ParamType::Bool: x.boolean = params.boolean(s.name) ? 1 : 0; break;
+        case ParamType::Int:
+          x.integer = params.integer(s.name);
+          break;
+        case ParamType::Real:
+          x.real = params.real(s.name);
+          break;
+        case ParamType::Bool:
+          x.boolean = params.boolean(s.name) ? 1 : 0;
+          break;
         case ParamType::String:
-        case ParamType::Choice: x.text = params.text(s.name).c_str(); break;
+        case ParamType::Choice:
+          x.text = params.text(s.name).c_str();
+          break;
         case ParamType::Vec3: {
           const glm::dvec3 d = params.vec3(s.name);
           x.vec3[0] = d.x;
@@ -195,7 +209,8 @@ class PluginAlgorithm final : public GrowthAlgorithm {
 
   void copy_plant(const growbench_plant_view& v) const {
     auto bad = [&](const std::string& what) {
-      return std::runtime_error(fmt::format("algorithm '{}' (a plugin) returned a malformed plant: {}", info_.name, what));
+      return std::runtime_error(
+          fmt::format("algorithm '{}' (a plugin) returned a malformed plant: {}", info_.name, what));
     };
     if ((v.node_count && !v.nodes) || (v.organ_count && !v.organs)) throw bad("a NULL array with a non-zero count");
     plant_.clear();
@@ -203,8 +218,8 @@ class PluginAlgorithm final : public GrowthAlgorithm {
     for (std::uint64_t i = 0; i < v.node_count; ++i) {
       const growbench_node& n = v.nodes[i];
       if (n.order > 0xFFFFu) throw bad(fmt::format("node {} has branch order {} (at most 65535)", i, n.order));
-      plant_.nodes.push_back({glm_of(n.position), n.radius, n.parent, static_cast<std::uint16_t>(n.order), n.shoot,
-                              n.birth_step});
+      plant_.nodes.push_back(
+          {glm_of(n.position), n.radius, n.parent, static_cast<std::uint16_t>(n.order), n.shoot, n.birth_step});
     }
     plant_.organs.reserve(v.organ_count);
     for (std::uint64_t i = 0; i < v.organ_count; ++i) {
@@ -244,7 +259,7 @@ class PluginAlgorithm final : public GrowthAlgorithm {
   std::vector<growbench_zone> zones_;
   mutable std::mutex fail_mutex_;
   mutable std::string failure_;
-  std::uint64_t version_ = 0;                // bumped by every call that may change the plant
+  std::uint64_t version_ = 0;                    // bumped by every call that may change the plant
   mutable std::uint64_t plant_version_ = ~0ull;  // the version plant_ was copied at
   mutable Plant plant_;
 
@@ -273,8 +288,8 @@ struct HostFunctions {
     std::vector<ClosestHit> hits(n);
     self(c).q_->closest_points(points(p, n), max_distance, climbable_only != 0, hits);
     for (std::uint64_t i = 0; i < n; ++i)
-      out[i] = {hits[i].found ? 1 : 0, abi(hits[i].point), abi(hits[i].normal), hits[i].distance, hits[i].mesh,
-                hits[i].triangle};
+      out[i] = {hits[i].found ? 1 : 0, abi(hits[i].point), abi(hits[i].normal),
+                hits[i].distance,      hits[i].mesh,       hits[i].triangle};
   }
   static std::vector<Ray> rays_of(const growbench_ray* r, std::uint64_t n) {
     std::vector<Ray> v(n);
@@ -285,7 +300,8 @@ struct HostFunctions {
     std::vector<RayHit> hits(n);
     self(c).q_->rays(rays_of(r, n), hits);
     for (std::uint64_t i = 0; i < n; ++i)
-      out[i] = {hits[i].hit ? 1 : 0, hits[i].t, abi(hits[i].point), abi(hits[i].normal), hits[i].mesh, hits[i].triangle};
+      out[i] = {hits[i].hit ? 1 : 0, hits[i].t,    abi(hits[i].point),
+                abi(hits[i].normal), hits[i].mesh, hits[i].triangle};
   }
   static void occluded(void* c, const growbench_ray* r, std::uint64_t n, std::uint8_t* out) {
     self(c).q_->occluded(rays_of(r, n), {out, static_cast<std::size_t>(n)});
@@ -295,8 +311,9 @@ struct HostFunctions {
     const HostQueries& q = *self(c).q_;
     if (!q.has_sdf()) return GROWBENCH_ERROR;
     q.signed_distance(points(p, n), {distance, static_cast<std::size_t>(n)},
-                      gradient ? std::span<glm::vec3>(reinterpret_cast<glm::vec3*>(gradient), static_cast<std::size_t>(n))
-                               : std::span<glm::vec3>());
+                      gradient
+                          ? std::span<glm::vec3>(reinterpret_cast<glm::vec3*>(gradient), static_cast<std::size_t>(n))
+                          : std::span<glm::vec3>());
     return GROWBENCH_OK;
   }
   static void inside(void* c, const growbench_vec3* p, std::uint64_t n, std::uint8_t* out) {
@@ -322,7 +339,8 @@ void PluginAlgorithm::make_host() {
   host_.abi_version = GROWBENCH_PLUGIN_ABI_VERSION;
   host_.struct_size = sizeof(growbench_host);
   host_.context = this;
-  host_.threads = static_cast<std::uint32_t>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+  host_.threads =
+      static_cast<std::uint32_t>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
   host_.log = &HostFunctions::log;
   host_.fail = &HostFunctions::fail;
   host_.cancelled = &HostFunctions::cancelled;

@@ -18,7 +18,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string fixture(const std::string& name) { return std::string(GROWBENCH_PLUGIN_DIR) + "/test/" + name + ".so"; }
+std::string fixture(const std::string& name) {
+  return std::string(GROWBENCH_PLUGIN_DIR) + "/test/" + name + ".so";
+}
 const std::string kSpacecolPlugin = std::string(GROWBENCH_PLUGIN_DIR) + "/spacecol_plugin.so";
 
 // A copy of a fixture under a fresh path: a clash test must not depend on what an earlier test loaded.
@@ -44,13 +46,13 @@ TEST(PluginLoader, AFileThatIsNotASharedLibrary) {
 TEST(PluginLoader, ALibraryWithoutTheEntryPoint) {
   const std::string p = copy_of("no_entry", "no_entry");
   EXPECT_EQ(load_error(p), p + ": no growbench_plugin_entry() entry point; is it a growbench plugin? (see "
-                                "docs/plugins.md)");
+                               "docs/plugins.md)");
 }
 
 TEST(PluginLoader, AnotherAbiVersionSaysBoth) {
   const std::string p = copy_of("abi_99", "abi_99");
   EXPECT_EQ(load_error(p), p + ": built for plugin ABI version 99, but this growbench speaks version 1; rebuild it "
-                                "against this growbench's SDK");
+                               "against this growbench's SDK");
 }
 
 TEST(PluginLoader, TheNameOfABuiltIn) {
@@ -81,8 +83,9 @@ TEST(PluginLoader, TheSameFileLoadsOnce) {
 }
 
 TEST(PluginLoader, ErrorsExitTwoFromTheCommandLine) {
-  for (const std::string& cmd : std::vector<std::string>{"list --plugin /nonexistent/walker.so", "run -a line -s wall --plugin " + fixture("abi_99"),
-                                 "list --plugin " + fixture("bad_table")}) {
+  for (const std::string& cmd : std::vector<std::string>{"list --plugin /nonexistent/walker.so",
+                                                         "run -a line -s wall --plugin " + fixture("abi_99"),
+                                                         "list --plugin " + fixture("bad_table")}) {
     const auto r = test::run_growbench(cmd);
     EXPECT_EQ(r.status, 2) << cmd << "\n" << r.out;
     EXPECT_NE(r.out.find("growbench: error: "), std::string::npos) << r.out;
@@ -170,7 +173,8 @@ TEST(CPlugin, ASuiteRecordsAMisbehavingPluginAndGoesOn) {
   test::write_text(dir / "suite.json", R"({"schema_version": 1, "name": "plugin_faults", "repetitions": 1,
     "warmup": 0, "timeout_s": 5, "memory_limit_mb": 1024, "plugins": ["line.so"], "scenes": ["wall"],
     "algorithms": [{"name": "line", "sweep": {"fault": ["crash", "hang", "oom", "fail", "none"]}}]})");
-  const auto r = test::run_growbench(fmt::format("suite {} -o {} -q", (dir / "suite.json").string(), (dir / "out").string()));
+  const auto r =
+      test::run_growbench(fmt::format("suite {} -o {} -q", (dir / "suite.json").string(), (dir / "out").string()));
   ASSERT_EQ(r.status, 0) << r.out;
   const ResultsFile res = read_results((dir / "out" / "results.json").string());
   std::map<std::string, std::string> status;

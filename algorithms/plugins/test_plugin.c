@@ -208,7 +208,11 @@ static const growbench_plugin kPlugin = {
     destroy};
 
 #if TEST_PLUGIN_VARIANT == 1
-GROWBENCH_PLUGIN_EXPORT const growbench_plugin* not_the_entry(void) { return &kPlugin; }
+GROWBENCH_PLUGIN_EXPORT const growbench_plugin* not_the_entry(void) {
+  return &kPlugin;
+}
 #else
-GROWBENCH_PLUGIN_EXPORT const growbench_plugin* growbench_plugin_entry(void) { return &kPlugin; }
+GROWBENCH_PLUGIN_EXPORT const growbench_plugin* growbench_plugin_entry(void) {
+  return &kPlugin;
+}
 #endif
