@@ -2,7 +2,8 @@
 # with growbench_add_plugin), and the data files the binary and its report read.
 #
 # Components, so the SDK can be installed from a configured tree before growbench is built:
-#   runtime  bin/growbench and share/growbench/ (report scripts, schema, bundled meshes, suites)
+#   runtime  bin/growbench and share/growbench/ (report scripts, schema, bundled meshes, L-system
+#            example grammars, suites)
 #   sdk      include/growbench/plugin.h, plugin.hpp and lib/cmake/growbench/
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
@@ -11,8 +12,9 @@ install(TARGETS growbench RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT 
 
 # The data keeps the checkout's layout under share/growbench, because report.py finds the results
 # schema and docs/metrics.md relative to itself. The binary itself still reads these from the source
-# path compiled into it (scenes/scene_io.cpp, harness/report/report.cpp); with the checkout gone,
-# GROWBENCH_REPORT_SCRIPT=P/share/growbench/reports/report.py points the report here.
+# paths compiled into it (scenes/scene_io.cpp, algorithms/lsystem/lsystem.cpp,
+# harness/report/report.cpp); with the checkout gone, only the report can be pointed here
+# (GROWBENCH_REPORT_SCRIPT=P/share/growbench/reports/report.py).
 set(GROWBENCH_INSTALL_DATADIR ${CMAKE_INSTALL_DATADIR}/growbench)
 install(FILES reports/report.py reports/history.py DESTINATION ${GROWBENCH_INSTALL_DATADIR}/reports COMPONENT runtime)
 install(FILES harness/record/results.schema.json DESTINATION ${GROWBENCH_INSTALL_DATADIR}/harness/record
@@ -20,6 +22,8 @@ install(FILES harness/record/results.schema.json DESTINATION ${GROWBENCH_INSTALL
 install(FILES docs/metrics.md DESTINATION ${GROWBENCH_INSTALL_DATADIR}/docs COMPONENT runtime)
 install(DIRECTORY scenes/meshes/ DESTINATION ${GROWBENCH_INSTALL_DATADIR}/scenes/meshes COMPONENT runtime
         FILES_MATCHING PATTERN "*.obj" PATTERN "*.md")
+install(DIRECTORY algorithms/lsystem/examples/ DESTINATION ${GROWBENCH_INSTALL_DATADIR}/algorithms/lsystem/examples
+        COMPONENT runtime FILES_MATCHING PATTERN "*.lsys")
 install(DIRECTORY bench/suites/ DESTINATION ${GROWBENCH_INSTALL_DATADIR}/suites COMPONENT runtime
         FILES_MATCHING PATTERN "*.json")
 
