@@ -161,7 +161,10 @@ class Walker final : public sdk::Algorithm {
     std::vector<growbench_closest_hit> hits(n);
     host().closest_points(candidates.data(), n, hits.data(), reach_, true);
     std::vector<Vec3> normals(n);
-    for (std::size_t i = 0; i < n; ++i) adhere(tips_[i], hits[i], candidates[i], normals[i]);
+    for (std::size_t i = 0; i < n; ++i) {
+      normals[i] = tips_[i].normal;
+      adhere(hits[i], candidates[i], normals[i]);
+    }
     // Refuse moves that end inside a solid or cross one on the way.
     std::vector<std::uint8_t> inside(n), crossed(n);
     host().inside(candidates.data(), n, inside.data());
@@ -237,24 +240,32 @@ class Walker final : public sdk::Algorithm {
            static_cast<std::uint64_t>(std::min(t.attempt, 0xffff));
   }
 
-  // Starts one root per seed whose start step has come, snapped to the surface nearest to it.
+  // Starts one root per seed whose start step has come, snapped to the surface nearest to it (unless
+  // that would put it inside a solid, as at a crease between two).
   void plant_seeds() {
+    std::vector<const growbench_seed*> starting;
     for (std::uint32_t s = 0; s < scene_->seed_count; ++s) {
-      const growbench_seed& seed = scene_->seeds[s];
-      last_start_step_ = std::max(last_start_step_, static_cast<std::uint32_t>(std::max(seed.start_step, 0)));
-      if (static_cast<std::uint32_t>(std::max(seed.start_step, 0)) != step_index_) continue;
+      const std::uint32_t start = static_cast<std::uint32_t>(std::max(scene_->seeds[s].start_step, 0));
+      last_start_step_ = std::max(last_start_step_, start);
+      if (start == step_index_) starting.push_back(&scene_->seeds[s]);
+    }
+    if (starting.empty()) return;
+    const std::size_t n = starting.size();
+    std::vector<Vec3> positions(n), normals(n, Vec3{0.0f, 1.0f, 0.0f});
+    for (std::size_t i = 0; i < n; ++i) positions[i] = starting[i]->position;
+    std::vector<growbench_closest_hit> hits(n);
+    host().closest_points(positions.data(), n, hits.data(), reach_, true);
+    for (std::size_t i = 0; i < n; ++i) adhere(hits[i], positions[i], normals[i]);
+    std::vector<std::uint8_t> inside(n);
+    host().inside(positions.data(), n, inside.data());
+    for (std::size_t i = 0; i < n; ++i) {
+      if (inside[i]) positions[i] = starting[i]->position;
       const Vec3 up{0.0f, 1.0f, 0.0f};
-      Vec3 position = seed.position, normal = up;
-      const growbench_closest_hit hit = host().closest_point(position, reach_, true);
-      if (hit.found) {
-        normal = outward(hit, position);
-        position = hit.point + cling_ * normal;
-      }
-      const Vec3 heading = normalized(tangential(normalized(seed.direction, up), normal), up);
-      const std::int32_t node = plant.add_node(position, tip_radius_, -1, 0, next_shoot_, step_index_);
+      const Vec3 heading = normalized(tangential(normalized(starting[i]->direction, up), normals[i]), up);
+      const std::int32_t node = plant.add_node(positions[i], tip_radius_, -1, 0, next_shoot_, step_index_);
       depth_.push_back(0);
-      normal_.push_back(normal);
-      tips_.push_back({node, heading, normal, 0, next_shoot_++, 0, 0, free_moves_});
+      normal_.push_back(normals[i]);
+      tips_.push_back({node, heading, normals[i], 0, next_shoot_++, 0, 0, free_moves_});
     }
   }
 
@@ -279,12 +290,10 @@ class Walker final : public sdk::Algorithm {
     return from + step_ * normalized(tangential(want, t.normal), t.heading);
   }
 
-  // Moves `candidate` onto the surface `hit` found (or leaves it, for a free move), and sets `normal`.
-  void adhere(const Tip& t, const growbench_closest_hit& hit, Vec3& candidate, Vec3& normal) const {
-    if (!hit.found) {
-      normal = t.normal;
-      return;
-    }
+  // Moves `candidate` onto the surface `hit` found and sets `normal` to the surface's; with no surface
+  // found, leaves both (a free move keeps the last normal).
+  void adhere(const growbench_closest_hit& hit, Vec3& candidate, Vec3& normal) const {
+    if (!hit.found) return;
     normal = outward(hit, candidate);
     candidate = hit.point + cling_ * normal;
   }
