@@ -2,7 +2,10 @@
 // limits, growth curves and animation frames work the same way for all of them.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
+#include <functional>
+#include <optional>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -11,7 +14,9 @@
 
 #include "algorithms/plant.hpp"
 #include "core/params.hpp"
+#include "core/plugin_origin.hpp"
 #include "scenes/scene.hpp"
+#include "scenes/host_queries.hpp"
 #include "scenes/scene_query.hpp"
 
 namespace growbench {
@@ -31,6 +36,9 @@ struct AlgorithmInfo {
 class GrowthAlgorithm {
  public:
   virtual ~GrowthAlgorithm() = default;
+  // The trial's time limit, set before start(): a step that can run long may check cancelled().
+  void set_deadline(std::chrono::steady_clock::time_point t) { deadline_ = t; }
+  [[nodiscard]] bool cancelled() const { return deadline_ && std::chrono::steady_clock::now() > *deadline_; }
   [[nodiscard]] virtual const AlgorithmInfo& describe() const = 0;
   // Prepares a run. `params` were validated against describe().params. The scene and query outlive
   // the algorithm. Throws InputError for combinations of parameters and scene that cannot work.
@@ -47,6 +55,21 @@ class GrowthAlgorithm {
   virtual void finish() {}
   // Algorithm-specific figures for the trial record (e.g. attraction points left).
   [[nodiscard]] virtual std::vector<std::pair<std::string, double>> stats() const { return {}; }
+
+ private:
+  std::optional<std::chrono::steady_clock::time_point> deadline_;
+};
+
+// An algorithm that asks the scene only what the plugin ABI's host table offers (HostQueries). The same
+// source builds into the binary, where its queries are the SceneQuery's own, and as a plugin
+// (growbench_builtin_plugin in algorithms/plugins/), where they cross the C ABI: which is how the
+// boundary is shown to lose nothing.
+class PortableGrowthAlgorithm : public GrowthAlgorithm {
+ public:
+  virtual void start_with(const Scene& scene, const HostQueries& queries, const Params& params, std::uint64_t seed) = 0;
+  void start(const Scene& scene, const SceneQuery& query, const Params& params, std::uint64_t seed) final {
+    start_with(scene, query.host_queries(), params, seed);
+  }
 };
 
 // A struct an algorithm reads its parameters into, as its registration names it.
@@ -58,16 +81,19 @@ struct ParamStruct {
 };
 
 struct AlgorithmEntry {
-  const AlgorithmInfo& (*info)();
-  std::unique_ptr<GrowthAlgorithm> (*make)();
-  std::vector<ParamStruct> param_structs;
+  std::function<const AlgorithmInfo&()> info;
+  std::function<std::unique_ptr<GrowthAlgorithm>()> make;
+  std::vector<ParamStruct> param_structs;        // built-ins only
+  std::shared_ptr<const PluginOrigin> plugin{};  // null for a built-in
 };
 
 // Every algorithm, in the order of the add_subdirectory lines in algorithms/CMakeLists.txt (the order
 // `growbench list` prints). The build generates it from the algorithms' growbench_algorithm() calls, so
 // adding an algorithm is its folder plus one line there.
 const std::vector<AlgorithmEntry>& algorithm_registry();
-// Finds an algorithm by name; InputError listing the valid names otherwise.
+// The built-ins, then the plugins loaded so far (algorithms/plugins/loader.hpp), in loading order.
+std::vector<const AlgorithmEntry*> all_algorithms();
+// Finds an algorithm, built-in or loaded plugin, by name; InputError listing the valid names otherwise.
 const AlgorithmEntry& find_algorithm(const std::string& name);
 // Default parameters of an algorithm, with `owner` set for error messages.
 Params default_params(const AlgorithmEntry& entry);

@@ -5,15 +5,23 @@
 #include <fmt/format.h>
 
 #include "algorithms/algorithm.hpp"
+#include "algorithms/plugins/loader.hpp"
 
 namespace growbench {
 
+std::vector<const AlgorithmEntry*> all_algorithms() {
+  std::vector<const AlgorithmEntry*> list;
+  for (const auto& e : algorithm_registry()) list.push_back(&e);
+  for (const AlgorithmEntry* e : plugin_algorithms()) list.push_back(e);
+  return list;
+}
+
 const AlgorithmEntry& find_algorithm(const std::string& name) {
-  const auto& list = algorithm_registry();
-  for (const auto& e : list)
-    if (e.info().name == name) return e;
+  const auto list = all_algorithms();
+  for (const AlgorithmEntry* e : list)
+    if (e->info().name == name) return *e;
   std::vector<std::string> names;
-  for (const auto& e : list) names.push_back(e.info().name);
+  for (const AlgorithmEntry* e : list) names.push_back(e->info().name);
   const std::string near = closest_match(name, names);
   throw InputError(fmt::format("unknown algorithm '{}'{}; expected one of {}", name,
                                near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near), fmt::join(names, ", ")));
@@ -24,29 +32,6 @@ Params default_params(const AlgorithmEntry& entry) {
   Params p(fmt::format("algorithm '{}'", info.name), info.params);
   if (!info.presets.empty()) p.set_presets(info.presets);
   return p;
-}
-
-std::vector<std::string> split_type_list(std::string_view list, std::size_t count) {
-  auto trim = [](std::string_view t) {
-    while (!t.empty() && t.front() == ' ') t.remove_prefix(1);
-    while (!t.empty() && t.back() == ' ') t.remove_suffix(1);
-    return std::string(t);
-  };
-  std::vector<std::string> names;
-  int depth = 0;
-  std::size_t start = 0;
-  for (std::size_t i = 0; i < list.size(); ++i) {
-    const char c = list[i];
-    if (c == '<' || c == '(') ++depth;
-    if (c == '>' || c == ')') --depth;
-    if (c == ',' && depth == 0) {
-      names.push_back(trim(list.substr(start, i - start)));
-      start = i + 1;
-    }
-  }
-  names.push_back(trim(list.substr(start)));
-  if (names.size() != count) names.assign(count, trim(list));
-  return names;
 }
 
 }  // namespace growbench

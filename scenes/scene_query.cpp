@@ -12,6 +12,7 @@
 #include "core/kdtree.hpp"
 #include "core/random.hpp"
 #include "scenes/geometry.hpp"
+#include "scenes/host_queries.hpp"
 #include "scenes/sdf.hpp"
 
 namespace growbench {
@@ -301,6 +302,7 @@ struct SceneQuery::Embree {
 
 SceneQuery::SceneQuery(const Scene& scene, SceneQueryOptions options)
     : scene_(scene), options_(options), embree_(std::make_unique<Embree>()) {
+  host_queries_ = std::make_unique<DirectQueries>(*this);
   if (scene.meshes.empty()) throw InputError(fmt::format("scene '{}' has no meshes", scene.name));
   for (const auto& m : scene.meshes)
     if (m.triangles.empty())

@@ -58,7 +58,8 @@ struct SurfaceSample {
   std::uint32_t mesh = 0, triangle = 0;
 };
 
-class SdfGrid;  // OpenVDB, in sdf.cpp only
+class SdfGrid;      // OpenVDB, in sdf.cpp only
+class HostQueries;  // scenes/host_queries.hpp
 
 // An Embree BVH over caller-given boxes (user geometry), for "which of these regions hold p" and
 // "which does this segment pass through" queries: the ivy's Luft adhesion asks which triangles'
@@ -187,6 +188,9 @@ class SceneQuery {
   [[nodiscard]] double sampled_area() const { return total_area_; }
 
   [[nodiscard]] const Scene& scene() const { return scene_; }
+  // These queries through the plugin ABI's interface (scenes/host_queries.hpp). Inline, so that an
+  // algorithm built as a plugin, which never has a SceneQuery, links without this file.
+  [[nodiscard]] const HostQueries& host_queries() const { return *host_queries_; }
   [[nodiscard]] float voxel_size() const { return voxel_size_; }
   [[nodiscard]] float band_width() const { return voxel_size_ * options_.band_voxels; }
   [[nodiscard]] bool has_sdf() const { return sdf_ != nullptr; }
@@ -215,6 +219,7 @@ class SceneQuery {
   std::vector<double> cdf_;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> cdf_tri_;
   double total_area_ = 0.0;
+  std::unique_ptr<HostQueries> host_queries_;
 };
 
 }  // namespace growbench

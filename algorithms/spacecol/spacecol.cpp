@@ -136,11 +136,11 @@ struct Pull {
   std::uint32_t count = 0;
 };
 
-class SpaceColonization final : public GrowthAlgorithm {
+class SpaceColonization final : public PortableGrowthAlgorithm {
  public:
   const AlgorithmInfo& describe() const override { return kInfo; }
 
-  void start(const Scene& scene, const SceneQuery& query, const Params& p, std::uint64_t seed) override {
+  void start_with(const Scene& scene, const HostQueries& query, const Params& p, std::uint64_t seed) override {
     scene_ = &scene;
     query_ = &query;
     seed_ = seed;
@@ -209,8 +209,9 @@ class SpaceColonization final : public GrowthAlgorithm {
         include_ok = false;
       }
     }
-    for (const auto& z : scene_->zones) {
-      const bool in = query_->inside_shape(z.shape, q);
+    for (std::size_t zi = 0; zi < scene_->zones.size(); ++zi) {
+      const Zone& z = scene_->zones[zi];
+      const bool in = query_->inside_shape(static_cast<int>(zi), q);
       if (in && (z.kind == Zone::Kind::Exclude || z.kind == Zone::Kind::Repel)) return false;
       if (in && z.kind == Zone::Kind::Include) include_ok = true;
     }
@@ -269,7 +270,7 @@ class SpaceColonization final : public GrowthAlgorithm {
                 q = env.center + rng.in_unit_ball() * env.radii;
               else
                 q = b.min + glm::vec3(rng.uniform(), rng.uniform(), rng.uniform()) * b.size();
-              if (env.kind != Shape::Kind::Mesh || query_->inside_shape(env, q)) return q;
+              if (env.kind != Shape::Kind::Mesh || query_->inside_shape(kEnvelopeShape, q)) return q;
             }
             return glm::vec3(std::numeric_limits<float>::quiet_NaN());
           },
@@ -406,10 +407,11 @@ class SpaceColonization final : public GrowthAlgorithm {
     if (cfg_.surface == Surface::Free) return c;
     // A few fixed-point iterations: the SDF gradient is that of a trilinear field, so one push lands close.
     for (int it = 0; it < 3; ++it) {
-      const float d = query_->signed_distance(c);
+      glm::vec3 g;
+      const float d = query_->signed_distance(c, g);
       if (cfg_.surface == Surface::Avoid && d >= cfg_.cling_distance) break;
       if (std::abs(d - cfg_.cling_distance) < 1e-3f * cfg_.step) break;
-      c += (cfg_.cling_distance - d) * query_->gradient(c);
+      c += (cfg_.cling_distance - d) * g;
     }
     return c;
   }
@@ -746,7 +748,7 @@ class SpaceColonization final : public GrowthAlgorithm {
 
   // ---------- state ----------
   const Scene* scene_ = nullptr;
-  const SceneQuery* query_ = nullptr;
+  const HostQueries* query_ = nullptr;
   std::uint64_t seed_ = 0;
   spacecol::Config cfg_{};  // set by start()
   bool ever_influenced_ = false;

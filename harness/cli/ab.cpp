@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "algorithms/plugins/loader.hpp"
 #include "harness/cli/command.hpp"
 #include "harness/gate/ab.hpp"
 #include "harness/suite/suite.hpp"
@@ -17,9 +18,11 @@ namespace {
 struct AbArgs {
   AbOptions options;
   std::string suite;
+  std::vector<std::string> plugins;
 };
 
 int run_ab_suite(const AbArgs& a) {
+  load_plugins(a.plugins);  // each side's trials load them again: their specs list every plugin loaded
   const Suite suite = load_suite(a.suite);
   const AbResult r = run_ab(suite, a.options);
   fmt::print("{}", r.table);
@@ -40,6 +43,7 @@ Command add_ab(CLI::App& app) {
   cmd->add_option("b", o.b_binary, "the candidate growbench binary")->required();
   cmd->add_option("suite", a->suite, "suite file (its cells, seeds and limits; its repetitions are not used)")
       ->required();
+  add_plugin_option(cmd, a->plugins);
   cmd->add_option("-o,--out", o.out_dir, "output directory: ab.json and the trials (default: out/ab/SUITE)");
   cmd->add_option("--effect", o.effect, "the smallest median ratio B/A to detect")->default_val(1.03);
   cmd->add_option("--alpha", o.alpha, "significance level of the Mann-Whitney U test")->default_val(0.01);

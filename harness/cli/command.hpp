@@ -5,6 +5,8 @@
 #pragma once
 
 #include <functional>
+#include <string>
+#include <vector>
 
 namespace CLI {
 class App;
@@ -17,6 +19,11 @@ struct Command {
   // Its exit status. Bad input throws InputError (main exits 2), any other failure another exception (1).
   std::function<int()> run;
 };
+
+// Adds --plugin PATH (repeatable), bound to `paths`, to a command that looks algorithms up. The command
+// loads them (algorithms/plugins/loader.hpp's load_plugins, which adds GROWBENCH_PLUGIN_PATH's) first
+// thing when it runs.
+void add_plugin_option(CLI::App* cmd, std::vector<std::string>& paths);
 
 Command add_list(CLI::App& app);
 Command add_scenes(CLI::App& app);

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "algorithms/algorithm.hpp"
+#include "algorithms/plugins/loader.hpp"
 #include "harness/cli/command.hpp"
 #include "harness/cli/param_table.hpp"
 
@@ -18,10 +19,21 @@ namespace {
 struct ListArgs {
   std::string name;
   bool markdown = false;
+  std::vector<std::string> plugins;
 };
 
-void print_text(const AlgorithmInfo& info) {
-  fmt::print("{}\n  {}\n", info.name, info.summary);
+// A plugin's provenance, as its records name it.
+std::string plugin_line(const AlgorithmEntry& e) {
+  if (!e.plugin) return "";
+  const PluginOrigin& p = *e.plugin;
+  return fmt::format("plugin {} (version {}, ABI {}, xxh3 {})", p.path, p.version.empty() ? "-" : p.version,
+                     p.abi_version, p.hash);
+}
+
+void print_text(const AlgorithmEntry& e) {
+  const AlgorithmInfo& info = e.info();
+  fmt::print("{}{}\n  {}\n", info.name, e.plugin ? "  [plugin]" : "", info.summary);
+  if (e.plugin) fmt::print("  {}\n", plugin_line(e));
   print_param_table(info.params);
   for (const auto& preset : info.presets) {
     std::vector<std::string> kv;
@@ -45,20 +57,23 @@ std::string markdown_of(const AlgorithmInfo& info) {
 }
 
 int list_algorithms(const ListArgs& a) {
+  load_plugins(a.plugins);
   if (!a.name.empty()) {
-    const AlgorithmInfo& info = find_algorithm(a.name).info();
+    const AlgorithmEntry& e = find_algorithm(a.name);
     if (a.markdown)
-      fmt::print("{}", markdown_of(info));
+      fmt::print("{}", markdown_of(e.info()));
     else
-      print_text(info);
+      print_text(e);
     return 0;
   }
   bool first = true;
-  for (const auto& e : algorithm_registry()) {
+  for (const AlgorithmEntry* e : all_algorithms()) {
+    const std::string origin = e->plugin ? fmt::format("\n\n{}", plugin_line(*e)) : "";
     if (a.markdown)
-      fmt::print("{}## {}\n\n{}\n\n{}", first ? "" : "\n", e.info().name, e.info().summary, markdown_of(e.info()));
+      fmt::print("{}## {}\n\n{}{}\n\n{}", first ? "" : "\n", e->info().name, e->info().summary, origin,
+                 markdown_of(e->info()));
     else
-      print_text(e.info());
+      print_text(*e);
     first = false;
   }
   return 0;
@@ -70,6 +85,7 @@ Command add_list(CLI::App& app) {
   auto* cmd = app.add_subcommand("list", "List the algorithms and their parameter tables");
   auto a = std::make_shared<ListArgs>();
   cmd->add_option("name", a->name, "only this algorithm");
+  add_plugin_option(cmd, a->plugins);
   cmd->add_flag("--markdown", a->markdown,
                 "the parameter tables as Markdown (name, type, default, allowed, unit, doc), as the algorithms' "
                 "READMEs carry them (scripts/readme-params)");

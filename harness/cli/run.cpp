@@ -124,6 +124,7 @@ Command add_run(CLI::App& app) {
   run->add_option("--scene-param", spec.scene_params, "scene parameter key=value (repeatable)");
   run->add_option("--seed", spec.seed, "random seed")->default_val(1);
   run->add_option("--set", spec.params, "algorithm parameter key=value (repeatable)");
+  add_plugin_option(run, spec.plugins);
   run->add_option("--seed-at", a->seed_at,
                   "seed position X,Y,Z, snapped to the nearest surface (repeatable; replaces the scene's seeds)");
   run->add_option("--max-steps", spec.max_steps, "step cap")->default_val(5000);

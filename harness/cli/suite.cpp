@@ -4,10 +4,12 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "algorithms/plugins/loader.hpp"
 #include "core/errors.hpp"
 #include "harness/cli/command.hpp"
 #include "harness/gate/history.hpp"
@@ -26,6 +28,7 @@ struct SuiteArgs {
   int repetitions = 0;
   bool instructions = false;
   std::string render, history;
+  std::vector<std::string> plugins;
 };
 
 // --shard I/N into `o`.
@@ -57,6 +60,7 @@ int run_suite_file(const SuiteArgs& a) {
   // First, while this process is small: the launcher that forks the trials (harness/run/process.hpp).
   std::unique_ptr<Launcher> launcher;
   if (!a.instructions) launcher = start_trial_launcher();
+  load_plugins(a.plugins);
   Suite suite = load_suite(a.file);
   if (a.repetitions > 0) suite.repetitions = a.repetitions;
   SuiteRunOptions o;
@@ -90,6 +94,7 @@ Command add_suite(CLI::App& app) {
   auto a = std::make_shared<SuiteArgs>();
   cmd->add_option("file", a->file, "suite file (e.g. bench/suites/quick.json)")->required();
   cmd->add_option("-o,--out", a->out, "results directory (default: out/suites/NAME)");
+  add_plugin_option(cmd, a->plugins);
   cmd->add_flag("--resume", a->resume, "continue an interrupted run in --out, skipping finished trials");
   cmd->add_option("--shard", a->shard, "run only shard I of N (I/N, 0-based): a deterministic slice of the cells");
   cmd->add_flag("-q,--quiet", a->quiet, "no progress lines");

@@ -340,6 +340,19 @@ void read(const Node& n, FramesInfo& v) {
   f.done();
 }
 
+json to_json(const PluginOrigin& v) {
+  return {{"name", v.name}, {"path", v.path}, {"hash", v.hash}, {"abi_version", v.abi_version}, {"version", v.version}};
+}
+void read(const Node& n, PluginOrigin& v) {
+  Fields f(n);
+  f.required("name", v.name);
+  f.required("path", v.path);
+  f.required("hash", v.hash);
+  f.required("abi_version", v.abi_version);
+  f.field("version", v.version);
+  f.done();
+}
+
 json to_json(const RunContext& v) {
   json j = {{"growbench_commit", v.growbench_commit},
             {"dirty", v.dirty},
@@ -357,6 +370,11 @@ json to_json(const RunContext& v) {
   put(j, "suite_file_hash", v.suite_file_hash);
   put(j, "parent_threads_at_fork", v.parent_threads_at_fork);
   put(j, "mixed_machines", v.mixed_machines);
+  if (!v.plugins.empty()) {
+    json list = json::array();
+    for (const auto& p : v.plugins) list.push_back(to_json(p));
+    j["plugins"] = std::move(list);
+  }
   return j;
 }
 void read(const Node& n, RunContext& v) {
@@ -377,6 +395,7 @@ void read(const Node& n, RunContext& v) {
   f.field("suite_file_hash", v.suite_file_hash);
   f.field("parent_threads_at_fork", v.parent_threads_at_fork);
   f.field("mixed_machines", v.mixed_machines);
+  f.field("plugins", v.plugins);
   f.done();
 }
 
@@ -508,6 +527,7 @@ json to_json(const TrialSpecRecord& v) {
   put(j, "out_dir", v.out_dir);
   put(j, "context", v.context);
   put(j, "skip_teardown", v.skip_teardown);
+  put(j, "plugins", v.plugins);
   return j;
 }
 void read(const Node& n, TrialSpecRecord& v) {
@@ -532,6 +552,7 @@ void read(const Node& n, TrialSpecRecord& v) {
   f.field("out_dir", v.out_dir);
   f.field("context", v.context);
   f.field("skip_teardown", v.skip_teardown);
+  f.field("plugins", v.plugins);
   f.done();
 }
 

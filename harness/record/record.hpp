@@ -24,6 +24,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/plugin_origin.hpp"
+
 namespace growbench {
 
 // The version of every document below. A field is only ever added; renaming or retyping one bumps this,
@@ -110,6 +112,8 @@ struct RunContext {
   std::optional<std::string> suite_file_hash;
   std::optional<int> parent_threads_at_fork;
   std::optional<bool> mixed_machines;  // merged shards that ran on different machines or builds
+  // Every plugin loaded: a result says exactly what ran (absent when there were none).
+  std::vector<PluginOrigin> plugins;
 };
 
 // One render (growbench render): harness/render/render.hpp's RenderResult and how it was made. Paths are
@@ -184,6 +188,7 @@ struct TrialSpecRecord {
   // Only in the job a suite sends a trial's process (never in results).
   std::optional<std::string> out_dir;
   std::optional<bool> context, skip_teardown;
+  std::optional<std::vector<std::string>> plugins;  // every plugin the writing process had loaded
 };
 
 // ---------------------------------------------------------------- a suite

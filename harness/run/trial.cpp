@@ -25,7 +25,9 @@
 #include <xxhash.h>
 
 #include "algorithms/algorithm.hpp"
+#include "algorithms/plugins/loader.hpp"
 #include "core/errors.hpp"
+#include "core/file_hash.hpp"
 #include "harness/record/files.hpp"
 #include "harness/record/record.hpp"
 #include "harness/run/alloc_counter.hpp"
@@ -208,15 +210,7 @@ void inject_fault(const std::string& fault) {
 // The running binary's content hash: what identifies the build whose timings these are, whatever the
 // source tree's state is by the time it runs (a commit made while a sharded run is under way).
 std::string binary_hash() {
-  std::ifstream in("/proc/self/exe", std::ios::binary);
-  XXH3_state_t* st = XXH3_createState();
-  XXH3_64bits_reset(st);
-  std::vector<char> buf(1 << 16);
-  while (in.read(buf.data(), static_cast<std::streamsize>(buf.size())) || in.gcount() > 0)
-    XXH3_64bits_update(st, buf.data(), static_cast<std::size_t>(in.gcount()));
-  const std::uint64_t h = XXH3_64bits_digest(st);
-  XXH3_freeState(st);
-  return in.bad() ? std::string("unknown") : fmt::format("{:016x}", h);
+  return file_hash("/proc/self/exe");
 }
 
 RunContext run_context_record() {
@@ -249,6 +243,7 @@ RunContext run_context_record() {
   c.hardware_threads = std::thread::hardware_concurrency();
   c.date = date;
   c.alloc_counting = alloc_counting_enabled();
+  c.plugins = loaded_plugins();
   c.dependencies = {{"embree", fmt::format("{}.{}.{}", RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH)},
                     {"openvdb", OPENVDB_LIBRARY_VERSION_STRING},
                     {"tbb", TBB_VERSION_STRING},
@@ -305,6 +300,7 @@ TrialSpec trial_spec_of(const TrialSpecRecord& r) {
   s.context = r.context.value_or(true);
   s.skip_teardown = r.skip_teardown.value_or(false);
   s.fault = r.fault;
+  s.plugins = r.plugins.value_or(std::vector<std::string>{});
   return s;
 }
 
@@ -398,6 +394,10 @@ void grow(const TrialSpec& spec, const Params& params, TrialState& st, PhaseTime
   FrameCapture frames{spec};
   timer.run("growth", rec.phases.growth, [&] {
     inject_fault(spec.fault);
+    if (spec.time_limit_s > 0.0)
+      algo.set_deadline(std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(spec.time_limit_s)));
     algo.start(st.scene, *st.query, params, spec.seed);
     const auto t0 = std::chrono::steady_clock::now();
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
@@ -484,6 +484,7 @@ void mesh_export_measure(const TrialSpec& spec, const MesherOptions& mesher, Tri
 
 TrialRecord run_trial_record(const TrialSpec& spec, const std::function<void(const Progress&)>& progress,
                              Plant* plant_out) {
+  load_plugins(spec.plugins);
   const AlgorithmEntry& entry = find_algorithm(spec.algorithm);
   const Params params = checked_params(spec, entry);
   // A custom leaf is read first: a bad file is invalid input before anything is grown.

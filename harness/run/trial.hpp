@@ -44,6 +44,9 @@ struct TrialSpec {
   // For testing the harness only: "crash" (SIGSEGV), "hang", "oom" (allocate until refused) at the
   // start of growth, "throw" (an internal error). Empty in real use.
   std::string fault;
+  // Plugin files to load before the trial looks up its algorithm: what a trial's own process (a suite's
+  // forked or callgrind child, an A/B side) needs to find a plugin algorithm. Never in results.
+  std::vector<std::string> plugins;
 };
 
 struct Progress {

@@ -24,6 +24,7 @@
 #include <xxhash.h>
 
 #include "algorithms/algorithm.hpp"
+#include "algorithms/plugins/loader.hpp"
 #include "core/errors.hpp"
 #include "core/json_util.hpp"
 #include "harness/output/exporters.hpp"
@@ -76,13 +77,14 @@ class SuiteReader : public JsonPathReader {
     const json j = parse_json_file_text(file(), text);
     only_keys(j, "",
               {"schema_version", "name", "description", "repetitions", "warmup", "threads", "timeout_s",
-               "memory_limit_mb", "max_steps", "seeds", "budget", "scenes", "algorithms"});
+               "memory_limit_mb", "max_steps", "seeds", "budget", "scenes", "algorithms", "plugins"});
     if (!j.contains("schema_version") || j["schema_version"] != 1) fail("/schema_version", "expected 1");
     Suite s;
     s.file = file();
     s.hash = fmt::format("{:016x}", XXH3_64bits(text.data(), text.size()));
     const Common common = read_settings(j, s);
     const std::vector<SceneEntry> scenes = read_scenes(j);
+    load_listed_plugins(j);
     const std::vector<AlgoEntry> algos = read_algorithms(j);
     make_cells(common, scenes, algos, s);
     return s;
@@ -112,6 +114,21 @@ class SuiteReader : public JsonPathReader {
       return n;
     }
   };
+
+  // "plugins": files relative to the suite file, loaded before its algorithms are looked up.
+  void load_listed_plugins(const json& j) const {
+    if (!j.contains("plugins")) return;
+    if (!j["plugins"].is_array()) fail("/plugins", "expected an array of plugin files");
+    for (std::size_t i = 0; i < j["plugins"].size(); ++i) {
+      const std::string path = fmt::format("/plugins/{}", i);
+      if (!j["plugins"][i].is_string()) fail(path, "expected a plugin file's path");
+      try {
+        load_plugin(relative_to_suite(j["plugins"][i].get<std::string>()));
+      } catch (const InputError& e) {
+        fail(path, e.what());
+      }
+    }
+  }
 
   Common read_settings(const json& j, Suite& s) const {
     s.name = j.value("name", fs::path(file()).stem().string());
@@ -682,6 +699,9 @@ json trial_job(const SuiteConfig& c, const std::string& dir) {
   spec.out_dir = dir;
   spec.context = false;
   spec.skip_teardown = true;
+  std::vector<std::string> plugins;
+  for (const auto& p : loaded_plugins()) plugins.push_back(p.path);
+  if (!plugins.empty()) spec.plugins = std::move(plugins);
   return to_json(spec);
 }
 

@@ -50,8 +50,9 @@ typedef struct growbench_vec3 {
  * host->fail() with a message. */
 typedef enum growbench_status {
   GROWBENCH_OK = 0,
-  GROWBENCH_INPUT_ERROR = 1, /* the parameters or the scene cannot work (the trial is invalid_input) */
-  GROWBENCH_ERROR = 2        /* anything else (the trial failed) */
+  GROWBENCH_INPUT_ERROR = 1,  /* the parameters or the scene cannot work (the trial is invalid_input) */
+  GROWBENCH_ERROR = 2,        /* anything else (the trial failed) */
+  GROWBENCH_OUT_OF_MEMORY = 3 /* an allocation was refused (the trial ran out of memory) */
 } growbench_status;
 
 /* ------------------------------------------------------------------ the parameter table */
@@ -83,10 +84,10 @@ typedef struct growbench_param {
   /* INT, REAL and each VEC3 component: the closed range allowed; -HUGE_VAL and HUGE_VAL (math.h)
    * for any finite value. Ignored for the other types. */
   double min, max;
-  const char* unit;                 /* "m", "deg", ... or NULL */
-  const char* doc;                  /* one line */
-  const char* const* choices;       /* CHOICE: the allowed values */
-  uint32_t choice_count;            /* CHOICE: how many; the default must be one of them */
+  const char* unit;           /* "m", "deg", ... or NULL */
+  const char* doc;            /* one line */
+  const char* const* choices; /* CHOICE: the allowed values */
+  uint32_t choice_count;      /* CHOICE: how many; the default must be one of them */
 } growbench_param;
 
 /* ------------------------------------------------------------------ the scene */
@@ -115,10 +116,10 @@ typedef enum growbench_shape_kind {
 
 /* An envelope or zone. Test whether a point is inside with host->inside_shape(). */
 typedef struct growbench_shape {
-  int32_t kind;                     /* growbench_shape_kind */
-  growbench_vec3 min, max;          /* BOX; for the others, their bounds */
-  growbench_vec3 center, radii;     /* ELLIPSOID */
-  growbench_mesh mesh;              /* MESH: a closed mesh */
+  int32_t kind;                 /* growbench_shape_kind */
+  growbench_vec3 min, max;      /* BOX; for the others, their bounds */
+  growbench_vec3 center, radii; /* ELLIPSOID */
+  growbench_mesh mesh;          /* MESH: a closed mesh */
 } growbench_shape;
 
 typedef enum growbench_zone_kind {
@@ -187,10 +188,7 @@ typedef struct growbench_surface_sample {
   uint32_t mesh, triangle;
 } growbench_surface_sample;
 
-typedef enum growbench_log_level {
-  GROWBENCH_LOG_INFO = 0,
-  GROWBENCH_LOG_WARNING = 1
-} growbench_log_level;
+typedef enum growbench_log_level { GROWBENCH_LOG_INFO = 0, GROWBENCH_LOG_WARNING = 1 } growbench_log_level;
 
 /* The envelope's index for inside_shape(); zones are 0 .. zone_count - 1. */
 #define GROWBENCH_ENVELOPE (-1)
@@ -234,8 +232,7 @@ typedef struct growbench_host {
   void (*inside_shape)(void* context, int32_t shape, const growbench_vec3* points, uint64_t n, uint8_t* out);
   /* Area-weighted uniform samples on the climbable meshes (all when none is): sample i is a pure
    * function of (seed, first_index + i). */
-  void (*sample_surface)(void* context, uint64_t seed, uint64_t first_index, uint64_t n,
-                         growbench_surface_sample* out);
+  void (*sample_surface)(void* context, uint64_t seed, uint64_t first_index, uint64_t n, growbench_surface_sample* out);
   /* Whether each point sees the scene's light (a ray towards it, started `bias` along it): 1 or 0. */
   void (*light_visible)(void* context, const growbench_vec3* points, uint64_t n, float bias, uint8_t* out);
 } growbench_host;

@@ -17,6 +17,7 @@
 // invalid-input trial and any other std::exception into a failed one, with its message.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -36,7 +37,9 @@
 namespace growbench::sdk {
 
 using Vec3 = growbench_vec3;
-inline Vec3 vec3(float x, float y, float z) { return Vec3{x, y, z}; }
+inline Vec3 vec3(float x, float y, float z) {
+  return Vec3{x, y, z};
+}
 
 // Thrown for parameters or a scene the algorithm cannot work with (the trial becomes invalid_input).
 struct InputError : std::runtime_error {
@@ -137,7 +140,8 @@ class Info {
       r.name = p.name_.c_str();
       r.type = p.type_;
       r.default_value = p.default_;
-      if (p.type_ == GROWBENCH_PARAM_STRING || p.type_ == GROWBENCH_PARAM_CHOICE) r.default_value.text = p.default_text_.c_str();
+      if (p.type_ == GROWBENCH_PARAM_STRING || p.type_ == GROWBENCH_PARAM_CHOICE)
+        r.default_value.text = p.default_text_.c_str();
       r.min = p.min_;
       r.max = p.max_;
       r.unit = p.unit_.c_str();
@@ -190,8 +194,13 @@ class Params {
     return values_[i].text ? values_[i].text : "";
   }
   [[nodiscard]] Vec3 vec3(const std::string& key) const {
-    const double* v = at(key, GROWBENCH_PARAM_VEC3).vec3;
+    const auto v = vector3(key);
     return {static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2])};
+  }
+  // The same in the doubles the host validated.
+  [[nodiscard]] std::array<double, 3> vector3(const std::string& key) const {
+    const double* v = at(key, GROWBENCH_PARAM_VEC3).vec3;
+    return {v[0], v[1], v[2]};
   }
 
  private:
@@ -364,6 +373,8 @@ int32_t guarded(const growbench_host* host, F&& f) {
     return f();
   } catch (const InputError& e) {
     return report(host, GROWBENCH_INPUT_ERROR, e.what());
+  } catch (const std::bad_alloc& e) {
+    return report(host, GROWBENCH_OUT_OF_MEMORY, e.what());
   } catch (const std::exception& e) {
     return report(host, GROWBENCH_ERROR, e.what());
   } catch (...) {
@@ -470,7 +481,7 @@ struct Exported {
 
 // Exports CLASS (an sdk::Algorithm with a static info() and a default constructor) as the library's
 // plugin. Use it once, at global scope, in one source file.
-#define GROWBENCH_PLUGIN(CLASS)                                                                  \
-  extern "C" GROWBENCH_PLUGIN_EXPORT const growbench_plugin* growbench_plugin_entry(void) {      \
-    return ::growbench::sdk::detail::Exported<CLASS>::table();                                   \
+#define GROWBENCH_PLUGIN(CLASS)                                                             \
+  extern "C" GROWBENCH_PLUGIN_EXPORT const growbench_plugin* growbench_plugin_entry(void) { \
+    return ::growbench::sdk::detail::Exported<CLASS>::table();                              \
   }

@@ -1,0 +1,240 @@
+#include "algorithms/plugins/loader.hpp"
+
+#include <dlfcn.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "algorithms/plugins/plugin_algorithm.hpp"
+#include "core/errors.hpp"
+#include "core/file_hash.hpp"
+#include "growbench/plugin.h"
+
+namespace growbench {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Loaded {
+  std::string path;
+  AlgorithmInfo info;
+  AlgorithmEntry entry;
+};
+
+std::deque<Loaded>& loaded() {
+  static std::deque<Loaded> list;  // a deque: registering more never moves an entry handed out
+  return list;
+}
+
+bool valid_name(const char* s) {
+  if (!s || !*s) return false;
+  for (const char* c = s; *c; ++c)
+    if (!((*c >= 'a' && *c <= 'z') || (*c >= '0' && *c <= '9') || *c == '_')) return false;
+  return true;
+}
+
+std::string text_or_empty(const char* s) { return s ? s : ""; }
+
+// One row of the plugin's table as a ParamSpec; throws std::invalid_argument saying what is wrong.
+ParamSpec read_row(const growbench_param& r) {
+  if (!valid_name(r.name)) throw std::invalid_argument("its name must be non-empty and of a-z, 0-9 and _");
+  ParamSpec s;
+  s.name = r.name;
+  s.unit = text_or_empty(r.unit);
+  s.doc = text_or_empty(r.doc);
+  const bool ranged = r.type == GROWBENCH_PARAM_INT || r.type == GROWBENCH_PARAM_REAL || r.type == GROWBENCH_PARAM_VEC3;
+  if (ranged) {
+    if (std::isnan(r.min) || std::isnan(r.max) || r.min > r.max)
+      throw std::invalid_argument(fmt::format("its range [{}, {}] is empty or not a number", r.min, r.max));
+    s.min = r.min;
+    s.max = r.max;
+  }
+  auto in_range = [&](double v) {
+    if (!std::isfinite(v) || v < r.min || v > r.max)
+      throw std::invalid_argument(fmt::format("its default {} is not a finite value in [{}, {}]", v, r.min, r.max));
+  };
+  switch (r.type) {
+    case GROWBENCH_PARAM_INT:
+      s.type = ParamType::Int;
+      in_range(static_cast<double>(r.default_value.integer));
+      s.default_value = r.default_value.integer;
+      break;
+    case GROWBENCH_PARAM_REAL:
+      s.type = ParamType::Real;
+      in_range(r.default_value.real);
+      s.default_value = r.default_value.real;
+      break;
+    case GROWBENCH_PARAM_BOOL:
+      s.type = ParamType::Bool;
+      if (r.default_value.boolean != 0 && r.default_value.boolean != 1)
+        throw std::invalid_argument(fmt::format("its default {} is not 0 or 1", r.default_value.boolean));
+      s.default_value = r.default_value.boolean == 1;
+      break;
+    case GROWBENCH_PARAM_STRING:
+      s.type = ParamType::String;
+      s.default_value = text_or_empty(r.default_value.text);
+      break;
+    case GROWBENCH_PARAM_VEC3:
+      s.type = ParamType::Vec3;
+      for (double v : r.default_value.vec3) in_range(v);
+      s.default_value = glm::dvec3(r.default_value.vec3[0], r.default_value.vec3[1], r.default_value.vec3[2]);
+      break;
+    case GROWBENCH_PARAM_CHOICE: {
+      s.type = ParamType::Choice;
+      if (r.choice_count == 0 || !r.choices) throw std::invalid_argument("a choice without choices");
+      std::set<std::string> seen;
+      for (std::uint32_t k = 0; k < r.choice_count; ++k) {
+        if (!r.choices[k] || !*r.choices[k]) throw std::invalid_argument(fmt::format("choice {} is empty", k));
+        if (!seen.insert(r.choices[k]).second)
+          throw std::invalid_argument(fmt::format("choice '{}' is listed twice", r.choices[k]));
+        s.choices.emplace_back(r.choices[k]);
+      }
+      const std::string d = text_or_empty(r.default_value.text);
+      if (!seen.count(d))
+        throw std::invalid_argument(fmt::format("its default '{}' is not one of its choices", d));
+      s.default_value = d;
+      break;
+    }
+    default:
+      throw std::invalid_argument(fmt::format("type {} is not a growbench_param_type", r.type));
+  }
+  return s;
+}
+
+// The plugin's descriptive members as an AlgorithmInfo; InputError naming the file for what is malformed.
+AlgorithmInfo read_table(const std::string& path, const growbench_plugin& t) {
+  auto bad = [&](const std::string& what) {
+    return InputError(fmt::format("{}: malformed plugin table: {}", path, what));
+  };
+  if (t.struct_size < sizeof(growbench_plugin))
+    throw bad(fmt::format("struct_size {} is smaller than ABI {}'s {}", t.struct_size, t.abi_version,
+                          sizeof(growbench_plugin)));
+  if (!valid_name(t.name)) throw bad("its name must be non-empty and of a-z, 0-9 and _");
+  if (!t.create || !t.start || !t.step || !t.finish || !t.plant || !t.destroy)
+    throw bad("create, start, step, finish, plant and destroy must all be set");
+  if (t.param_count > 0 && !t.params) throw bad(fmt::format("param_count is {} but params is NULL", t.param_count));
+  if (t.test_param_count > 0 && !t.test_params)
+    throw bad(fmt::format("test_param_count is {} but test_params is NULL", t.test_param_count));
+  AlgorithmInfo info;
+  info.name = t.name;
+  info.summary = text_or_empty(t.summary);
+  std::set<std::string> names;
+  for (std::uint32_t i = 0; i < t.param_count; ++i) {
+    const growbench_param& r = t.params[i];
+    try {
+      info.params.push_back(read_row(r));
+    } catch (const std::invalid_argument& e) {
+      throw bad(fmt::format("parameter {} ('{}'): {}", i, text_or_empty(r.name), e.what()));
+    }
+    if (!names.insert(info.params.back().name).second)
+      throw bad(fmt::format("parameter {} ('{}') is declared twice", i, info.params.back().name));
+  }
+  Params check(fmt::format("plugin '{}'", info.name), info.params);
+  for (std::uint32_t i = 0; i < t.test_param_count; ++i) {
+    const std::string a = text_or_empty(t.test_params[i]);
+    try {
+      check.set_assignment(a);
+    } catch (const InputError& e) {
+      throw bad(fmt::format("test_params[{}] '{}': {}", i, a, e.what()));
+    }
+    info.test_params.push_back(a);
+  }
+  return info;
+}
+
+const growbench_plugin* open_plugin(const std::string& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw InputError(fmt::format("{}: no such plugin file", path));
+  if (fs::is_directory(path, ec)) throw InputError(fmt::format("{}: is a directory, not a plugin file", path));
+  // RTLD_LOCAL: one plugin's symbols never satisfy another's. Never closed (see loader.hpp).
+  void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+  if (!handle) {
+    const char* why = dlerror();
+    throw InputError(fmt::format("{}: not a loadable shared library ({})", path, why ? why : "dlopen failed"));
+  }
+  dlerror();
+  void* sym = dlsym(handle, GROWBENCH_PLUGIN_ENTRY_SYMBOL);
+  if (!sym)
+    throw InputError(fmt::format("{}: no {}() entry point; is it a growbench plugin? (see docs/plugins.md)", path,
+                                 GROWBENCH_PLUGIN_ENTRY_SYMBOL));
+  const auto entry = reinterpret_cast<growbench_plugin_entry_fn>(sym);
+  const growbench_plugin* t = entry();
+  if (!t) throw InputError(fmt::format("{}: {}() returned NULL", path, GROWBENCH_PLUGIN_ENTRY_SYMBOL));
+  if (t->abi_version != GROWBENCH_PLUGIN_ABI_VERSION)
+    throw InputError(fmt::format("{}: built for plugin ABI version {}, but this growbench speaks version {}; rebuild "
+                                 "it against this growbench's SDK",
+                                 path, t->abi_version, GROWBENCH_PLUGIN_ABI_VERSION));
+  return t;
+}
+
+void check_name_free(const std::string& path, const std::string& name) {
+  for (const auto& e : algorithm_registry())
+    if (e.info().name == name)
+      throw InputError(fmt::format("{}: plugin algorithm '{}' has the name of a built-in algorithm", path, name));
+  for (const auto& l : loaded())
+    if (l.info.name == name)
+      throw InputError(
+          fmt::format("{}: plugin algorithm '{}' has the name of the plugin loaded from {}", path, name, l.path));
+}
+
+}  // namespace
+
+const AlgorithmEntry& load_plugin(const std::string& given) {
+  std::error_code ec;
+  const fs::path abs = fs::weakly_canonical(fs::absolute(given, ec), ec);
+  const std::string path = abs.empty() ? given : abs.string();
+  for (const auto& l : loaded())
+    if (l.path == path) return l.entry;
+  const growbench_plugin* t = open_plugin(path);
+  AlgorithmInfo info = read_table(path, *t);
+  check_name_free(path, info.name);
+  auto origin = std::make_shared<PluginOrigin>(
+      PluginOrigin{info.name, path, file_hash(path), t->abi_version, text_or_empty(t->version)});
+  Loaded& l = loaded().emplace_back(Loaded{path, std::move(info), {}});
+  const AlgorithmInfo* ip = &l.info;
+  l.entry = AlgorithmEntry{[ip]() -> const AlgorithmInfo& { return *ip; },
+                           [t, ip]() { return make_plugin_algorithm(t, *ip); }, {}, std::move(origin)};
+  return l.entry;
+}
+
+void load_plugins(const std::vector<std::string>& paths) {
+  for (const auto& p : paths) load_plugin(p);
+  const char* env = std::getenv("GROWBENCH_PLUGIN_PATH");
+  if (!env) return;
+  std::string list = env;
+  for (std::size_t start = 0; start <= list.size();) {
+    const std::size_t end = std::min(list.find(':', start), list.size());
+    const std::string dir = list.substr(start, end - start);
+    start = end + 1;
+    if (dir.empty()) continue;
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec))
+      throw InputError(fmt::format("GROWBENCH_PLUGIN_PATH: '{}' is not a directory", dir));
+    std::vector<std::string> files;
+    for (const auto& f : fs::directory_iterator(dir, ec))
+      if (f.path().extension() == ".so") files.push_back(f.path().string());
+    std::sort(files.begin(), files.end());
+    for (const auto& f : files) load_plugin(f);
+  }
+}
+
+std::vector<const AlgorithmEntry*> plugin_algorithms() {
+  std::vector<const AlgorithmEntry*> v;
+  for (const auto& l : loaded()) v.push_back(&l.entry);
+  return v;
+}
+
+std::vector<PluginOrigin> loaded_plugins() {
+  std::vector<PluginOrigin> v;
+  for (const auto& l : loaded()) v.push_back(*l.entry.plugin);
+  return v;
+}
+
+}  // namespace growbench

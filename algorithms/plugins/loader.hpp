@@ -1,0 +1,27 @@
+// Loading algorithm plugins (include/growbench/plugin.h): shared libraries that register one algorithm
+// each beside the built-ins. A loaded plugin stays loaded until the process exits: its tables and any
+// thread-local or TBB state it made must outlive every algorithm it created, and forked trials inherit
+// it. Loading is for the command line to do before any work starts; it is not thread-safe.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "algorithms/algorithm.hpp"
+
+namespace growbench {
+
+// Loads the plugin at `path` and registers its algorithm; loading the same file again returns the
+// entry already registered. InputError naming the file when it is missing, is not a shared library,
+// has no growbench_plugin_entry, speaks another ABI version, takes a name already taken, or has a
+// malformed table.
+const AlgorithmEntry& load_plugin(const std::string& path);
+// Loads `paths` in order, then every *.so in the directories GROWBENCH_PLUGIN_PATH names (separated
+// by ':', each directory's files in name order).
+void load_plugins(const std::vector<std::string>& paths);
+// The plugins' algorithms, in loading order.
+std::vector<const AlgorithmEntry*> plugin_algorithms();
+// Where each loaded plugin came from, in loading order (what a run's context records).
+std::vector<PluginOrigin> loaded_plugins();
+
+}  // namespace growbench

@@ -1,0 +1,346 @@
+// The host's side of the plugin ABI: the scene and the queries handed to the plugin as plain arrays and
+// C functions, and its plant copied back into a Plant.
+#include "algorithms/plugins/plugin_algorithm.hpp"
+
+#include <mutex>
+#include <new>
+#include <stdexcept>
+#include <type_traits>
+
+#include <fmt/format.h>
+#include <tbb/global_control.h>
+
+#include "core/errors.hpp"
+#include "core/random.hpp"
+
+namespace growbench {
+namespace {
+
+// glm's vectors and the ABI's are the same three floats, so arrays pass without a copy.
+static_assert(sizeof(glm::vec3) == sizeof(growbench_vec3) && std::is_standard_layout_v<glm::vec3>);
+static_assert(sizeof(glm::uvec3) == 3 * sizeof(std::uint32_t));
+
+const growbench_vec3* abi(const glm::vec3* p) { return reinterpret_cast<const growbench_vec3*>(p); }
+growbench_vec3 abi(const glm::vec3& p) { return {p.x, p.y, p.z}; }
+glm::vec3 glm_of(const growbench_vec3& p) { return {p.x, p.y, p.z}; }
+std::span<const glm::vec3> points(const growbench_vec3* p, std::uint64_t n) {
+  return {reinterpret_cast<const glm::vec3*>(p), static_cast<std::size_t>(n)};
+}
+
+growbench_mesh mesh_view(const TriangleMesh& m, bool solid) {
+  return {m.name.c_str(),
+          abi(m.vertices.data()),
+          m.vertices.size(),
+          reinterpret_cast<const std::uint32_t*>(m.triangles.data()),
+          m.triangles.size(),
+          m.climbable ? 1 : 0,
+          solid ? 1 : 0};
+}
+
+growbench_shape shape_view(const Shape& s) {
+  growbench_shape v{};
+  const Aabb b = s.bounds();
+  v.kind = s.kind == Shape::Kind::Box      ? GROWBENCH_SHAPE_BOX
+           : s.kind == Shape::Kind::Sphere ? GROWBENCH_SHAPE_ELLIPSOID
+                                           : GROWBENCH_SHAPE_MESH;
+  v.min = abi(s.kind == Shape::Kind::Box ? s.min : b.min);
+  v.max = abi(s.kind == Shape::Kind::Box ? s.max : b.max);
+  v.center = abi(s.center);
+  v.radii = abi(s.radii);
+  if (s.kind == Shape::Kind::Mesh) v.mesh = mesh_view(s.mesh, true);
+  return v;
+}
+
+class PluginAlgorithm final : public GrowthAlgorithm {
+ public:
+  PluginAlgorithm(const growbench_plugin* t, const AlgorithmInfo& info) : t_(t), info_(info) {}
+  ~PluginAlgorithm() override {
+    if (inst_) t_->destroy(inst_);
+  }
+  PluginAlgorithm(const PluginAlgorithm&) = delete;
+  PluginAlgorithm& operator=(const PluginAlgorithm&) = delete;
+
+  const AlgorithmInfo& describe() const override { return info_; }
+
+  void start(const Scene& scene, const SceneQuery& query, const Params& params, std::uint64_t seed) override {
+    q_ = &query.host_queries();
+    seed_ = seed;
+    describe_scene(scene, query);
+    make_host();
+    std::vector<growbench_value> values = read_values(params);
+    inst_ = t_->create(&host_);
+    if (!inst_) raise(GROWBENCH_ERROR, "create");
+    check(t_->start(inst_, &scene_, values.data(), seed), "start");
+  }
+
+  bool step() override {
+    const std::int32_t r = t_->step(inst_);
+    ++version_;
+    if (r < 0) raise(-r, "step");
+    if (r > 1) raise(GROWBENCH_ERROR, fmt::format("step (returned {}, expected 1, 0 or an error)", r));
+    return r == 1;
+  }
+
+  void finish() override {
+    check(t_->finish(inst_), "finish");
+    ++version_;
+  }
+
+  const Plant& plant() const override {
+    if (plant_version_ != version_) {
+      growbench_plant_view v{};
+      check(t_->plant(inst_, &v), "plant");
+      copy_plant(v);
+      plant_version_ = version_;
+    }
+    return plant_;
+  }
+
+  std::size_t node_count() const override { return counts().first; }
+  std::size_t organ_count() const override { return counts().second; }
+
+  std::vector<std::pair<std::string, double>> stats() const override {
+    std::vector<std::pair<std::string, double>> out;
+    if (!t_->stats) return out;
+    const growbench_stat* s = nullptr;
+    const std::uint32_t n = t_->stats(inst_, &s);
+    for (std::uint32_t i = 0; i < n && s; ++i)
+      if (s[i].name) out.emplace_back(s[i].name, s[i].value);
+    return out;
+  }
+
+ private:
+  std::pair<std::size_t, std::size_t> counts() const {
+    if (!t_->counts) {
+      const Plant& p = plant();
+      return {p.nodes.size(), p.organs.size()};
+    }
+    std::uint64_t nodes = 0, organs = 0;
+    t_->counts(inst_, &nodes, &organs);
+    return {static_cast<std::size_t>(nodes), static_cast<std::size_t>(organs)};
+  }
+
+  // The scene as arrays that point into `scene`, which outlives the algorithm.
+  void describe_scene(const Scene& scene, const SceneQuery& query) {
+    meshes_.clear();
+    for (std::size_t i = 0; i < scene.meshes.size(); ++i) meshes_.push_back(mesh_view(scene.meshes[i], query.mesh_solid()[i]));
+    seeds_.clear();
+    for (const auto& s : scene.seeds) seeds_.push_back({abi(s.position), abi(s.direction), s.start_step});
+    zones_.clear();
+    for (const auto& z : scene.zones) zones_.push_back({static_cast<std::int32_t>(z.kind), shape_view(z.shape), z.strength});
+    scene_ = {};
+    scene_.name = scene.name.c_str();
+    scene_.meshes = meshes_.data();
+    scene_.mesh_count = static_cast<std::uint32_t>(meshes_.size());
+    scene_.seeds = seeds_.data();
+    scene_.seed_count = static_cast<std::uint32_t>(seeds_.size());
+    scene_.light = {scene.light.kind == Light::Kind::Point ? 1 : 0, abi(scene.light.direction), abi(scene.light.position)};
+    scene_.has_envelope = scene.envelope ? 1 : 0;
+    if (scene.envelope) scene_.envelope = shape_view(*scene.envelope);
+    scene_.zones = zones_.data();
+    scene_.zone_count = static_cast<std::uint32_t>(zones_.size());
+    const Aabb b = scene.bounds();
+    scene_.bounds_min = abi(b.min);
+    scene_.bounds_max = abi(b.max);
+    scene_.has_sdf = query.has_sdf() ? 1 : 0;
+    scene_.voxel_size = query.voxel_size();
+  }
+
+  static_assert(static_cast<int>(Zone::Kind::Attract) == GROWBENCH_ZONE_ATTRACT &&
+                static_cast<int>(Zone::Kind::Repel) == GROWBENCH_ZONE_REPEL &&
+                static_cast<int>(Zone::Kind::Include) == GROWBENCH_ZONE_INCLUDE &&
+                static_cast<int>(Zone::Kind::Exclude) == GROWBENCH_ZONE_EXCLUDE);
+
+  // The values in the table's order; strings point into `params`, which outlives start().
+  static std::vector<growbench_value> read_values(const Params& params) {
+    std::vector<growbench_value> v;
+    for (const ParamSpec& s : params.specs()) {
+      growbench_value x{};
+      switch (s.type) {
+        case ParamType::Int: x.integer = params.integer(s.name); break;
+        case ParamType::Real: x.real = params.real(s.name); break;
+        case ParamType::Bool: x.boolean = params.boolean(s.name) ? 1 : 0; break;
+        case ParamType::String:
+        case ParamType::Choice: x.text = params.text(s.name).c_str(); break;
+        case ParamType::Vec3: {
+          const glm::dvec3 d = params.vec3(s.name);
+          x.vec3[0] = d.x;
+          x.vec3[1] = d.y;
+          x.vec3[2] = d.z;
+          break;
+        }
+      }
+      v.push_back(x);
+    }
+    return v;
+  }
+
+  void make_host();
+
+  [[noreturn]] void raise(std::int32_t status, const std::string& where) const {
+    std::string message;
+    {
+      std::lock_guard lock(fail_mutex_);
+      message = failure_.empty() ? "no message given" : failure_;
+      failure_.clear();
+    }
+    const std::string text = fmt::format("algorithm '{}' (a plugin) failed in {}: {}", info_.name, where, message);
+    if (status == GROWBENCH_INPUT_ERROR) throw InputError(text);
+    if (status == GROWBENCH_OUT_OF_MEMORY) throw std::bad_alloc();
+    throw std::runtime_error(text);
+  }
+  void check(std::int32_t status, const std::string& where) const {
+    if (status != GROWBENCH_OK) raise(status, where);
+  }
+
+  void copy_plant(const growbench_plant_view& v) const {
+    auto bad = [&](const std::string& what) {
+      return std::runtime_error(fmt::format("algorithm '{}' (a plugin) returned a malformed plant: {}", info_.name, what));
+    };
+    if ((v.node_count && !v.nodes) || (v.organ_count && !v.organs)) throw bad("a NULL array with a non-zero count");
+    plant_.clear();
+    plant_.nodes.reserve(v.node_count);
+    for (std::uint64_t i = 0; i < v.node_count; ++i) {
+      const growbench_node& n = v.nodes[i];
+      if (n.order > 0xFFFFu) throw bad(fmt::format("node {} has branch order {} (at most 65535)", i, n.order));
+      plant_.nodes.push_back({glm_of(n.position), n.radius, n.parent, static_cast<std::uint16_t>(n.order), n.shoot,
+                              n.birth_step});
+    }
+    plant_.organs.reserve(v.organ_count);
+    for (std::uint64_t i = 0; i < v.organ_count; ++i) {
+      const growbench_organ& o = v.organs[i];
+      if (o.kind < GROWBENCH_ORGAN_LEAF || o.kind > GROWBENCH_ORGAN_BUD)
+        throw bad(fmt::format("organ {} has kind {}, not a growbench_organ_kind", i, o.kind));
+      Organ g;
+      g.position = glm_of(o.position);
+      g.orientation = glm::quat(o.orientation[0], o.orientation[1], o.orientation[2], o.orientation[3]);
+      g.size = o.size;
+      g.kind = static_cast<OrganKind>(o.kind);
+      g.node = o.node;
+      g.stamp = {o.stamp[0], o.stamp[1], o.stamp[2]};
+      plant_.organs.push_back(g);
+    }
+    if (v.polygon_count == 0) return;
+    if (!v.polygon_offsets || !v.polygon_vertices) throw bad("polygons without their arrays");
+    if (v.polygon_offsets[0] != 0) throw bad("polygon_offsets[0] is not 0");
+    for (std::uint64_t i = 0; i < v.polygon_count; ++i) {
+      const std::uint64_t a = v.polygon_offsets[i], b = v.polygon_offsets[i + 1];
+      if (b < a) throw bad(fmt::format("polygon_offsets decrease at polygon {}", i));
+      PlantPolygon poly;
+      for (std::uint64_t k = a; k < b; ++k) poly.vertices.push_back(glm_of(v.polygon_vertices[k]));
+      plant_.polygons.push_back(std::move(poly));
+    }
+  }
+
+  const growbench_plugin* t_;
+  const AlgorithmInfo& info_;
+  growbench_instance* inst_ = nullptr;
+  const HostQueries* q_ = nullptr;
+  std::uint64_t seed_ = 0;
+  growbench_host host_{};
+  growbench_scene scene_{};
+  std::vector<growbench_mesh> meshes_;
+  std::vector<growbench_seed> seeds_;
+  std::vector<growbench_zone> zones_;
+  mutable std::mutex fail_mutex_;
+  mutable std::string failure_;
+  std::uint64_t version_ = 0;                // bumped by every call that may change the plant
+  mutable std::uint64_t plant_version_ = ~0ull;  // the version plant_ was copied at
+  mutable Plant plant_;
+
+  // The host table's functions: `context` is the PluginAlgorithm.
+  static PluginAlgorithm& self(void* c) { return *static_cast<PluginAlgorithm*>(c); }
+  friend struct HostFunctions;
+};
+
+// Each host function; all but fail() only read the algorithm's state, so they are safe from any thread.
+struct HostFunctions {
+  static void log(void* c, std::int32_t level, const char* message) {
+    fmt::print(stderr, "{}: {}{}\n", self(c).info_.name, level == GROWBENCH_LOG_WARNING ? "warning: " : "",
+               message ? message : "");
+  }
+  static void fail(void* c, const char* message) {
+    PluginAlgorithm& a = self(c);
+    std::lock_guard lock(a.fail_mutex_);
+    if (a.failure_.empty()) a.failure_ = message ? message : "";
+  }
+  static std::int32_t cancelled(void* c) { return self(c).cancelled() ? 1 : 0; }
+  static std::uint64_t random_bits(void* c, std::uint64_t stream, std::uint64_t counter) {
+    return growbench::random_bits(self(c).seed_, stream, counter);
+  }
+  static void closest_points(void* c, const growbench_vec3* p, std::uint64_t n, float max_distance,
+                             std::int32_t climbable_only, growbench_closest_hit* out) {
+    std::vector<ClosestHit> hits(n);
+    self(c).q_->closest_points(points(p, n), max_distance, climbable_only != 0, hits);
+    for (std::uint64_t i = 0; i < n; ++i)
+      out[i] = {hits[i].found ? 1 : 0, abi(hits[i].point), abi(hits[i].normal), hits[i].distance, hits[i].mesh,
+                hits[i].triangle};
+  }
+  static std::vector<Ray> rays_of(const growbench_ray* r, std::uint64_t n) {
+    std::vector<Ray> v(n);
+    for (std::uint64_t i = 0; i < n; ++i) v[i] = {glm_of(r[i].origin), glm_of(r[i].direction), r[i].tmin, r[i].tmax};
+    return v;
+  }
+  static void rays(void* c, const growbench_ray* r, std::uint64_t n, growbench_ray_hit* out) {
+    std::vector<RayHit> hits(n);
+    self(c).q_->rays(rays_of(r, n), hits);
+    for (std::uint64_t i = 0; i < n; ++i)
+      out[i] = {hits[i].hit ? 1 : 0, hits[i].t, abi(hits[i].point), abi(hits[i].normal), hits[i].mesh, hits[i].triangle};
+  }
+  static void occluded(void* c, const growbench_ray* r, std::uint64_t n, std::uint8_t* out) {
+    self(c).q_->occluded(rays_of(r, n), {out, static_cast<std::size_t>(n)});
+  }
+  static std::int32_t signed_distance(void* c, const growbench_vec3* p, std::uint64_t n, float* distance,
+                                      growbench_vec3* gradient) {
+    const HostQueries& q = *self(c).q_;
+    if (!q.has_sdf()) return GROWBENCH_ERROR;
+    q.signed_distance(points(p, n), {distance, static_cast<std::size_t>(n)},
+                      gradient ? std::span<glm::vec3>(reinterpret_cast<glm::vec3*>(gradient), static_cast<std::size_t>(n))
+                               : std::span<glm::vec3>());
+    return GROWBENCH_OK;
+  }
+  static void inside(void* c, const growbench_vec3* p, std::uint64_t n, std::uint8_t* out) {
+    self(c).q_->inside(points(p, n), {out, static_cast<std::size_t>(n)});
+  }
+  static void inside_shape(void* c, std::int32_t shape, const growbench_vec3* p, std::uint64_t n, std::uint8_t* out) {
+    self(c).q_->inside_shape(shape, points(p, n), {out, static_cast<std::size_t>(n)});
+  }
+  static void sample_surface(void* c, std::uint64_t seed, std::uint64_t first, std::uint64_t n,
+                             growbench_surface_sample* out) {
+    std::vector<SurfaceSample> s(n);
+    self(c).q_->sample_surface(seed, first, s);
+    for (std::uint64_t i = 0; i < n; ++i) out[i] = {abi(s[i].position), abi(s[i].normal), s[i].mesh, s[i].triangle};
+  }
+  static void light_visible(void* c, const growbench_vec3* p, std::uint64_t n, float bias, std::uint8_t* out) {
+    self(c).q_->light_visible(points(p, n), bias, {out, static_cast<std::size_t>(n)});
+  }
+  static PluginAlgorithm& self(void* c) { return PluginAlgorithm::self(c); }
+};
+
+void PluginAlgorithm::make_host() {
+  host_ = {};
+  host_.abi_version = GROWBENCH_PLUGIN_ABI_VERSION;
+  host_.struct_size = sizeof(growbench_host);
+  host_.context = this;
+  host_.threads = static_cast<std::uint32_t>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+  host_.log = &HostFunctions::log;
+  host_.fail = &HostFunctions::fail;
+  host_.cancelled = &HostFunctions::cancelled;
+  host_.random_bits = &HostFunctions::random_bits;
+  host_.closest_points = &HostFunctions::closest_points;
+  host_.rays = &HostFunctions::rays;
+  host_.occluded = &HostFunctions::occluded;
+  host_.signed_distance = &HostFunctions::signed_distance;
+  host_.inside = &HostFunctions::inside;
+  host_.inside_shape = &HostFunctions::inside_shape;
+  host_.sample_surface = &HostFunctions::sample_surface;
+  host_.light_visible = &HostFunctions::light_visible;
+}
+
+}  // namespace
+
+std::unique_ptr<GrowthAlgorithm> make_plugin_algorithm(const growbench_plugin* table, const AlgorithmInfo& info) {
+  return std::make_unique<PluginAlgorithm>(table, info);
+}
+
+}  // namespace growbench

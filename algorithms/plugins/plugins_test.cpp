@@ -1,0 +1,219 @@
+// The plugin boundary: one test per loader error, a plugin written in C grown like a built-in, a suite
+// that records a misbehaving plugin and goes on, and spacecol built as a plugin growing the built-in's
+// plant bit for bit on every standard scene.
+#include <filesystem>
+#include <regex>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include "algorithms/plugins/loader.hpp"
+#include "harness/record/record.hpp"
+#include "harness/run/trial.hpp"
+#include "scenes/scene_library.hpp"
+#include "test_util.hpp"
+
+namespace growbench {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string fixture(const std::string& name) { return std::string(GROWBENCH_PLUGIN_DIR) + "/test/" + name + ".so"; }
+const std::string kSpacecolPlugin = std::string(GROWBENCH_PLUGIN_DIR) + "/spacecol_plugin.so";
+
+// A copy of a fixture under a fresh path: a clash test must not depend on what an earlier test loaded.
+std::string copy_of(const std::string& name, const std::string& as) {
+  const fs::path p = test::temp_dir("plugin_" + as) / (as + ".so");
+  fs::copy_file(fixture(name), p, fs::copy_options::overwrite_existing);
+  return p.string();
+}
+
+std::string load_error(const std::string& path) {
+  return test::error_of([&] { load_plugin(path); });
+}
+
+TEST(PluginLoader, MissingFileIsNamed) {
+  EXPECT_EQ(load_error("/nonexistent/walker.so"), "/nonexistent/walker.so: no such plugin file");
+}
+
+TEST(PluginLoader, AFileThatIsNotASharedLibrary) {
+  const std::string p = test::write_text(test::temp_dir("plugin_text") / "notes.so", "not an ELF file\n");
+  EXPECT_EQ(load_error(p).rfind(p + ": not a loadable shared library (", 0), 0u) << load_error(p);
+}
+
+TEST(PluginLoader, ALibraryWithoutTheEntryPoint) {
+  const std::string p = copy_of("no_entry", "no_entry");
+  EXPECT_EQ(load_error(p), p + ": no growbench_plugin_entry() entry point; is it a growbench plugin? (see "
+                                "docs/plugins.md)");
+}
+
+TEST(PluginLoader, AnotherAbiVersionSaysBoth) {
+  const std::string p = copy_of("abi_99", "abi_99");
+  EXPECT_EQ(load_error(p), p + ": built for plugin ABI version 99, but this growbench speaks version 1; rebuild it "
+                                "against this growbench's SDK");
+}
+
+TEST(PluginLoader, TheNameOfABuiltIn) {
+  const std::string p = copy_of("builtin_name", "builtin_name");
+  EXPECT_EQ(load_error(p), p + ": plugin algorithm 'spacecol' has the name of a built-in algorithm");
+}
+
+TEST(PluginLoader, TheNameOfAnotherPlugin) {
+  const std::string a = copy_of("line", "line_a"), b = copy_of("line", "line_b");
+  load_plugin(a);
+  EXPECT_EQ(load_error(b), b + ": plugin algorithm 'line' has the name of the plugin loaded from " + a);
+}
+
+TEST(PluginLoader, AMalformedParameterTable) {
+  const std::string p = copy_of("bad_table", "bad_table");
+  EXPECT_EQ(load_error(p),
+            p + ": malformed plugin table: parameter 1 ('step'): its default 5 is not a finite value in [0.001, 1]");
+}
+
+TEST(PluginLoader, TheSameFileLoadsOnce) {
+  const std::string p = copy_of("no_entry", "absent");  // any name: the copy below replaces it
+  fs::copy_file(fixture("line"), p, fs::copy_options::overwrite_existing);
+  const AlgorithmEntry& one = load_plugin(p);
+  const std::size_t loaded = plugin_algorithms().size();
+  EXPECT_EQ(&load_plugin(p), &one);
+  EXPECT_EQ(&load_plugin(fs::path(p).parent_path().string() + "/./absent.so"), &one);
+  EXPECT_EQ(plugin_algorithms().size(), loaded);
+}
+
+TEST(PluginLoader, ErrorsExitTwoFromTheCommandLine) {
+  for (const std::string& cmd : std::vector<std::string>{"list --plugin /nonexistent/walker.so", "run -a line -s wall --plugin " + fixture("abi_99"),
+                                 "list --plugin " + fixture("bad_table")}) {
+    const auto r = test::run_growbench(cmd);
+    EXPECT_EQ(r.status, 2) << cmd << "\n" << r.out;
+    EXPECT_NE(r.out.find("growbench: error: "), std::string::npos) << r.out;
+  }
+}
+
+TEST(PluginLoader, ListShowsAPluginWithItsTableAndOrigin) {
+  const auto r = test::run_growbench("list line --plugin " + fixture("line"));
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("line  [plugin]"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("plugin " + fs::canonical(fixture("line")).string() + " (version 1, ABI 1, xxh3 "),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("length"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("misbehave, for tests"), std::string::npos) << r.out;
+}
+
+TEST(PluginLoader, DirectoriesFromTheEnvironment) {
+  const fs::path dir = test::temp_dir("plugin_env");
+  fs::copy_file(fixture("line"), dir / "line.so");
+  const auto r = test::run_growbench("list line");
+  EXPECT_EQ(r.status, 2) << r.out;  // not loaded without it
+  ::setenv("GROWBENCH_PLUGIN_PATH", dir.c_str(), 1);
+  const auto found = test::run_growbench("list line");
+  ::unsetenv("GROWBENCH_PLUGIN_PATH");
+  EXPECT_EQ(found.status, 0) << found.out;
+  EXPECT_NE(found.out.find("line  [plugin]"), std::string::npos) << found.out;
+}
+
+TrialSpec line_spec(const std::string& scene) {
+  TrialSpec spec;
+  spec.algorithm = "line";
+  spec.scene = scene;
+  spec.plugins = {fixture("line")};
+  spec.metrics = false;
+  return spec;
+}
+
+// A plugin in C grows through the host's queries like a built-in, and its record says what ran.
+TEST(CPlugin, GrowsAndItsRecordNamesThePlugin) {
+  TrialSpec spec = line_spec("wall");
+  spec.threads = 1;
+  Plant plant;
+  const TrialRecord one = run_trial_record(spec, {}, &plant);
+  spec.threads = 2;
+  const TrialRecord two = run_trial_record(spec);
+  EXPECT_EQ(one.geometry_hash, two.geometry_hash);
+  EXPECT_EQ(plant.validate(), "");
+  const Scene scene = load_scene("wall");
+  EXPECT_EQ(plant.nodes.size(), 20 * scene.seeds.size());  // `length` nodes per seed, nothing in the way
+  EXPECT_EQ(plant.organs.size(), scene.seeds.size());      // a leaf at each tip
+  EXPECT_EQ(one.algorithm_stats.at("steps"), 20.0);        // the 20th step grows nothing and ends growth
+  ASSERT_TRUE(one.context.has_value());
+  ASSERT_EQ(one.context->plugins.size(), 1u);
+  const PluginOrigin& o = one.context->plugins[0];
+  EXPECT_EQ(o.name, "line");
+  EXPECT_EQ(o.path, fs::canonical(fixture("line")).string());
+  EXPECT_TRUE(std::regex_match(o.hash, std::regex("[0-9a-f]{16}"))) << o.hash;
+  EXPECT_EQ(o.abi_version, 1u);
+  EXPECT_EQ(o.version, "1");
+}
+
+TEST(CPlugin, ItsErrorsKeepTheirKindAndMessage) {
+  TrialSpec spec = line_spec("wall");
+  spec.params = {"fault=input"};
+  EXPECT_EQ(test::error_of([&] { run_trial_record(spec); }),
+            "algorithm 'line' (a plugin) failed in start: fault=input: this scene will not do");
+  spec.params = {"fault=fail"};
+  try {
+    run_trial_record(spec);
+    ADD_FAILURE() << "fault=fail did not fail";
+  } catch (const InputError& e) {
+    ADD_FAILURE() << "an internal failure was reported as bad input: " << e.what();
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "algorithm 'line' (a plugin) failed in step: fault=fail: gave up");
+  }
+  spec.params = {"step=7"};  // validated by the host against the plugin's table, as for a built-in
+  EXPECT_NE(test::error_of([&] { run_trial_record(spec); }).find("'step'"), std::string::npos);
+}
+
+// A plugin that crashes, hangs or runs out of memory in a suite is recorded as such, and the suite goes on.
+TEST(CPlugin, ASuiteRecordsAMisbehavingPluginAndGoesOn) {
+  const fs::path dir = test::temp_dir("plugin_suite");
+  fs::copy_file(fixture("line"), dir / "line.so");
+  test::write_text(dir / "suite.json", R"({"schema_version": 1, "name": "plugin_faults", "repetitions": 1,
+    "warmup": 0, "timeout_s": 5, "memory_limit_mb": 1024, "plugins": ["line.so"], "scenes": ["wall"],
+    "algorithms": [{"name": "line", "sweep": {"fault": ["crash", "hang", "oom", "fail", "none"]}}]})");
+  const auto r = test::run_growbench(fmt::format("suite {} -o {} -q", (dir / "suite.json").string(), (dir / "out").string()));
+  ASSERT_EQ(r.status, 0) << r.out;
+  const ResultsFile res = read_results((dir / "out" / "results.json").string());
+  std::map<std::string, std::string> status;
+  for (const auto& c : res.trials) status[c.sweep.at("fault").get<std::string>()] = c.status;
+  EXPECT_EQ(status["crash"], "crashed");
+  EXPECT_EQ(status["hang"], "timeout");
+  EXPECT_EQ(status["oom"], "out_of_memory");
+  EXPECT_EQ(status["fail"], "crashed");
+  EXPECT_EQ(status["none"], "ok");
+  ASSERT_EQ(res.context.plugins.size(), 1u);
+  EXPECT_EQ(res.context.plugins[0].path, fs::canonical(dir / "line.so").string());
+}
+
+// The boundary loses nothing: spacecol, compiled from its own source as a plugin and loaded under
+// another name, grows the built-in's plant bit for bit, its every query crossing the C ABI.
+class SpacecolAsPlugin : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(SpacecolAsPlugin, GrowsTheBuiltInsPlant) {
+  TrialSpec spec;
+  spec.scene = GetParam();
+  spec.params = find_algorithm("spacecol").info().test_params;
+  spec.metrics = false;
+  spec.threads = 2;
+  spec.algorithm = "spacecol";
+  const TrialRecord builtin = run_trial_record(spec);
+  spec.algorithm = "spacecol_plugin";
+  spec.plugins = {kSpacecolPlugin};
+  const TrialRecord plugin = run_trial_record(spec);
+  EXPECT_EQ(plugin.geometry_hash, builtin.geometry_hash);
+  EXPECT_EQ(plugin.counts.nodes, builtin.counts.nodes);
+  EXPECT_EQ(plugin.steps, builtin.steps);
+  EXPECT_EQ(plugin.algorithm_stats, builtin.algorithm_stats);
+  EXPECT_GT(builtin.counts.nodes, 10u);
+}
+
+std::vector<std::string> scene_names() {
+  std::vector<std::string> v;
+  for (const auto& s : standard_scenes()) v.push_back(s.name);
+  return v;
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryStandardScene, SpacecolAsPlugin, ::testing::ValuesIn(scene_names()),
+                         [](const auto& info) { return info.param; });
+
+}  // namespace
+}  // namespace growbench

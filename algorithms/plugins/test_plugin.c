@@ -1,0 +1,214 @@
+/* Plugins for the loader's tests, written in plain C99 against plugin.h alone: one source, compiled once
+ * per variant (TEST_PLUGIN_VARIANT, see CMakeLists.txt).
+ *
+ *  0 "line": a working plugin. From every seed, a straight stalk that climbs one `step` per growth step
+ *    along the seed's direction until `length` nodes or a solid (host->inside) stops it; a leaf at each
+ *    tip. Its `fault` parameter makes it crash, hang, exhaust memory or report errors, for the tests of
+ *    how a suite records a misbehaving plugin.
+ *  1 no entry point; 2 another ABI version; 3 a built-in's name; 4 a malformed parameter table. */
+#include <math.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "growbench/plugin.h"
+
+#ifndef TEST_PLUGIN_VARIANT
+#define TEST_PLUGIN_VARIANT 0
+#endif
+
+static const char* const kFaults[] = {"none", "crash", "hang", "oom", "fail", "input"};
+
+static const growbench_param kParams[] = {
+    {"length", GROWBENCH_PARAM_INT, {20, 0.0, 0, NULL, {0, 0, 0}}, 1, 100000, "", "nodes per stalk", NULL, 0},
+#if TEST_PLUGIN_VARIANT == 4
+    {"step", GROWBENCH_PARAM_REAL, {0, 5.0, 0, NULL, {0, 0, 0}}, 0.001, 1.0, "m", "length of one step", NULL, 0},
+#else
+    {"step", GROWBENCH_PARAM_REAL, {0, 0.02, 0, NULL, {0, 0, 0}}, 0.001, 1.0, "m", "length of one step", NULL, 0},
+#endif
+    {"fault", GROWBENCH_PARAM_CHOICE, {0, 0.0, 0, "none", {0, 0, 0}}, 1, 0, "", "misbehave, for tests", kFaults, 6},
+};
+
+static const char* const kTestParams[] = {"length=8"};
+
+typedef struct state {
+  const growbench_host* host;
+  const growbench_scene* scene;
+  int64_t length;
+  float step;
+  int fault;
+  growbench_node* nodes;
+  uint64_t node_count;
+  growbench_organ* organs;
+  uint64_t organ_count;
+  int64_t* tip; /* per seed: its stalk's last node, or -1 when it has stopped */
+  int64_t steps;
+} state;
+
+static growbench_instance* create(const growbench_host* host) {
+  state* s = (state*)calloc(1, sizeof(state));
+  if (!s) host->fail(host->context, "out of memory");
+  if (s) s->host = host;
+  return (growbench_instance*)s;
+}
+
+static int32_t start(growbench_instance* instance, const growbench_scene* scene, const growbench_value* params,
+                     uint64_t seed) {
+  state* s = (state*)instance;
+  uint32_t i;
+  (void)seed;
+  s->scene = scene;
+  s->length = params[0].integer;
+  s->step = (float)params[1].real;
+  for (s->fault = 0; s->fault < 6 && strcmp(kFaults[s->fault], params[2].text) != 0; ++s->fault) {
+  }
+  if (s->fault == 5) {
+    s->host->fail(s->host->context, "fault=input: this scene will not do");
+    return GROWBENCH_INPUT_ERROR;
+  }
+  if (scene->seed_count == 0) {
+    s->host->fail(s->host->context, "the scene has no seeds");
+    return GROWBENCH_INPUT_ERROR;
+  }
+  s->nodes = (growbench_node*)calloc((size_t)(scene->seed_count * s->length), sizeof(growbench_node));
+  s->organs = (growbench_organ*)calloc(scene->seed_count, sizeof(growbench_organ));
+  s->tip = (int64_t*)calloc(scene->seed_count, sizeof(int64_t));
+  if (!s->nodes || !s->organs || !s->tip) {
+    s->host->fail(s->host->context, "out of memory");
+    return GROWBENCH_ERROR;
+  }
+  for (i = 0; i < scene->seed_count; ++i) {
+    growbench_node* n = &s->nodes[s->node_count];
+    n->position = scene->seeds[i].position;
+    n->radius = 0.004f;
+    n->parent = -1;
+    n->shoot = i;
+    s->tip[i] = (int64_t)s->node_count++;
+  }
+  return GROWBENCH_OK;
+}
+
+static int32_t step(growbench_instance* instance) {
+  state* s = (state*)instance;
+  uint32_t i;
+  int grew = 0;
+  if (s->fault == 1) raise(SIGSEGV);
+  if (s->fault == 2)
+    while (!s->host->cancelled(s->host->context)) {
+    }
+  if (s->fault == 3) /* never freed: the trial's process ends next */
+    while (malloc(1 << 20)) {
+    }
+  if (s->fault == 3) {
+    s->host->fail(s->host->context, "fault=oom: an allocation was refused");
+    return -GROWBENCH_OUT_OF_MEMORY;
+  }
+  if (s->fault == 4) {
+    s->host->fail(s->host->context, "fault=fail: gave up");
+    return -GROWBENCH_ERROR;
+  }
+  ++s->steps;
+  for (i = 0; i < s->scene->seed_count; ++i) {
+    const growbench_vec3 d = s->scene->seeds[i].direction;
+    const float len = sqrtf(d.x * d.x + d.y * d.y + d.z * d.z);
+    growbench_vec3 p;
+    uint8_t inside = 0;
+    growbench_node* n;
+    if (s->tip[i] < 0 || s->steps >= s->length || len <= 0.0f) continue;
+    p = s->nodes[s->tip[i]].position;
+    p.x += s->step * d.x / len;
+    p.y += s->step * d.y / len;
+    p.z += s->step * d.z / len;
+    s->host->inside(s->host->context, &p, 1, &inside);
+    if (inside) {
+      s->tip[i] = -1;
+      continue;
+    }
+    n = &s->nodes[s->node_count];
+    n->position = p;
+    n->radius = 0.004f;
+    n->parent = (int32_t)s->tip[i];
+    n->shoot = i;
+    n->birth_step = (uint32_t)s->steps;
+    s->tip[i] = (int64_t)s->node_count++;
+    grew = 1;
+  }
+  return grew;
+}
+
+static int32_t finish(growbench_instance* instance) {
+  state* s = (state*)instance;
+  uint64_t k;
+  for (k = 0; k < s->node_count; ++k) {
+    int is_tip = 1;
+    uint64_t m;
+    for (m = k + 1; m < s->node_count && is_tip; ++m) is_tip = s->nodes[m].parent != (int32_t)k;
+    if (is_tip && s->nodes[k].parent >= 0) {
+      growbench_organ* o = &s->organs[s->organ_count++];
+      o->position = s->nodes[k].position;
+      o->orientation[0] = 1.0f;
+      o->size = 0.03f;
+      o->kind = GROWBENCH_ORGAN_LEAF;
+      o->node = (int32_t)k;
+    }
+  }
+  return GROWBENCH_OK;
+}
+
+static int32_t plant(growbench_instance* instance, growbench_plant_view* out) {
+  state* s = (state*)instance;
+  memset(out, 0, sizeof(*out));
+  out->nodes = s->nodes;
+  out->node_count = s->node_count;
+  out->organs = s->organs;
+  out->organ_count = s->organ_count;
+  return GROWBENCH_OK;
+}
+
+static uint32_t stats(growbench_instance* instance, const growbench_stat** out) {
+  static growbench_stat one[1] = {{"steps", 0.0}};
+  one[0].value = (double)((state*)instance)->steps;
+  *out = one;
+  return 1;
+}
+
+static void destroy(growbench_instance* instance) {
+  state* s = (state*)instance;
+  free(s->nodes);
+  free(s->organs);
+  free(s->tip);
+  free(s);
+}
+
+static const growbench_plugin kPlugin = {
+#if TEST_PLUGIN_VARIANT == 2
+    99u,
+#else
+    GROWBENCH_PLUGIN_ABI_VERSION,
+#endif
+    sizeof(growbench_plugin),
+#if TEST_PLUGIN_VARIANT == 3
+    "spacecol",
+#else
+    "line",
+#endif
+    "a straight stalk from every seed (a test plugin in C)",
+    "1",
+    kParams,
+    3,
+    kTestParams,
+    1,
+    create,
+    start,
+    step,
+    finish,
+    plant,
+    NULL,
+    stats,
+    destroy};
+
+#if TEST_PLUGIN_VARIANT == 1
+GROWBENCH_PLUGIN_EXPORT const growbench_plugin* not_the_entry(void) { return &kPlugin; }
+#else
+GROWBENCH_PLUGIN_EXPORT const growbench_plugin* growbench_plugin_entry(void) { return &kPlugin; }
+#endif
