@@ -9,7 +9,7 @@ JOBS ?= $(shell nproc)
 # Repetitions per cell in `make demo` (a number, or "suite" for the standard suite's own).
 DEMO_REPETITIONS ?= 1
 
-.PHONY: all deps configure build cli test demo demo-full bench gate baseline readme-params plugin-sdk format clean
+.PHONY: all deps configure build cli test demo demo-full bench plugin-bench gate baseline readme-params plugin-sdk format clean
 
 all: build
 
@@ -62,6 +62,13 @@ plugin-sdk: cli
 
 bench: build
 	$(BUILD)/bench/growbench_bench
+
+# What the plugin ABI costs: the built-in spacecol against the same source built as a plugin, side by
+# side in one suite (bench/suites/plugin-boundary.json), then their growth medians.
+plugin-bench: build
+	$(GROWBENCH) suite bench/suites/plugin-boundary.json --plugin $(BUILD)/plugins/spacecol_plugin.so \
+	  --out out/plugin-boundary -q
+	$(GROWBENCH) summary out/plugin-boundary/results.json
 
 # Reformat every C and C++ file with the committed .clang-format (CI checks it: scripts/check-format).
 format:

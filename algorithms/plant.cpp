@@ -39,9 +39,9 @@ double Plant::total_length() const {
 
 std::string Plant::geometry_hash() const {
   // Fields are gathered in a small buffer and hashed a chunk at a time: the same value as feeding XXH3
-  // field by field (it does not depend on how its input is split), at a fraction of the cost (a quarter
-  // of a million 4-byte updates for a 25k-node ivy took 1.6 ms). The buffer is fixed and reused: one
-  // the size of the plant would be fresh memory, whose page faults cost ~20 us per 4 KiB on a VM.
+  // field by field (it does not depend on how its input is split), at a fraction of the cost of many
+  // tiny updates. The buffer is fixed and reused: one the size of the plant would be fresh memory, whose
+  // page faults are slow on a VM.
   struct Hasher {
     XXH3_state_t* st = XXH3_createState();
     std::array<char, 1 << 14> buf{};

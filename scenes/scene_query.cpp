@@ -169,8 +169,8 @@ float nearest_vertex_bound(const Vec3Tree& tree, const glm::vec3& p) {
 }  // namespace
 
 // Every vertex used by a triangle lies on the surface, so the nearest one bounds the closest-point
-// distance from above: an unbounded Embree point query starts from that radius instead of infinity
-// (about 60x fewer BVH nodes visited for points far from the bunny).
+// distance from above: an unbounded Embree point query starts from that radius instead of infinity,
+// so a point far from the mesh visits a small part of the BVH rather than most of it.
 struct SceneQuery::VertexIndex {
   std::vector<glm::vec3> pts;
   Vec3Cloud cloud{&pts};

@@ -127,12 +127,7 @@ const AlgorithmInfo kInfo = {
             param::real("gravity", 0.5)
                 .range(0, 1000)
                 .unit("m/s^2")
-                .doc(
-                    "a_g, downwards. Growth runs in time-lapse (0.2 m per simulated second), and at 9.81 shoots not "
-                    "yet "
-                    "anchored fold to the ground under shape matching at 2 iterations. At 1 shoots peeled off convex "
-                    "and overhanging supports (the bunny: 5% of it covered, the rest on the ground); 0.5 keeps them on "
-                    "(18%) with a visible sag where a support ends"),
+                .doc("a_g, the downward acceleration of free particles (below Earth's: growth runs in time-lapse)"),
             param::real("stiffness", 0.8)
                 .range(0, 1)
                 .doc("shape matching: fraction of the way to the goal per iteration"),

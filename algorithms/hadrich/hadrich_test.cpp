@@ -309,8 +309,8 @@ TEST(Hadrich, WallPlantClimbsAndLeavesFaceOut) {
 }
 
 // Hugging, not sprawling: on the corner and on the bunny (whose ground is not climbable) most of the
-// plant is up on the climbable surfaces and close to them. With the former default gravity of 1 the
-// shoots peeled off and lay on the ground (bunny: median node height 0.011 m; corner: 0.038 m).
+// plant is up on the climbable surfaces and close to them. Under too strong a gravity the shoots peel
+// off and lie on the ground (README, "Gravity is below Earth's").
 TEST(Hadrich, PlantsClimbTheCornerAndTheBunnyRatherThanTheGround) {
   for (const std::string& name : std::vector<std::string>{"corner", "mesh:stanford-bunny"}) {
     Scene s = load_scene(name);

@@ -131,8 +131,8 @@ constexpr std::uint64_t kGrowStream = 0x1f7a11ull << 32;
 constexpr std::uint64_t kBranchStream = 0xb4a9c4ull << 32;
 constexpr std::uint64_t kLeafStream = 0x1eaf00ull << 32;
 constexpr float kTwoPi = 2.0f * std::numbers::pi_v<float>;
-// Height of the short adhesion prisms, in growth steps (see EmbreeGeometry). On the bunny, 2, 3 and 4
-// steps were within noise of each other, and 3 took the fewest instructions.
+// Height of the short adhesion prisms, in growth steps (see EmbreeGeometry): the height that took the
+// fewest instructions on the bunny, its neighbours within noise of it.
 constexpr float kShortPrism = 3.0f;
 
 // Uniform in [-0.5, 0.5]^3 (Luft's getRandomized, Blender's rand_val() - 0.5).
@@ -149,14 +149,14 @@ glm::vec3 cube(Rng& rng) {
 // normal for the adhesion distance) and the closest such triangle wins. A ball query would have to
 // visit every triangle within the adhesion distance to learn that none counts, which is the common
 // case above convex parts of a scanned mesh (between the prisms of a convex surface lie the regions
-// closest to its edges and vertices, where no face counts): on the bunny such nodes visited ~650
+// closest to its edges and vertices, where no face counts): on the bunny such nodes visited many
 // triangles each. So the prisms' bounding boxes get their own Embree BVH, and a point query returns the
-// ~10 whose box holds p; the exact rule then decides. Each box is padded beyond anything rounding or
+// few whose box holds p; the exact rule then decides. Each box is padded beyond anything rounding or
 // the inside test's tolerance can accept, so it is a superset and the answer is Luft's, bit for bit.
 // A node near the surface is first looked up among prisms only kShortPrism steps tall: their boxes
 // are small and overlap little, so the traversal is cheap, and a target found there no farther than
 // that height is final (any triangle that could beat or tie it is that close too, so its short prism
-// holds p). On the bunny 79% of nodes end there (measured at two steps); the rest ask the full index.
+// holds p). On the bunny most nodes end there; the rest ask the full index.
 // A node whose segment crossed nothing got this lookup from the crossing test, whose traversal of the
 // same index passed every box that holds the segment's end (crosses_any).
 // Closest mode keeps growing balls around the previous target (the true closest point is found at
@@ -167,8 +167,8 @@ class EmbreeGeometry final : public ivy::Geometry {
       : query_(q), table_(t), cfg_(c) {
     // One index of every triangle's box swept kShortPrism steps along its normal serves both the
     // short-prism lookup and the crossing test (a triangle's box lies inside its swept box): a
-    // separate index of the bare boxes made bunny nodes ~4% faster but cost a third Embree build,
-    // ~25 ms per trial on the bunny, more than it saves below ~500k nodes.
+    // separate index of the bare boxes made bunny nodes a little faster but cost a third Embree build
+    // per trial, more than it saves on all but very large plants.
     const bool luft = cfg_.adhesion_mode == ivy::AdhesionMode::Luft;
     if (luft && kShortPrism * cfg_.step < cfg_.max_adhesion) short_height_ = kShortPrism * cfg_.step;
     if (cfg_.collision_mode == ivy::CollisionMode::Luft || short_height_ > 0.0f)
@@ -505,8 +505,8 @@ bool Grower::limits_reached() const {
 
 namespace {
 // Resizes v to n, growing its capacity by half when it must grow: the per-node arrays then hold at
-// most 1.5x their nodes (doubling, as push_back and resize do, left up to 2x: ~112 bytes per node
-// just past a power of two, against the 100 the issue allows).
+// most 1.5x their nodes (doubling, as push_back and resize do, leaves up to 2x just past a power of
+// two; README, "Memory per node").
 template <class T>
 void grow_by_half(std::vector<T>& v, std::size_t n) {
   if (n > v.capacity()) v.reserve(std::max(n, v.capacity() + v.capacity() / 2));
@@ -552,9 +552,9 @@ bool Grower::step() {
       r.ahead_valid = g.ahead.valid;
     }
   };
-  // A node costs about a microsecond: grains of 8 roots keep the threads' shares of a step even, and
-  // each writes contiguous runs of the node arrays (dynamic chunks of 4-16 roots handed out one at a
-  // time interleaved the threads' writes and were ~30% slower on 2 threads).
+  // A node is cheap: grains of 8 roots keep the threads' shares of a step even, and each writes
+  // contiguous runs of the node arrays (small dynamic chunks handed out one at a time interleaved the
+  // threads' writes and were slower).
   if (count >= 16)
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 8),
                       [&](const tbb::blocked_range<std::size_t>& rg) { grow_range(rg.begin(), rg.end()); });

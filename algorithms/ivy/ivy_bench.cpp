@@ -60,10 +60,9 @@ GrowResult grow(IvyScene& s, std::size_t budget, const std::vector<std::string>&
 }
 
 // kWarm: every benchmark grows once untimed first. A first grow touches fresh pages as the node
-// arrays double, and a page fault costs ~12 us on these VMs (4.4k faults, ~50 ms of a 300k-node
-// bunny grow); later grows reuse the freed memory (bench_main.cpp keeps glibc from handing it back).
-// Without the warm-up whichever row ran first paid for all of them (the wall looked 2.5x faster on 2
-// threads than on 1).
+// arrays double, and page faults are slow on these VMs; later grows reuse the freed memory
+// (bench_main.cpp keeps glibc from handing it back). Without the warm-up whichever row ran first paid
+// for all of them (the wall looked much faster on 2 threads than on 1).
 //
 // Unlimited root length: on a closed mesh roots never die, so any node budget is reachable.
 const std::vector<std::string> kUnlimited = {"max_root_length=0"};

@@ -294,7 +294,7 @@ class SpaceColonization final : public PortableGrowthAlgorithm {
 
   // Orders the points along a Morton (Z-order) curve, ties by their original index: point ids become
   // spatially coherent, so kd-tree leaves and the per-point arrays are read with good locality
-  // (about 2x faster radius queries at 1M points). Deterministic, like everything here.
+  // (faster radius queries on large point sets). Deterministic, like everything here.
   void morton_order() {
     Aabb b;
     for (const auto& v : pts_) b.extend(v);

@@ -20,13 +20,11 @@ struct RenderArgs {
 
 int render_dir(RenderArgs& a) {
   a.options.render.quality = parse_render_quality(a.quality);
-  const auto r = render_directory(a.dir, a.options);
+  const RenderSummary r = render_directory_record(a.dir, a.options);
   fmt::print("rendered {} images ({} failed, {} POV-Ray warnings) in {:.1f} s with {} POV-Ray processes at once\n",
-             r["renders"].get<int>(), r["failed"].get<int>(), r["warnings"].get<int>(), r["wall_s"].get<double>(),
-             r["jobs"].get<int>());
-  if (r.contains("grid"))
-    fmt::print("grid: {}\n", (std::filesystem::path(a.dir) / r["grid"].get<std::string>()).string());
-  return r["failed"].get<int>() > 0 ? 1 : 0;
+             r.renders, r.failed, r.warnings, r.wall_s, r.jobs);
+  if (r.grid) fmt::print("grid: {}\n", (std::filesystem::path(a.dir) / *r.grid).string());
+  return r.failed > 0 ? 1 : 0;
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -14,7 +15,7 @@
 
 #include "core/params.hpp"
 #include "harness/cli/command.hpp"
-#include "harness/record/files.hpp"
+#include "harness/record/record.hpp"
 #include "harness/render/render_results.hpp"
 #include "harness/run/trial.hpp"
 
@@ -46,24 +47,22 @@ std::string default_out_dir(const TrialSpec& spec) {
   return fmt::format("out/{}-{}", spec.algorithm, name);
 }
 
-void print_record(const nlohmann::json& rec, const TrialSpec& spec, const std::string& out_dir) {
-  const auto& ph = rec["phases"];
+void print_record(const TrialRecord& rec, const TrialSpec& spec, const std::string& out_dir) {
+  // A trial that returns has run every phase; value() says so if one is ever missing.
+  const Phases& ph = rec.phases;
   fmt::print("{} on {} (seed {}, {} threads): {} steps ({}), {} nodes, {} leaves, {:.2f} m of branches\n",
-             rec["algorithm"].get<std::string>(), rec["scene"]["name"].get<std::string>(), spec.seed,
-             rec["threads"].get<int>(), rec["steps"].get<int>(), rec["stopped_by"].get<std::string>(),
-             rec["counts"]["nodes"].get<std::size_t>(), rec["counts"]["leaves"].get<std::size_t>(),
-             rec["total_length_m"].get<double>());
+             rec.algorithm, rec.scene.name, spec.seed, rec.threads, rec.steps, rec.stopped_by, rec.counts.nodes,
+             rec.counts.leaves, rec.total_length_m);
   fmt::print(
       "  time: scene {:.3f} s, query {:.3f} s, growth {:.3f} s, meshing {:.3f} s, export {:.3f} s; peak RSS {:.1f} "
       "MiB\n",
-      ph["scene_load"]["wall_s"].get<double>(), ph["query_build"]["wall_s"].get<double>(),
-      ph["growth"]["wall_s"].get<double>(), ph["meshing"]["wall_s"].get<double>(), ph["export"]["wall_s"].get<double>(),
-      rec["peak_rss_bytes"].get<double>() / (1024.0 * 1024.0));
+      ph.scene_load.value().wall_s, ph.query_build.value().wall_s, ph.growth.value().wall_s, ph.meshing.value().wall_s,
+      ph.exporting.value().wall_s, static_cast<double>(rec.peak_rss_bytes) / (1024.0 * 1024.0));
   fmt::print("  wrote {}/plant.obj, plant.ply, plant.glb, skeleton.obj, record.json (geometry hash {})\n", out_dir,
-             rec["geometry_hash"].get<std::string>());
-  if (rec.contains("frames"))
-    fmt::print("  kept {} frames in {}/frames (capture took {:.3f} s, not counted in growth)\n",
-               rec["frames"]["count"].get<int>(), out_dir, ph["growth"]["frame_capture_wall_s"].get<double>());
+             rec.geometry_hash);
+  if (rec.frames)
+    fmt::print("  kept {} frames in {}/frames (capture took {:.3f} s, not counted in growth)\n", rec.frames->count,
+               out_dir, ph.growth.value().frame_capture_wall_s.value());
 }
 
 // Renders the run directory and reports what the record says of it: 1 when the render failed.
@@ -71,19 +70,21 @@ int render_run(const std::string& out_dir, RenderQuality quality, bool quiet) {
   RenderDirOptions ro;
   ro.render.quality = quality;
   ro.quiet = quiet;
-  const auto r = render_directory(out_dir, ro);
-  const auto updated = read_json_file((std::filesystem::path(out_dir) / "record.json").string());
-  const auto& rr = updated["render"];
-  if (rr["status"] == "ok")
-    fmt::print("  rendered {}/render.png ({}x{}, {}) in {:.2f} s of POV-Ray{}\n", out_dir, rr["width"].get<int>(),
-               rr["height"].get<int>(), to_string(quality), rr["wall_s"].get<double>(),
-               updated.contains("animation")
-                   ? fmt::format(", {} frames: {}", updated["animation"]["frames"].get<int>(),
-                                 updated["animation"].value("file", updated["animation"]["status"].get<std::string>()))
-                   : "");
+  const RenderSummary r = render_directory_record(out_dir, ro);
+  const std::string record_path = (std::filesystem::path(out_dir) / "record.json").string();
+  const TrialRecord updated = read_trial_record(record_path);
+  if (!updated.render)
+    throw std::runtime_error(fmt::format("{}: at render: expected the render just made, found none", record_path));
+  const RenderRecord& rr = *updated.render;
+  if (rr.status == "ok")
+    fmt::print("  rendered {}/render.png ({}x{}, {}) in {:.2f} s of POV-Ray{}\n", out_dir, rr.width, rr.height,
+               to_string(quality), rr.wall_s,
+               updated.animation ? fmt::format(", {} frames: {}", updated.animation->frames,
+                                               updated.animation->file.value_or(updated.animation->status))
+                                 : "");
   else
-    fmt::print(stderr, "growbench: render failed: {}\n", rr.value("message", rr["status"].get<std::string>()));
-  return r["failed"].get<int>() > 0 ? 1 : 0;
+    fmt::print(stderr, "growbench: render failed: {}\n", rr.message.value_or(rr.status));
+  return r.failed > 0 ? 1 : 0;
 }
 
 int run_one(RunArgs& a) {
@@ -103,7 +104,7 @@ int run_one(RunArgs& a) {
     fmt::print(stderr, "{}growing: step {}, {} nodes, {:.1f} s{}", tty ? "\r" : "", p.step, p.nodes, p.growth_seconds,
                tty ? "   " : "\n");
   };
-  const nlohmann::json rec = run_trial(spec, progress);
+  const TrialRecord rec = run_trial_record(spec, progress);
   if (!a.quiet && isatty(STDERR_FILENO)) fmt::print(stderr, "\r{:60}\r", "");
   print_record(rec, spec, a.out_dir);
   return quality ? render_run(a.out_dir, *quality, a.quiet) : 0;

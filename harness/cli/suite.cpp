@@ -13,7 +13,7 @@
 #include "core/errors.hpp"
 #include "harness/cli/command.hpp"
 #include "harness/gate/history.hpp"
-#include "harness/record/files.hpp"
+#include "harness/record/record.hpp"
 #include "harness/render/render_results.hpp"
 #include "harness/report/summary.hpp"
 #include "harness/suite/suite.hpp"
@@ -50,10 +50,9 @@ void render_suite(const std::string& results_path, RenderQuality quality, bool q
   RenderDirOptions ro;
   ro.render.quality = quality;
   ro.quiet = quiet;
-  const auto r = render_directory(std::filesystem::path(results_path).parent_path().string(), ro);
-  fmt::print("rendered {} trials ({} failed) in {:.0f} s; grid: {}\n", r["renders"].get<int>(), r["failed"].get<int>(),
-             r["wall_s"].get<double>(),
-             (std::filesystem::path(results_path).parent_path() / r.value("grid", "")).string());
+  const RenderSummary r = render_directory_record(std::filesystem::path(results_path).parent_path().string(), ro);
+  fmt::print("rendered {} trials ({} failed) in {:.0f} s; grid: {}\n", r.renders, r.failed, r.wall_s,
+             (std::filesystem::path(results_path).parent_path() / r.grid.value_or("")).string());
 }
 
 int run_suite_file(const SuiteArgs& a) {
@@ -79,7 +78,7 @@ int run_suite_file(const SuiteArgs& a) {
   std::optional<RenderQuality> quality;
   if (!a.render.empty()) quality = parse_render_quality(a.render, "--render");
   const std::string path = run_suite(suite, o);
-  fmt::print("{}", summarize_results(read_json_file(path)));
+  fmt::print("{}", summarize_results(read_results(path)));
   fmt::print("\nwrote {} and results.csv beside it\n", path);
   if (!a.history.empty()) fmt::print("history: appended to {}\n", history_add(path, a.history));
   if (quality) render_suite(path, *quality, a.quiet);

@@ -5,9 +5,8 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
-#include "core/errors.hpp"
 #include "harness/cli/command.hpp"
-#include "harness/record/files.hpp"
+#include "harness/record/record.hpp"
 #include "harness/report/summary.hpp"
 
 namespace growbench::cli {
@@ -15,10 +14,8 @@ namespace growbench::cli {
 namespace {
 
 int summarize(const std::string& results_file) {
-  const nlohmann::json results = read_json_file(results_file);
-  if (!results.contains("trials") || results.value("kind", "") != "growbench-results")
-    throw InputError(fmt::format("{}: not a growbench results file (no kind/trials)", results_file));
-  fmt::print("{}", summarize_results(results));
+  // read_results refuses a file of another kind, or one without trials, naming the file and the JSON path.
+  fmt::print("{}", summarize_results(read_results(results_file)));
   return 0;
 }
 

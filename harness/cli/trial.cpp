@@ -5,7 +5,6 @@
 #include <CLI/CLI.hpp>
 
 #include "harness/cli/command.hpp"
-#include "harness/record/files.hpp"
 #include "harness/run/trial.hpp"
 #include "harness/suite/suite.hpp"
 
@@ -18,7 +17,7 @@ struct TrialArgs {
 };
 
 int run_spec(const TrialArgs& a) {
-  TrialSpec ts = trial_spec_from_json(read_json_file(a.spec_file));
+  TrialSpec ts = read_trial_spec(a.spec_file);  // errors name the spec file and the JSON path
   if (!a.fault.empty()) ts.fault = a.fault;
   return run_trial_child(ts, ts.out_dir);
 }

@@ -13,6 +13,7 @@
 #include "core/json_util.hpp"
 #include "harness/output/exporters.hpp"
 #include "harness/record/files.hpp"
+#include "harness/record/record.hpp"
 #include "harness/run/process.hpp"
 #include "harness/stats/stats.hpp"
 #include "harness/run/trial.hpp"
@@ -180,22 +181,23 @@ class Trials {
       cell.error = fmt::format("side {} ({}): {}", kSides[side], bins_[side], why);
       return;
     }
-    json rec;
+    TrialRecord rec;
     try {
-      rec = json::parse(read_text_file((dir / "record.json").string()));
+      rec = read_trial_record((dir / "record.json").string());
     } catch (const std::exception& e) {
       cell.error = fmt::format("side {}: {}/record.json is unreadable: {}", kSides[side], dir.string(), e.what());
       return;
     }
-    cell.hash[static_cast<std::size_t>(side)] = rec.value("geometry_hash", "");
+    cell.hash[static_cast<std::size_t>(side)] = rec.geometry_hash;
     if (!into) return;  // a warm-up
     for (const auto& p : o_.phases) {
-      if (!rec["phases"].contains(p)) {
+      const PhaseMeasures* m = rec.phases.find(p);
+      if (!m) {
         cell.error = fmt::format("side {}: its record has no phase '{}'", kSides[side], p);
         return;
       }
-      (*into)[static_cast<std::size_t>(side)][p + ".wall_s"].push_back(rec["phases"][p]["wall_s"].get<double>());
-      (*into)[static_cast<std::size_t>(side)][p + ".cpu_s"].push_back(rec["phases"][p]["cpu_s"].get<double>());
+      (*into)[static_cast<std::size_t>(side)][p + ".wall_s"].push_back(m->wall_s);
+      (*into)[static_cast<std::size_t>(side)][p + ".cpu_s"].push_back(m->cpu_s);
     }
   }
 

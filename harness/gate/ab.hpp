@@ -1,15 +1,14 @@
 // `growbench ab A B SUITE`: the statistical gate. Two growbench binaries (a base and a candidate, built
 // elsewhere: ab builds nothing) run the same suite's trials alternately, A B then B A, so drift on a
 // shared machine falls on both sides alike. Each cell gets a pilot of repetitions; its measured noise
-// (coefficient of variation) then sets how many more it needs to see the effect asked for (default 3%),
-// up to a cap. Wall and CPU time of the chosen phases are compared with a Mann-Whitney U test and a
-// bootstrap interval of the median ratio (harness/stats/stats.hpp), and, because each A ran next to a B, with
-// the Wilcoxon signed-rank test of the pairs' ratios: on a shared VM whose speed drifts by 20-50% over a
-// few minutes (measured: robust CV 15-30% per cell on the quick suite), drift moves both sides of a pair
-// and cancels in its ratio, while the unpaired test counts it as noise. A cell flagged slower or faster is run
-// again, a fresh batch, and only a flag the rerun repeats is reported as a regression (exit 1) or an
-// improvement. Noise too high for the effect within the cap is reported as "inconclusive", never as
-// "no change".
+// (coefficient of variation) then sets how many more it needs to see the effect asked for (--effect), up
+// to a cap. Wall and CPU time of the chosen phases are compared with a Mann-Whitney U test and a
+// bootstrap interval of the median ratio (harness/stats/stats.hpp), and, because each A ran next to a B,
+// with the Wilcoxon signed-rank test of the pairs' ratios: on a shared VM whose speed drifts within
+// minutes, drift moves both sides of a pair and cancels in its ratio, while the unpaired test counts it
+// as noise. A cell flagged slower or faster is run again, a fresh batch, and only a flag the rerun
+// repeats is reported as a regression (exit 1) or an improvement. Noise too high for the effect within
+// the cap is reported as "inconclusive", never as "no change".
 #pragma once
 
 #include <string>

@@ -19,14 +19,13 @@ namespace growbench {
 
 struct CompareOptions {
   double instructions_threshold = 0.02;  // a phase's Ir more than this fraction above the base fails ...
-  // ... and by more than this many instructions: the smallest phases (a scene load of 50k instructions)
-  // move by a few hundred with the heap layout (path lengths differ between checkouts).
+  // ... and by more than this many instructions: the smallest phases (a scene load) move a little with the
+  // heap layout (path lengths differ between checkouts), and a relative threshold alone would fail them.
   double instructions_floor = 1e5;
   // Allocations may differ by this much per phase without failing. Where code builds absolute paths into
   // the checkout (the bundled meshes, the L-system's example grammars), the checkout's path enters them:
-  // its length the bytes (90 between /work/main and /work/cleancheck), its depth the count, as each
-  // std::filesystem::path holds its components (a checkout one directory deeper: 7 more allocations in
-  // the bunny's scene load, 3 in an L-system's growth). A per-node or per-step regression is far larger.
+  // its length the bytes, its depth the count, as each std::filesystem::path holds its components. A
+  // per-node or per-step regression is far larger.
   double alloc_bytes_slack = 4096;
   double alloc_count_slack = 32;
   double timing_effect = 1.03;  // the statistical comparison's effect size and significance level

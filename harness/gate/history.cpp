@@ -47,7 +47,7 @@ HistoryCell history_cell(const SuiteCell& t, bool timing) {
       growth_rss.push_back(static_cast<double>(g->peak_rss_bytes));
     }
   }
-  // Timings only from timing runs: under callgrind they are ~50x slower and mean nothing.
+  // Timings only from timing runs: under callgrind they are many times slower and mean nothing.
   auto keep = [&](std::optional<double>& median, std::optional<std::uint64_t>& n, const std::vector<double>& x) {
     if (!timing || x.empty()) return;
     median = median_of(x);

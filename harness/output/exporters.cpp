@@ -25,7 +25,7 @@ namespace {
 static_assert(std::endian::native == std::endian::little, "the PLY writer assumes a little-endian host");
 
 // Formatted text streamed through an AtomicFile: records are formatted into a small buffer that is handed
-// on whenever it passes 64 KiB. Building a whole OBJ in memory first (560 MB for the wall's ivy) cost
+// on whenever it passes 64 KiB. Building a whole OBJ in memory first (hundreds of MB for a big plant) cost
 // more in page faults and reallocation copies than the formatting itself.
 class TextFile {
  public:
@@ -41,7 +41,7 @@ class TextFile {
   }
   // format(i, buffer) appends record i for i in [0, n): chunks of records are formatted in parallel and
   // written in order, so the file is the same byte for byte as a serial loop's. Formatting is most of
-  // an OBJ's cost (fmt writes ~150 MB/s of it on one core here).
+  // an OBJ's cost.
   template <class Format>
   void records(std::size_t n, const Format& format) {
     constexpr std::size_t kChunk = 8192;
@@ -236,8 +236,8 @@ std::uint64_t write_glb(const std::string& path, const OutputMesh& m) {
   scene.nodes = {0};
   model.scenes.push_back(scene);
   model.defaultScene = 0;
-  // Streamed to the file: a string stream of the whole file and its copy cost 3-4 times its size in fresh
-  // pages. tinygltf still copies the binary chunk once.
+  // Streamed to the file: a string stream of the whole file and its copy cost several times its size in
+  // fresh pages. tinygltf still copies the binary chunk once.
   const std::string tmp = path + ".tmp";
   {
     std::ofstream out(tmp, std::ios::binary);

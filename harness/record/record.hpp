@@ -79,7 +79,7 @@ struct OutputBytes {
   std::optional<std::uint64_t> obj, ply, glb, skeleton_obj;
 };
 
-// The growth curve: at most 2 x 256 points, thinned by doubling `every` (harness/run/trial.cpp).
+// The growth curve: a bounded number of points, thinned by doubling `every` (kCurveCap in harness/run/trial.cpp).
 struct Curve {
   int every = 1;
   std::vector<int> step;

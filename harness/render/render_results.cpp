@@ -376,8 +376,4 @@ RenderSummary render_directory_record(const std::string& dir_arg, const RenderDi
   return summary;
 }
 
-json render_directory(const std::string& dir, const RenderDirOptions& options) {
-  return to_json(render_directory_record(dir, options));
-}
-
 }  // namespace growbench

@@ -6,8 +6,6 @@
 
 #include <string>
 
-#include <nlohmann/json.hpp>
-
 #include "harness/record/record.hpp"
 #include "harness/render/render.hpp"
 
@@ -27,6 +25,5 @@ struct RenderDirOptions {
 // written are kept. Throws InputError when DIR is neither (or its file does not read as one). Returns the
 // "renders" summary.
 RenderSummary render_directory_record(const std::string& dir, const RenderDirOptions& options);
-nlohmann::json render_directory(const std::string& dir, const RenderDirOptions& options);  // to_json of the above
 
 }  // namespace growbench

@@ -254,8 +254,8 @@ struct Spare {
   int report_fd = -1;  // read end of its report pipe
 };
 
-// While it waits, a job's child takes the page faults its job would otherwise take first (each costs
-// ~12 us on a paravirtualised VM): the top of its stack, and copies of the launcher's heap pages that
+// While it waits, a job's child takes the page faults its job would otherwise take first (each one costly
+// on a paravirtualised VM): the top of its stack, and copies of the launcher's heap pages that
 // malloc writes (the arena's free lists and the chunks it hands out first).
 __attribute__((noinline)) void warm_up() {
   volatile char stack[256 * 1024];

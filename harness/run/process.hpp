@@ -33,11 +33,11 @@ struct ChildResult {
 int process_thread_count();
 
 // Runs `body` in a forked child (stdout and stderr appended to `log_path` when given) and waits for it.
-// The child exits with body's return value (an escaping exception exits 70). Forking rather than
-// exec'ing keeps the launch to 2-3 ms on a paravirtualised VM (the fork, then the child's first page
-// faults and syscalls): exec'ing growbench spends 70-80 ms in the dynamic linker relocating OpenVDB, TBB
-// and Embree. The caller must not have started threads (TBB, Embree) before forking: only the calling
-// thread exists in the child. Throws std::runtime_error when the process cannot be started.
+// The child exits with body's return value (an escaping exception exits 70). Forking rather than exec'ing
+// keeps the launch to the fork and the child's first page faults and syscalls: exec'ing growbench would
+// spend far longer in the dynamic linker relocating OpenVDB, TBB and Embree. The caller must not have
+// started threads (TBB, Embree) before forking: only the calling thread exists in the child. Throws
+// std::runtime_error when the process cannot be started.
 ChildResult run_forked(const std::function<int()>& body, const ChildLimits& limits, const std::string& log_path);
 
 // The same, with a report channel: body gets the write end of a pipe, and may write one report of at most
@@ -50,8 +50,8 @@ ChildResult run_forked(const std::function<int(int report_fd)>& body, const Chil
 // A small process, forked before its owner builds up state, that forks each job's child on request.
 // A child forked straight from a long-running suite process inherits all of that process's heap (the
 // results of every trial so far): the inherited pages count in the child's peak RSS, which then grows
-// over a suite, and each one the child writes costs a copy-on-write fault (~20 us on a paravirtualised
-// VM). The launcher's heap stays as small and unfragmented as it was when it was forked.
+// over a suite, and each one the child writes costs a copy-on-write fault, slow on a paravirtualised
+// VM. The launcher's heap stays as small and unfragmented as it was when it was forked.
 class Launcher {
  public:
   struct Job {
@@ -65,7 +65,7 @@ class Launcher {
   // Forks the launcher. The caller must be single-threaded (see run_forked). The launcher keeps one
   // job's child forked ahead, waiting for its job: at first, and again as soon as the running job's
   // child reports (while the kernel frees that child's memory and the owner reads its results), so a
-  // job's launch is a pipe write, not a fork (2-3 ms on a paravirtualised VM).
+  // job's launch is a pipe write, not a fork.
   explicit Launcher(Prepare prepare);
   ~Launcher();  // the launcher exits when its request pipe closes, and is reaped here
   Launcher(const Launcher&) = delete;

@@ -94,7 +94,7 @@ class PhaseTimer {
     // Under callgrind (`growbench suite --instructions`, which starts with instrumentation off) each
     // phase is instrumented and dumped on its own; natively these are a few no-op instructions. The
     // query build (OpenVDB's level set and Embree's BVH, the same for every algorithm) is left
-    // uninstrumented: at about 50x it would take most of the gate's time (2.5 G instructions on the wall).
+    // uninstrumented: under callgrind's slowdown it would take most of the gate's time.
     const bool instrument = std::strcmp(name, "query_build") != 0;
     if (instrument) {
       CALLGRIND_ZERO_STATS;

@@ -716,7 +716,7 @@ std::unique_ptr<Launcher> start_trial_launcher() {
   // worker threads when the library loads, before main: stop it (logging still works without it).
   log4cplus::deinitialize();
   // TBB's one-time initialisation (hardware topology; no worker threads: those start with the first
-  // parallel algorithm) is done here once, so each forked trial inherits it instead of paying ~3 ms.
+  // parallel algorithm) is done here once, so each forked trial inherits it instead of paying for it again.
   (void)tbb::info::default_concurrency();
   { tbb::global_control warm(tbb::global_control::max_allowed_parallelism, tbb::info::default_concurrency()); }
   // The pool's threads are joined, but the kernel counts a joined thread until it has finished
