@@ -9,7 +9,7 @@ JOBS ?= $(shell nproc)
 # Repetitions per cell in `make demo` (a number, or "suite" for the standard suite's own).
 DEMO_REPETITIONS ?= 1
 
-.PHONY: all deps configure build cli test demo demo-full bench plugin-bench gate baseline readme-params format clean
+.PHONY: all deps configure build cli test demo demo-full bench plugin-bench gate baseline readme-params plugin-sdk format clean
 
 all: build
 
@@ -54,6 +54,11 @@ baseline: build
 # the ctest readme.params fails while a committed table differs from the binary's).
 readme-params: cli
 	/usr/bin/python3 scripts/readme-params $(GROWBENCH)
+
+# The plugin SDK as a user meets it: install into a temporary prefix, build examples/plugin against it,
+# run it in a suite beside a built-in and report it (scripts/test-plugin-sdk).
+plugin-sdk: cli
+	bash scripts/test-plugin-sdk $(BUILD)
 
 bench: build
 	$(BUILD)/bench/growbench_bench

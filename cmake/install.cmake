@@ -1,0 +1,47 @@
+# `cmake --install BUILD --prefix P`: the growbench binary, the plugin SDK (headers and a CMake package
+# with growbench_add_plugin), and the data files the binary and its report read.
+#
+# Components, so the SDK can be installed from a configured tree before growbench is built:
+#   runtime  bin/growbench and share/growbench/ (report scripts, schema, bundled meshes, L-system
+#            example grammars, suites)
+#   sdk      include/growbench/plugin.h, plugin.hpp and lib/cmake/growbench/
+include(GNUInstallDirs)
+include(CMakePackageConfigHelpers)
+
+install(TARGETS growbench RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
+
+# The data keeps the checkout's layout under share/growbench, because report.py finds the results
+# schema and docs/metrics.md relative to itself. The binary itself still reads these from the source
+# paths compiled into it (scenes/scene_io.cpp, algorithms/lsystem/lsystem.cpp,
+# harness/report/report.cpp); with the checkout gone, only the report can be pointed here
+# (GROWBENCH_REPORT_SCRIPT=P/share/growbench/reports/report.py).
+set(GROWBENCH_INSTALL_DATADIR ${CMAKE_INSTALL_DATADIR}/growbench)
+install(FILES reports/report.py reports/history.py DESTINATION ${GROWBENCH_INSTALL_DATADIR}/reports COMPONENT runtime)
+install(FILES harness/record/results.schema.json DESTINATION ${GROWBENCH_INSTALL_DATADIR}/harness/record
+        COMPONENT runtime)
+install(FILES docs/metrics.md DESTINATION ${GROWBENCH_INSTALL_DATADIR}/docs COMPONENT runtime)
+install(DIRECTORY scenes/meshes/ DESTINATION ${GROWBENCH_INSTALL_DATADIR}/scenes/meshes COMPONENT runtime
+        FILES_MATCHING PATTERN "*.obj" PATTERN "*.md")
+install(DIRECTORY algorithms/lsystem/examples/ DESTINATION ${GROWBENCH_INSTALL_DATADIR}/algorithms/lsystem/examples
+        COMPONENT runtime FILES_MATCHING PATTERN "*.lsys")
+install(DIRECTORY bench/suites/ DESTINATION ${GROWBENCH_INSTALL_DATADIR}/suites COMPONENT runtime
+        FILES_MATCHING PATTERN "*.json")
+
+install(FILES include/growbench/plugin.h include/growbench/plugin.hpp
+        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/growbench COMPONENT sdk)
+
+# The ABI version the headers declare, so a plugin's build can check it without compiling anything.
+file(STRINGS include/growbench/plugin.h _gb_abi_line REGEX "^#define GROWBENCH_PLUGIN_ABI_VERSION ")
+string(REGEX REPLACE "^#define GROWBENCH_PLUGIN_ABI_VERSION ([0-9]+)u.*" "\\1" GROWBENCH_PLUGIN_ABI_VERSION
+                     "${_gb_abi_line}")
+
+set(GROWBENCH_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/growbench)
+configure_package_config_file(cmake/growbenchConfig.cmake.in ${PROJECT_BINARY_DIR}/growbenchConfig.cmake
+                              INSTALL_DESTINATION ${GROWBENCH_INSTALL_CMAKEDIR}
+                              PATH_VARS CMAKE_INSTALL_INCLUDEDIR CMAKE_INSTALL_BINDIR GROWBENCH_INSTALL_DATADIR)
+# Whether a plugin loads is decided at load time by GROWBENCH_PLUGIN_ABI_VERSION, not by this version;
+# it only lets a project ask for a release line. Not arch-independent: a plugin must match the binary.
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/growbenchConfigVersion.cmake VERSION ${PROJECT_VERSION}
+                                 COMPATIBILITY SameMajorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/growbenchConfig.cmake ${PROJECT_BINARY_DIR}/growbenchConfigVersion.cmake
+        DESTINATION ${GROWBENCH_INSTALL_CMAKEDIR} COMPONENT sdk)
