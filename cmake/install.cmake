@@ -10,11 +10,9 @@ include(CMakePackageConfigHelpers)
 
 install(TARGETS growbench RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
 
-# The data keeps the checkout's layout under share/growbench, because report.py finds the results
-# schema and docs/metrics.md relative to itself. The binary itself still reads these from the source
-# paths compiled into it (scenes/scene_io.cpp, algorithms/lsystem/lsystem.cpp,
-# harness/report/report.cpp); with the checkout gone, only the report can be pointed here
-# (GROWBENCH_REPORT_SCRIPT=P/share/growbench/reports/report.py).
+# The data keeps the checkout's layout under share/growbench: report.py finds the results schema and
+# docs/metrics.md relative to itself, and the binary (core/data_path.hpp) reads from here once the
+# checkout it was built from is gone.
 set(GROWBENCH_INSTALL_DATADIR ${CMAKE_INSTALL_DATADIR}/growbench)
 install(FILES reports/report.py reports/history.py DESTINATION ${GROWBENCH_INSTALL_DATADIR}/reports COMPONENT runtime)
 install(FILES harness/record/results.schema.json DESTINATION ${GROWBENCH_INSTALL_DATADIR}/harness/record

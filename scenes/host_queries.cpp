@@ -20,7 +20,7 @@ void DirectQueries::signed_distance(std::span<const glm::vec3> p, std::span<floa
                                     std::span<glm::vec3> gradient) const {
   if (!q_.has_sdf()) throw InputError("the scene has no distance field");
   for (std::size_t i = 0; i < p.size(); ++i) {
-    distance[i] = q_.signed_distance(p[i]);
+    if (!distance.empty()) distance[i] = q_.signed_distance(p[i]);
     if (!gradient.empty()) gradient[i] = q_.gradient(p[i]);
   }
 }

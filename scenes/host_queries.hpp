@@ -32,7 +32,8 @@ class HostQueries {
                               std::span<ClosestHit> out) const = 0;
   virtual void rays(std::span<const Ray> r, std::span<RayHit> out) const = 0;
   virtual void occluded(std::span<const Ray> r, std::span<std::uint8_t> out) const = 0;
-  // `gradient` may be empty. Throws InputError when the scene has no distance field.
+  // Either of `distance` and `gradient` may be empty: only the other is computed. Throws InputError
+  // when the scene has no distance field.
   virtual void signed_distance(std::span<const glm::vec3> p, std::span<float> distance,
                                std::span<glm::vec3> gradient) const = 0;
   virtual void inside(std::span<const glm::vec3> p, std::span<std::uint8_t> out) const = 0;
@@ -65,7 +66,7 @@ class HostQueries {
   }
   [[nodiscard]] glm::vec3 gradient(const glm::vec3& p) const {
     glm::vec3 g(0.0f);
-    (void)signed_distance(p, g);
+    signed_distance({&p, 1}, {}, {&g, 1});
     return g;
   }
   [[nodiscard]] SurfaceSample sample_surface(std::uint64_t seed, std::uint64_t index) const {

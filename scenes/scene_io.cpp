@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <tiny_obj_loader.h>
 
+#include "core/data_path.hpp"
 #include "core/json_util.hpp"
 #include "scenes/geometry.hpp"
 #include "scenes/scene_library.hpp"
@@ -25,7 +26,7 @@ bool is_mesh_name(const std::string& ref) {
 std::vector<std::string> bundled_meshes() {
   std::vector<std::string> names;
   std::error_code ec;
-  for (const auto& e : fs::directory_iterator(GROWBENCH_MESH_DIR, ec))
+  for (const auto& e : fs::directory_iterator(data_path("scenes/meshes"), ec))
     if (e.path().extension() == ".obj") names.push_back(e.path().stem().string());
   std::sort(names.begin(), names.end());
   return names;
@@ -33,16 +34,16 @@ std::vector<std::string> bundled_meshes() {
 
 std::string mesh_path(const std::string& ref) {
   if (!is_mesh_name(ref)) return ref;
-  const fs::path p = fs::path(GROWBENCH_MESH_DIR) / (ref + ".obj");
+  const fs::path p = fs::path(data_path("scenes/meshes")) / (ref + ".obj");
   if (fs::exists(p)) return p.string();
   const std::vector<std::string> names = bundled_meshes();
   std::string near = closest_match(ref, names);
   for (const auto& n : names)  // "bunny" means the Stanford bunny
     if (near.empty() && n.find(ref) != std::string::npos) near = n;
-  throw InputError(fmt::format(
-      "unknown mesh '{}'{}; expected a bundled mesh ({}) or a path to an OBJ file", ref,
-      near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near),
-      names.empty() ? fmt::format("none found in {}", GROWBENCH_MESH_DIR) : fmt::format("{}", fmt::join(names, ", "))));
+  throw InputError(fmt::format("unknown mesh '{}'{}; expected a bundled mesh ({}) or a path to an OBJ file", ref,
+                               near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near),
+                               names.empty() ? fmt::format("none found in {}", data_path("scenes/meshes"))
+                                             : fmt::format("{}", fmt::join(names, ", "))));
 }
 
 TriangleMesh load_obj(const std::string& path) {

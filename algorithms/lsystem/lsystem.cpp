@@ -24,12 +24,9 @@
 #include "algorithms/lsystem/derive.hpp"
 #include "algorithms/lsystem/grammar.hpp"
 #include "algorithms/lsystem/turtle.hpp"
+#include "core/data_path.hpp"
 #include "core/errors.hpp"
 #include "core/random.hpp"
-
-#ifndef GROWBENCH_LSYSTEM_EXAMPLES
-#define GROWBENCH_LSYSTEM_EXAMPLES "algorithms/lsystem/examples"
-#endif
 
 namespace growbench {
 namespace {
@@ -445,7 +442,7 @@ GROWBENCH_REGISTER_ALGORITHM(lsystem, LSystem, kInfo, lsys::TurtleSettings, lsys
 std::vector<std::string> lsystem_examples() {
   std::vector<std::string> names;
   std::error_code ec;
-  for (const auto& e : std::filesystem::directory_iterator(GROWBENCH_LSYSTEM_EXAMPLES, ec))
+  for (const auto& e : std::filesystem::directory_iterator(data_path("algorithms/lsystem/examples"), ec))
     if (e.path().extension() == ".lsys") names.push_back(e.path().stem().string());
   std::sort(names.begin(), names.end());
   return names;
@@ -455,7 +452,7 @@ std::string resolve_grammar_path(const std::string& name) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (fs::is_regular_file(name, ec)) return name;
-  const fs::path dir(GROWBENCH_LSYSTEM_EXAMPLES);
+  const fs::path dir(data_path("algorithms/lsystem/examples"));
   for (const auto& candidate : {dir / name, dir / (name + ".lsys")})
     if (fs::is_regular_file(candidate, ec)) return candidate.string();
   const auto names = lsystem_examples();

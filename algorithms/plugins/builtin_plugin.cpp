@@ -107,7 +107,8 @@ class TableQueries final : public HostQueries {
   void signed_distance(std::span<const glm::vec3> p, std::span<float> distance,
                        std::span<glm::vec3> gradient) const override {
     auto* g = gradient.empty() ? nullptr : reinterpret_cast<growbench_vec3*>(gradient.data());
-    if (h_.signed_distance(h_.context, abi(p.data()), p.size(), distance.data(), g) != GROWBENCH_OK)
+    float* d = distance.empty() ? nullptr : distance.data();
+    if (h_.signed_distance(h_.context, abi(p.data()), p.size(), d, g) != GROWBENCH_OK)
       throw InputError("the scene has no distance field");
   }
   void inside(std::span<const glm::vec3> p, std::span<std::uint8_t> out) const override {

@@ -310,10 +310,10 @@ struct HostFunctions {
                                       growbench_vec3* gradient) {
     const HostQueries& q = *self(c).q_;
     if (!q.has_sdf()) return GROWBENCH_ERROR;
-    q.signed_distance(points(p, n), {distance, static_cast<std::size_t>(n)},
-                      gradient
-                          ? std::span<glm::vec3>(reinterpret_cast<glm::vec3*>(gradient), static_cast<std::size_t>(n))
-                          : std::span<glm::vec3>());
+    q.signed_distance(
+        points(p, n), distance ? std::span<float>(distance, static_cast<std::size_t>(n)) : std::span<float>(),
+        gradient ? std::span<glm::vec3>(reinterpret_cast<glm::vec3*>(gradient), static_cast<std::size_t>(n))
+                 : std::span<glm::vec3>());
     return GROWBENCH_OK;
   }
   static void inside(void* c, const growbench_vec3* p, std::uint64_t n, std::uint8_t* out) {

@@ -407,11 +407,10 @@ class SpaceColonization final : public PortableGrowthAlgorithm {
     if (cfg_.surface == Surface::Free) return c;
     // A few fixed-point iterations: the SDF gradient is that of a trilinear field, so one push lands close.
     for (int it = 0; it < 3; ++it) {
-      glm::vec3 g;
-      const float d = query_->signed_distance(c, g);
+      const float d = query_->signed_distance(c);
       if (cfg_.surface == Surface::Avoid && d >= cfg_.cling_distance) break;
       if (std::abs(d - cfg_.cling_distance) < 1e-3f * cfg_.step) break;
-      c += (cfg_.cling_distance - d) * g;
+      c += (cfg_.cling_distance - d) * query_->gradient(c);
     }
     return c;
   }

@@ -44,6 +44,9 @@ Command add_ab(CLI::App& app) {
   cmd->add_option("suite", a->suite, "suite file (its cells, seeds and limits; its repetitions are not used)")
       ->required();
   add_plugin_option(cmd, a->plugins);
+  cmd->add_option("--plugin-b", o.b_plugins,
+                  "side B loads this plugin file instead of --plugin's and the suite's (repeatable): A/B of two "
+                  "builds of one plugin");
   cmd->add_option("-o,--out", o.out_dir, "output directory: ab.json and the trials (default: out/ab/SUITE)");
   cmd->add_option("--effect", o.effect, "the smallest median ratio B/A to detect")->default_val(1.03);
   cmd->add_option("--alpha", o.alpha, "significance level of the Mann-Whitney U test")->default_val(0.01);

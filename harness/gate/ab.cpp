@@ -91,7 +91,7 @@ void check_options(const AbOptions& o) {
 }
 
 // One cell per suite config, with the spec file each side's trials read.
-std::vector<Cell> make_cells(const Suite& suite, const fs::path& out) {
+std::vector<Cell> make_cells(const Suite& suite, const fs::path& out, const std::vector<std::string>& b_plugins) {
   std::vector<Cell> cells;
   for (const auto& c : suite.configs) {
     Cell cell;
@@ -99,7 +99,12 @@ std::vector<Cell> make_cells(const Suite& suite, const fs::path& out) {
     cell.dir = out / "cells" / c.id;
     for (int s = 0; s < 2; ++s) {
       fs::create_directories(cell.dir / kSides[s]);
-      const std::string text = trial_job(c, (cell.dir / kSides[s]).string()).dump() + "\n";
+      json job = trial_job(c, (cell.dir / kSides[s]).string());
+      if (s == 1 && !b_plugins.empty()) {
+        job["plugins"] = json::array();
+        for (const auto& p : b_plugins) job["plugins"].push_back(fs::absolute(p).lexically_normal().string());
+      }
+      const std::string text = job.dump() + "\n";
       write_file_atomic((cell.dir / kSides[s] / "spec.json").string(), text.data(), text.size());
     }
     cells.push_back(std::move(cell));
@@ -334,7 +339,8 @@ json doc_of(Findings&& f, const Suite& suite, const AbOptions& o, const Binaries
                 {"min_repetitions", o.min_repetitions},
                 {"max_repetitions", o.max_repetitions},
                 {"phases", o.phases},
-                {"confirm", o.confirm}}},
+                {"confirm", o.confirm},
+                {"b_plugins", o.b_plugins}}},
               {"context", run_context()},
               {"trials_run", trials_run},
               {"cells", std::move(f.cells)}};
@@ -350,7 +356,7 @@ AbResult run_ab(const Suite& suite, const AbOptions& o) {
   const fs::path out = o.out_dir.empty() ? fs::path("out/ab") / suite.name : fs::path(o.out_dir);
   fs::create_directories(out);
   const Binaries bins = {fs::absolute(o.a_binary).string(), fs::absolute(o.b_binary).string()};
-  std::vector<Cell> cells = make_cells(suite, out);
+  std::vector<Cell> cells = make_cells(suite, out, o.b_plugins);
 
   Trials trials(suite, o, bins, cells);
   trials.warm_up();

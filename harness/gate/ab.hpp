@@ -31,6 +31,8 @@ struct AbOptions {
   std::vector<std::string> phases = {"growth"};
   bool confirm = true;  // rerun flagged cells
   bool quiet = false;
+  // Side B's plugin files instead of those this process loaded: two builds of one plugin, A/B.
+  std::vector<std::string> b_plugins;
 };
 
 struct AbResult {

@@ -7,19 +7,16 @@
 
 #include <fmt/format.h>
 
+#include "core/data_path.hpp"
 #include "core/errors.hpp"
 #include "harness/run/process.hpp"
-
-#ifndef GROWBENCH_SOURCE_DIR
-#define GROWBENCH_SOURCE_DIR ""
-#endif
 
 namespace growbench {
 namespace fs = std::filesystem;
 
 std::string report_script() {
   if (const char* s = std::getenv("GROWBENCH_REPORT_SCRIPT"); s && *s) return s;
-  return (fs::path(GROWBENCH_SOURCE_DIR) / "reports" / "report.py").string();
+  return data_path("reports/report.py");
 }
 
 std::string report_python() {

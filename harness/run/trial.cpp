@@ -26,6 +26,7 @@
 
 #include "algorithms/algorithm.hpp"
 #include "algorithms/plugins/loader.hpp"
+#include "core/data_path.hpp"
 #include "core/errors.hpp"
 #include "core/file_hash.hpp"
 #include "harness/record/files.hpp"
@@ -220,7 +221,8 @@ RunContext run_context_record() {
   RunContext c;
   // The commit the binary was configured at; the source tree's current state when it is reachable.
   c.growbench_commit = GROWBENCH_GIT_COMMIT;
-  if (std::filesystem::exists(std::string(GROWBENCH_SOURCE_DIR) + "/.git")) {
+  // Not for an installed copy: the checkout may have moved on since it was built.
+  if (running_from_build_tree() && std::filesystem::exists(std::string(GROWBENCH_SOURCE_DIR) + "/.git")) {
     const std::string commit =
         run_command(fmt::format("git -C '{}' rev-parse --short=12 HEAD 2>/dev/null", GROWBENCH_SOURCE_DIR));
     if (!commit.empty()) c.growbench_commit = commit;

@@ -221,8 +221,9 @@ typedef struct growbench_host {
   void (*rays)(void* context, const growbench_ray* rays, uint64_t n, growbench_ray_hit* out);
   /* Whether anything lies along each ray within (tmin, tmax): 1 or 0. */
   void (*occluded)(void* context, const growbench_ray* rays, uint64_t n, uint8_t* out);
-  /* Signed distance to the solids (negative inside) and, when `gradient` is not NULL, its unit
-   * gradient (outwards). Returns GROWBENCH_ERROR, writing nothing, when the scene has no field. */
+  /* Signed distance to the solids (negative inside) and its unit gradient (outwards): either array may
+   * be NULL, and then only the other is computed. Returns GROWBENCH_ERROR, writing nothing, when the
+   * scene has no field. */
   int32_t (*signed_distance)(void* context, const growbench_vec3* points, uint64_t n, float* distance,
                              growbench_vec3* gradient);
   /* Whether each point lies inside a solid (exact; the surface itself is outside): 1 or 0. */

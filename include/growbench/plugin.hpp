@@ -257,7 +257,7 @@ class Host {
   void occluded(const growbench_ray* r, std::size_t n, std::uint8_t* out) const {
     h_->occluded(h_->context, r, n, out);
   }
-  // Throws InputError when the scene has no distance field. `gradient` may be null.
+  // Throws InputError when the scene has no distance field. Either output may be null.
   void signed_distance(const Vec3* p, std::size_t n, float* distance, Vec3* gradient = nullptr) const {
     if (h_->signed_distance(h_->context, p, n, distance, gradient) != GROWBENCH_OK)
       throw InputError("the scene has no distance field");

@@ -1,0 +1,17 @@
+// Where the binary finds the data it reads (bundled meshes, example grammars, the report script): in
+// the checkout it was built from while that is still there, otherwise in the share/growbench/ an
+// installed binary has beside it (cmake/install.cmake keeps the checkout's layout there).
+#pragma once
+
+#include <string>
+#include <string_view>
+
+namespace growbench {
+
+// `relative` is a path in the checkout, e.g. "scenes/meshes".
+std::string data_path(std::string_view relative);
+
+// Whether this binary runs from the build tree it was built in (not an installed copy).
+bool running_from_build_tree();
+
+}  // namespace growbench
