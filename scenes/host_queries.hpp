@@ -58,12 +58,6 @@ class HostQueries {
     signed_distance({&p, 1}, {&d, 1}, {});
     return d;
   }
-  // The signed distance and its unit gradient at p.
-  [[nodiscard]] float signed_distance(const glm::vec3& p, glm::vec3& gradient) const {
-    float d = 0.0f;
-    signed_distance({&p, 1}, {&d, 1}, {&gradient, 1});
-    return d;
-  }
   [[nodiscard]] glm::vec3 gradient(const glm::vec3& p) const {
     glm::vec3 g(0.0f);
     signed_distance({&p, 1}, {}, {&g, 1});

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "algorithms/algorithm.hpp"
+#include "algorithms/plugins/abi_convert.hpp"
 #include "growbench/plugin.hpp"
 
 #define GROWBENCH_CONCAT2(a, b) a##b
@@ -26,20 +27,10 @@ const AlgorithmEntry& builtin() {
   return e;
 }
 
-glm::vec3 glm_of(const growbench_vec3& v) {
-  return {v.x, v.y, v.z};
-}
-growbench_vec3 abi(const glm::vec3& v) {
-  return {v.x, v.y, v.z};
-}
-const growbench_vec3* abi(const glm::vec3* p) {
-  return reinterpret_cast<const growbench_vec3*>(p);
-}
-
 TriangleMesh mesh_of(const growbench_mesh& m) {
   TriangleMesh t;
   t.name = m.name ? m.name : "";
-  for (std::uint64_t i = 0; i < m.vertex_count; ++i) t.vertices.push_back(glm_of(m.vertices[i]));
+  for (std::uint64_t i = 0; i < m.vertex_count; ++i) t.vertices.push_back(abi::of(m.vertices[i]));
   for (std::uint64_t i = 0; i < m.triangle_count; ++i)
     t.triangles.emplace_back(m.triangles[3 * i], m.triangles[3 * i + 1], m.triangles[3 * i + 2]);
   t.climbable = m.climbable != 0;
@@ -51,10 +42,10 @@ Shape shape_of(const growbench_shape& s) {
   r.kind = s.kind == GROWBENCH_SHAPE_BOX         ? Shape::Kind::Box
            : s.kind == GROWBENCH_SHAPE_ELLIPSOID ? Shape::Kind::Sphere
                                                  : Shape::Kind::Mesh;
-  r.min = glm_of(s.min);
-  r.max = glm_of(s.max);
-  r.center = glm_of(s.center);
-  r.radii = glm_of(s.radii);
+  r.min = abi::of(s.min);
+  r.max = abi::of(s.max);
+  r.center = abi::of(s.center);
+  r.radii = abi::of(s.radii);
   if (r.kind == Shape::Kind::Mesh) r.mesh = mesh_of(s.mesh);
   return r;
 }
@@ -64,10 +55,10 @@ Scene scene_of(const growbench_scene& s) {
   r.name = s.name ? s.name : "";
   for (std::uint32_t i = 0; i < s.mesh_count; ++i) r.meshes.push_back(mesh_of(s.meshes[i]));
   for (std::uint32_t i = 0; i < s.seed_count; ++i)
-    r.seeds.push_back({glm_of(s.seeds[i].position), glm_of(s.seeds[i].direction), s.seeds[i].start_step});
+    r.seeds.push_back({abi::of(s.seeds[i].position), abi::of(s.seeds[i].direction), s.seeds[i].start_step});
   r.light.kind = s.light.point ? Light::Kind::Point : Light::Kind::Sun;
-  r.light.direction = glm_of(s.light.direction);
-  r.light.position = glm_of(s.light.position);
+  r.light.direction = abi::of(s.light.direction);
+  r.light.position = abi::of(s.light.position);
   if (s.has_envelope) r.envelope = shape_of(s.envelope);
   for (std::uint32_t i = 0; i < s.zone_count; ++i)
     r.zones.push_back({static_cast<Zone::Kind>(s.zones[i].kind), shape_of(s.zones[i].shape), s.zones[i].strength});
@@ -82,23 +73,19 @@ class TableQueries final : public HostQueries {
   void closest_points(std::span<const glm::vec3> p, float max_distance, bool climbable_only,
                       std::span<ClosestHit> out) const override {
     std::vector<growbench_closest_hit> hits(p.size());
-    h_.closest_points(h_.context, abi(p.data()), p.size(), max_distance, climbable_only ? 1 : 0, hits.data());
-    for (std::size_t i = 0; i < p.size(); ++i)
-      out[i] = {hits[i].found != 0, glm_of(hits[i].point), glm_of(hits[i].normal),
-                hits[i].distance,   hits[i].mesh,          hits[i].triangle};
+    h_.closest_points(h_.context, abi::of(p.data()), p.size(), max_distance, climbable_only ? 1 : 0, hits.data());
+    abi::convert<growbench_closest_hit>(hits, out);
   }
   static std::vector<growbench_ray> abi_rays(std::span<const Ray> r) {
     std::vector<growbench_ray> v(r.size());
-    for (std::size_t i = 0; i < r.size(); ++i) v[i] = {abi(r[i].origin), abi(r[i].direction), r[i].tmin, r[i].tmax};
+    abi::convert(r, std::span(v));
     return v;
   }
   void rays(std::span<const Ray> r, std::span<RayHit> out) const override {
     const auto rays = abi_rays(r);
     std::vector<growbench_ray_hit> hits(r.size());
     h_.rays(h_.context, rays.data(), rays.size(), hits.data());
-    for (std::size_t i = 0; i < r.size(); ++i)
-      out[i] = {hits[i].hit != 0,       hits[i].t,    glm_of(hits[i].point),
-                glm_of(hits[i].normal), hits[i].mesh, hits[i].triangle};
+    abi::convert<growbench_ray_hit>(hits, out);
   }
   void occluded(std::span<const Ray> r, std::span<std::uint8_t> out) const override {
     const auto rays = abi_rays(r);
@@ -108,23 +95,22 @@ class TableQueries final : public HostQueries {
                        std::span<glm::vec3> gradient) const override {
     auto* g = gradient.empty() ? nullptr : reinterpret_cast<growbench_vec3*>(gradient.data());
     float* d = distance.empty() ? nullptr : distance.data();
-    if (h_.signed_distance(h_.context, abi(p.data()), p.size(), d, g) != GROWBENCH_OK)
+    if (h_.signed_distance(h_.context, abi::of(p.data()), p.size(), d, g) != GROWBENCH_OK)
       throw InputError("the scene has no distance field");
   }
   void inside(std::span<const glm::vec3> p, std::span<std::uint8_t> out) const override {
-    h_.inside(h_.context, abi(p.data()), p.size(), out.data());
+    h_.inside(h_.context, abi::of(p.data()), p.size(), out.data());
   }
   void inside_shape(int shape, std::span<const glm::vec3> p, std::span<std::uint8_t> out) const override {
-    h_.inside_shape(h_.context, shape, abi(p.data()), p.size(), out.data());
+    h_.inside_shape(h_.context, shape, abi::of(p.data()), p.size(), out.data());
   }
   void sample_surface(std::uint64_t seed, std::uint64_t first, std::span<SurfaceSample> out) const override {
     std::vector<growbench_surface_sample> s(out.size());
     h_.sample_surface(h_.context, seed, first, out.size(), s.data());
-    for (std::size_t i = 0; i < out.size(); ++i)
-      out[i] = {glm_of(s[i].position), glm_of(s[i].normal), s[i].mesh, s[i].triangle};
+    abi::convert<growbench_surface_sample>(s, out);
   }
   void light_visible(std::span<const glm::vec3> p, float bias, std::span<std::uint8_t> out) const override {
-    h_.light_visible(h_.context, abi(p.data()), p.size(), bias, out.data());
+    h_.light_visible(h_.context, abi::of(p.data()), p.size(), bias, out.data());
   }
 
  private:
@@ -209,9 +195,10 @@ class Builtin final : public sdk::Algorithm {
     plant.organs.clear();
     plant.polygon_vertices.clear();
     plant.polygon_offsets.clear();
-    for (const auto& n : p.nodes) plant.add_node(abi(n.position), n.radius, n.parent, n.order, n.shoot, n.birth_step);
+    for (const auto& n : p.nodes)
+      plant.add_node(abi::of(n.position), n.radius, n.parent, n.order, n.shoot, n.birth_step);
     for (const auto& o : p.organs)
-      plant.organs.push_back({abi(o.position),
+      plant.organs.push_back({abi::of(o.position),
                               {o.orientation.w, o.orientation.x, o.orientation.y, o.orientation.z},
                               o.size,
                               static_cast<std::int32_t>(o.kind),
@@ -219,7 +206,7 @@ class Builtin final : public sdk::Algorithm {
                               {o.stamp[0], o.stamp[1], o.stamp[2]}});
     for (const auto& poly : p.polygons) {
       if (plant.polygon_offsets.empty()) plant.polygon_offsets.push_back(0);
-      for (const auto& v : poly.vertices) plant.polygon_vertices.push_back(abi(v));
+      for (const auto& v : poly.vertices) plant.polygon_vertices.push_back(abi::of(v));
       plant.polygon_offsets.push_back(plant.polygon_vertices.size());
     }
     return plant;

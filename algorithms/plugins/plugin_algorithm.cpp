@@ -5,36 +5,21 @@
 #include <mutex>
 #include <new>
 #include <stdexcept>
-#include <type_traits>
 
 #include <fmt/format.h>
 #include <tbb/global_control.h>
 
+#include "algorithms/plugins/abi_convert.hpp"
 #include "core/errors.hpp"
 #include "core/random.hpp"
 
 namespace growbench {
 namespace {
 
-// glm's vectors and the ABI's are the same three floats, so arrays pass without a copy.
-static_assert(sizeof(glm::vec3) == sizeof(growbench_vec3) && std::is_standard_layout_v<glm::vec3>);
-static_assert(sizeof(glm::uvec3) == 3 * sizeof(std::uint32_t));
-
-const growbench_vec3* abi(const glm::vec3* p) {
-  return reinterpret_cast<const growbench_vec3*>(p);
-}
-growbench_vec3 abi(const glm::vec3& p) {
-  return {p.x, p.y, p.z};
-}
-glm::vec3 glm_of(const growbench_vec3& p) {
-  return {p.x, p.y, p.z};
-}
-std::span<const glm::vec3> points(const growbench_vec3* p, std::uint64_t n) {
-  return {reinterpret_cast<const glm::vec3*>(p), static_cast<std::size_t>(n)};
-}
+using abi::points;
 
 growbench_mesh mesh_view(const TriangleMesh& m, bool solid) {
-  return {m.name.c_str(),     abi(m.vertices.data()),
+  return {m.name.c_str(),     abi::of(m.vertices.data()),
           m.vertices.size(),  reinterpret_cast<const std::uint32_t*>(m.triangles.data()),
           m.triangles.size(), m.climbable ? 1 : 0,
           solid ? 1 : 0};
@@ -46,10 +31,10 @@ growbench_shape shape_view(const Shape& s) {
   v.kind = s.kind == Shape::Kind::Box      ? GROWBENCH_SHAPE_BOX
            : s.kind == Shape::Kind::Sphere ? GROWBENCH_SHAPE_ELLIPSOID
                                            : GROWBENCH_SHAPE_MESH;
-  v.min = abi(s.kind == Shape::Kind::Box ? s.min : b.min);
-  v.max = abi(s.kind == Shape::Kind::Box ? s.max : b.max);
-  v.center = abi(s.center);
-  v.radii = abi(s.radii);
+  v.min = abi::of(s.kind == Shape::Kind::Box ? s.min : b.min);
+  v.max = abi::of(s.kind == Shape::Kind::Box ? s.max : b.max);
+  v.center = abi::of(s.center);
+  v.radii = abi::of(s.radii);
   if (s.kind == Shape::Kind::Mesh) v.mesh = mesh_view(s.mesh, true);
   return v;
 }
@@ -114,9 +99,11 @@ class PluginAlgorithm final : public GrowthAlgorithm {
 
  private:
   std::pair<std::size_t, std::size_t> counts() const {
-    if (!t_->counts) {
-      const Plant& p = plant();
-      return {p.nodes.size(), p.organs.size()};
+    if (!t_->counts) {  // the view's sizes: no copy of the plant after every step
+      if (plant_version_ == version_) return {plant_.nodes.size(), plant_.organs.size()};
+      growbench_plant_view v{};
+      check(t_->plant(inst_, &v), "plant");
+      return {static_cast<std::size_t>(v.node_count), static_cast<std::size_t>(v.organ_count)};
     }
     std::uint64_t nodes = 0, organs = 0;
     t_->counts(inst_, &nodes, &organs);
@@ -129,7 +116,7 @@ class PluginAlgorithm final : public GrowthAlgorithm {
     for (std::size_t i = 0; i < scene.meshes.size(); ++i)
       meshes_.push_back(mesh_view(scene.meshes[i], query.mesh_solid()[i]));
     seeds_.clear();
-    for (const auto& s : scene.seeds) seeds_.push_back({abi(s.position), abi(s.direction), s.start_step});
+    for (const auto& s : scene.seeds) seeds_.push_back({abi::of(s.position), abi::of(s.direction), s.start_step});
     zones_.clear();
     for (const auto& z : scene.zones)
       zones_.push_back({static_cast<std::int32_t>(z.kind), shape_view(z.shape), z.strength});
@@ -139,15 +126,15 @@ class PluginAlgorithm final : public GrowthAlgorithm {
     scene_.mesh_count = static_cast<std::uint32_t>(meshes_.size());
     scene_.seeds = seeds_.data();
     scene_.seed_count = static_cast<std::uint32_t>(seeds_.size());
-    scene_.light = {scene.light.kind == Light::Kind::Point ? 1 : 0, abi(scene.light.direction),
-                    abi(scene.light.position)};
+    scene_.light = {scene.light.kind == Light::Kind::Point ? 1 : 0, abi::of(scene.light.direction),
+                    abi::of(scene.light.position)};
     scene_.has_envelope = scene.envelope ? 1 : 0;
     if (scene.envelope) scene_.envelope = shape_view(*scene.envelope);
     scene_.zones = zones_.data();
     scene_.zone_count = static_cast<std::uint32_t>(zones_.size());
     const Aabb b = scene.bounds();
-    scene_.bounds_min = abi(b.min);
-    scene_.bounds_max = abi(b.max);
+    scene_.bounds_min = abi::of(b.min);
+    scene_.bounds_max = abi::of(b.max);
     scene_.has_sdf = query.has_sdf() ? 1 : 0;
     scene_.voxel_size = query.voxel_size();
   }
@@ -219,7 +206,7 @@ class PluginAlgorithm final : public GrowthAlgorithm {
       const growbench_node& n = v.nodes[i];
       if (n.order > 0xFFFFu) throw bad(fmt::format("node {} has branch order {} (at most 65535)", i, n.order));
       plant_.nodes.push_back(
-          {glm_of(n.position), n.radius, n.parent, static_cast<std::uint16_t>(n.order), n.shoot, n.birth_step});
+          {abi::of(n.position), n.radius, n.parent, static_cast<std::uint16_t>(n.order), n.shoot, n.birth_step});
     }
     plant_.organs.reserve(v.organ_count);
     for (std::uint64_t i = 0; i < v.organ_count; ++i) {
@@ -227,7 +214,7 @@ class PluginAlgorithm final : public GrowthAlgorithm {
       if (o.kind < GROWBENCH_ORGAN_LEAF || o.kind > GROWBENCH_ORGAN_BUD)
         throw bad(fmt::format("organ {} has kind {}, not a growbench_organ_kind", i, o.kind));
       Organ g;
-      g.position = glm_of(o.position);
+      g.position = abi::of(o.position);
       g.orientation = glm::quat(o.orientation[0], o.orientation[1], o.orientation[2], o.orientation[3]);
       g.size = o.size;
       g.kind = static_cast<OrganKind>(o.kind);
@@ -242,7 +229,7 @@ class PluginAlgorithm final : public GrowthAlgorithm {
       const std::uint64_t a = v.polygon_offsets[i], b = v.polygon_offsets[i + 1];
       if (b < a) throw bad(fmt::format("polygon_offsets decrease at polygon {}", i));
       PlantPolygon poly;
-      for (std::uint64_t k = a; k < b; ++k) poly.vertices.push_back(glm_of(v.polygon_vertices[k]));
+      for (std::uint64_t k = a; k < b; ++k) poly.vertices.push_back(abi::of(v.polygon_vertices[k]));
       plant_.polygons.push_back(std::move(poly));
     }
   }
@@ -287,21 +274,17 @@ struct HostFunctions {
                              std::int32_t climbable_only, growbench_closest_hit* out) {
     std::vector<ClosestHit> hits(n);
     self(c).q_->closest_points(points(p, n), max_distance, climbable_only != 0, hits);
-    for (std::uint64_t i = 0; i < n; ++i)
-      out[i] = {hits[i].found ? 1 : 0, abi(hits[i].point), abi(hits[i].normal),
-                hits[i].distance,      hits[i].mesh,       hits[i].triangle};
+    abi::convert<ClosestHit>(hits, std::span(out, hits.size()));
   }
   static std::vector<Ray> rays_of(const growbench_ray* r, std::uint64_t n) {
     std::vector<Ray> v(n);
-    for (std::uint64_t i = 0; i < n; ++i) v[i] = {glm_of(r[i].origin), glm_of(r[i].direction), r[i].tmin, r[i].tmax};
+    abi::convert(std::span(r, v.size()), std::span(v));
     return v;
   }
   static void rays(void* c, const growbench_ray* r, std::uint64_t n, growbench_ray_hit* out) {
     std::vector<RayHit> hits(n);
     self(c).q_->rays(rays_of(r, n), hits);
-    for (std::uint64_t i = 0; i < n; ++i)
-      out[i] = {hits[i].hit ? 1 : 0, hits[i].t,    abi(hits[i].point),
-                abi(hits[i].normal), hits[i].mesh, hits[i].triangle};
+    abi::convert<RayHit>(hits, std::span(out, hits.size()));
   }
   static void occluded(void* c, const growbench_ray* r, std::uint64_t n, std::uint8_t* out) {
     self(c).q_->occluded(rays_of(r, n), {out, static_cast<std::size_t>(n)});
@@ -326,7 +309,7 @@ struct HostFunctions {
                              growbench_surface_sample* out) {
     std::vector<SurfaceSample> s(n);
     self(c).q_->sample_surface(seed, first, s);
-    for (std::uint64_t i = 0; i < n; ++i) out[i] = {abi(s[i].position), abi(s[i].normal), s[i].mesh, s[i].triangle};
+    abi::convert<SurfaceSample>(s, std::span(out, s.size()));
   }
   static void light_visible(void* c, const growbench_vec3* p, std::uint64_t n, float bias, std::uint8_t* out) {
     self(c).q_->light_visible(points(p, n), bias, {out, static_cast<std::size_t>(n)});

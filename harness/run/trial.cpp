@@ -22,7 +22,6 @@
 #include <tbb/global_control.h>
 #include <tbb/version.h>
 #include <valgrind/callgrind.h>
-#include <xxhash.h>
 
 #include "algorithms/algorithm.hpp"
 #include "algorithms/plugins/loader.hpp"
