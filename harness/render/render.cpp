@@ -250,7 +250,9 @@ void write_cones(Out out, const Plant& plant) {
 // Branches as RenderOptions::branches asks: cone chains, or the mesher's tubes as one mesh2.
 void write_branches(Out out, const Plant& plant, const RenderOptions& o) {
   if (o.branches == "mesh") {
-    const OutputMesh tubes = mesh_plant(Plant{plant.nodes, {}, {}, {}, {}}, o.mesher);
+    Plant branches;
+    branches.nodes = plant.nodes;
+    const OutputMesh tubes = mesh_plant(branches, o.mesher);
     if (!tubes.triangles.empty()) {
       fmt::format_to(out, "// branches: {} nodes as one mesh2\n", plant.nodes.size());
       write_mesh2(out, tubes.positions, tubes.normals, tubes.triangles, 0,
