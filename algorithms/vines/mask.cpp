@@ -19,7 +19,8 @@ Mask Mask::read(const std::string& path, const std::string& key) {
   if (stbi_info(path.c_str(), &w, &h, &channels) == 0)
     throw InputError(fmt::format("{}={}: not a readable image ({}); expected a PNG", key, path, stbi_failure_reason()));
   if (w <= 0 || h <= 0 || w > 16384 || h > 16384)
-    throw InputError(fmt::format("{}={}: the image is {} x {} pixels; expected 1 to 16384 on each side", key, path, w, h));
+    throw InputError(
+        fmt::format("{}={}: the image is {} x {} pixels; expected 1 to 16384 on each side", key, path, w, h));
   std::unique_ptr<stbi_uc, void (*)(void*)> px(stbi_load(path.c_str(), &w, &h, &channels, 4), &stbi_image_free);
   if (!px) throw InputError(fmt::format("{}={}: cannot decode the image ({})", key, path, stbi_failure_reason()));
   Mask m;
@@ -46,7 +47,8 @@ Mask Mask::read(const std::string& path, const std::string& key) {
     while (!stack.empty()) {
       const std::size_t i = stack.back();
       stack.pop_back();
-      const int x = static_cast<int>(i % static_cast<std::size_t>(w)), y = static_cast<int>(i / static_cast<std::size_t>(w));
+      const int x = static_cast<int>(i % static_cast<std::size_t>(w)),
+                y = static_cast<int>(i / static_cast<std::size_t>(w));
       sx += x;
       sy += y;
       ++count;
@@ -54,7 +56,8 @@ Mask Mask::read(const std::string& path, const std::string& key) {
         for (int dx = -1; dx <= 1; ++dx) {
           const int nx = x + dx, ny = y + dy;
           if (nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
-          const std::size_t j = static_cast<std::size_t>(ny) * static_cast<std::size_t>(w) + static_cast<std::size_t>(nx);
+          const std::size_t j =
+              static_cast<std::size_t>(ny) * static_cast<std::size_t>(w) + static_cast<std::size_t>(nx);
           if (green[j] == 1) {
             green[j] = 2;
             stack.push_back(j);

@@ -216,7 +216,10 @@ glm::vec2 Surface::to_uv(std::uint32_t t, const glm::vec3& d) const {
 }
 
 std::optional<Location> Surface::locate(const glm::vec2& uv) const {
-  const glm::ivec2 i = glm::ivec2(glm::floor((uv - grid_min_) / grid_cell_));
+  glm::ivec2 i = glm::ivec2(glm::floor((uv - grid_min_) / grid_cell_));
+  // The grid's far edges belong to its last cells (uv = 1 lies on the unit square).
+  if (i.x == grid_n_ && uv.x <= grid_min_.x + grid_cell_.x * static_cast<float>(grid_n_)) i.x = grid_n_ - 1;
+  if (i.y == grid_n_ && uv.y <= grid_min_.y + grid_cell_.y * static_cast<float>(grid_n_)) i.y = grid_n_ - 1;
   if (i.x < 0 || i.y < 0 || i.x >= grid_n_ || i.y >= grid_n_) return std::nullopt;
   const std::size_t cell = static_cast<std::size_t>(i.y) * grid_n_ + static_cast<std::size_t>(i.x);
   // A little slack on the edges, so that a point on an edge shared by two triangles is found.

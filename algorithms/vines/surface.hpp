@@ -28,7 +28,7 @@ struct UvPiece {
 
 struct Walk {
   Location end;
-  float length = 0.0f;  // surface distance covered (less than asked when the walk was stopped)
+  float length = 0.0f;   // surface distance covered (less than asked when the walk was stopped)
   bool stopped = false;  // by a boundary, by a seam (when not crossing them) or by a degenerate triangle
   int seams = 0;         // UV seams crossed
   // The walk in UV, one piece per chart it passed through, in order (for drawing).
@@ -75,8 +75,8 @@ class Surface {
   void build_uv_grid();
   [[nodiscard]] bool is_seam(std::uint32_t tri, int edge) const;
 
-  std::vector<glm::vec3> pos_;           // welded positions
-  std::vector<glm::uvec3> corners_;      // into pos_
+  std::vector<glm::vec3> pos_;                // welded positions
+  std::vector<glm::uvec3> corners_;           // into pos_
   std::vector<std::array<glm::vec2, 3>> uv_;  // per triangle corner
   std::vector<glm::vec3> normal_;
   std::vector<float> ratio_;
