@@ -219,7 +219,8 @@ class Vines final : public GrowthAlgorithm {
     leaf_texture_ = p.text("leaf_texture");
     if (!leaf_texture_.empty()) check_png(leaf_texture_, "leaf_texture");
     std::optional<vines::Mask> mask;
-    if (!p.text("mask").empty()) mask = vines::Mask::read(p.text("mask"), "mask");
+    mask_path_ = p.text("mask");
+    if (!mask_path_.empty()) mask = vines::Mask::read(mask_path_, "mask");
     make_surface();
     place_attractors(mask ? &*mask : nullptr);
     place_roots(p.text("roots"), mask ? &*mask : nullptr);
@@ -541,7 +542,7 @@ class Vines final : public GrowthAlgorithm {
   const SceneQuery* query_ = nullptr;
   std::uint64_t seed_ = 0;
   vines::Config cfg_{};
-  std::string leaf_texture_;
+  std::string leaf_texture_, mask_path_;
   std::int32_t mesh_ = kNone;
   Canvas canvas_;
   bool climbable_ = true;  // the canvas projects onto climbable meshes; without any it stands free
@@ -724,9 +725,9 @@ void Vines::place_roots(const std::string& text, const vines::Mask* mask) {
       const auto l = surface_->locate(uv);
       if (!l)
         throw InputError(
-            fmt::format("algorithm 'vines': the mask's green dot at UV ({:.4f}, {:.4f}) lies outside "
-                        "the texture's charts",
-                        uv.x, uv.y));
+            fmt::format("algorithm 'vines': mask={}: the green dot at UV ({:.4f}, {:.4f}) lies outside the "
+                        "texture's charts",
+                        mask_path_, uv.x, uv.y));
       roots.emplace_back(*l, tag_of(roots.size()));
     }
   } else {
