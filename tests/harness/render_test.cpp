@@ -513,5 +513,54 @@ TEST(RenderCli, RunRendersThePlantAndItsGrowthFrames) {
   EXPECT_NE(bad.out.find("neither a suite results directory"), std::string::npos) << bad.out;
 }
 
+TEST(RenderCli, DecalImagesAreReadBesideTheirSnapshotsAndAreNotAnimationFrames) {
+  const auto dir = test::temp_dir("cli_render_decals");
+  const auto run = test::run_growbench(
+      "run -q -a spacecol -s wall --set point_count=300 --max-steps 20 --frames 10 -o " + dir.string());
+  ASSERT_EQ(run.status, 0) << run.out;
+  // Decals on the plant and its frames, as an algorithm that paints them leaves them: the run's image
+  // beside plant.gbplant, each frame's as step_NNNNNN.IMAGE beside its snapshot.
+  SurfaceDecal d = tilted_planar_decal("vine.png");
+  Plant plant = read_plant_snapshot((dir / "plant.gbplant").string());
+  plant.decals = {d};
+  write_plant_snapshot((dir / "plant.gbplant").string(), plant);
+  write_decal_png(dir / "vine.png");
+  std::size_t frames = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir / "frames")) {
+    if (e.path().extension() != ".gbplant") continue;
+    const std::string prefix = e.path().stem().string() + ".";
+    Plant f = read_plant_snapshot(e.path().string());
+    f.decals = {d};
+    write_plant_snapshot(e.path().string(), f, prefix);
+    write_decal_png(dir / "frames" / (prefix + "vine.png"));
+    ++frames;
+  }
+  ASSERT_GE(frames, 2u);
+  RenderDirOptions ro;
+  ro.render.width = 64;
+  ro.render.height = 48;
+  ro.quiet = true;
+  const RenderSummary summary = render_directory_record(dir.string(), ro);
+  EXPECT_EQ(summary.failed, 0u);
+  EXPECT_EQ(summary.ok, frames + 1);
+  EXPECT_EQ(summary.warnings, 0u);
+  EXPECT_NE(read_file(dir / "frames" / "step_000010.pov").find("png \"step_000010.vine.png\""), std::string::npos);
+  EXPECT_NE(read_file(dir / "render.pov").find("png \"vine.png\""), std::string::npos);
+  std::ifstream in(dir / "record.json");
+  const auto rec = nlohmann::json::parse(in);
+  EXPECT_EQ(rec["render"]["status"], "ok") << rec["render"].dump();
+  if (std::system("command -v ffmpeg > /dev/null && command -v ffprobe > /dev/null") != 0) return;
+  // The animation is made of the rendered frames alone, not of the decal images beside them.
+  EXPECT_EQ(rec["animation"]["status"], "ok") << rec["animation"].dump();
+  EXPECT_EQ(rec["animation"]["frames"], frames);
+  const std::string probe = (dir / "probe.txt").string();
+  ASSERT_EQ(std::system(("ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames,width "
+                         "-of csv=p=0 " +
+                         (dir / "animation.mp4").string() + " > " + probe)
+                            .c_str()),
+            0);
+  EXPECT_EQ(read_file(probe), "64," + std::to_string(frames) + "\n");
+}
+
 }  // namespace
 }  // namespace growbench
