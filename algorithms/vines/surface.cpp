@@ -47,6 +47,26 @@ struct UnionFind {
   }
 };
 
+// Joins consecutive pieces that meet and run on in the same direction in UV (an edge inside a region
+// mapped by one affine map, such as a canvas), and drops pieces of no length.
+void join_straight(std::vector<UvPiece>& pieces) {
+  std::size_t w = 0;
+  for (std::size_t i = 0; i < pieces.size(); ++i) {
+    const UvPiece& p = pieces[i];
+    if (w > 0) {
+      UvPiece& q = pieces[w - 1];
+      const glm::vec2 d1 = q.b - q.a, d2 = p.b - p.a;
+      const float cross = d1.x * d2.y - d1.y * d2.x, scale = glm::length(d1) * glm::length(d2);
+      if (q.b == p.a && (glm::dot(d2, d2) == 0.0f || (std::abs(cross) <= 1e-6f * scale && glm::dot(d1, d2) >= 0.0f))) {
+        q.b = p.b;
+        continue;
+      }
+    }
+    pieces[w++] = p;
+  }
+  pieces.resize(w);
+}
+
 }  // namespace
 
 Surface::Surface(const TriangleMesh& mesh) {
@@ -252,8 +272,17 @@ Location Surface::closest(const glm::vec3& p) const {
   return best;
 }
 
-Walk Surface::walk(const Location& from, const glm::vec3& d_in, float length, bool cross_seams) const {
+Walk Surface::walk(const Location& from, const glm::vec3& d, float length, bool cross_seams) const {
   Walk w;
+  walk(from, d, length, cross_seams, w);
+  return w;
+}
+
+void Surface::walk(const Location& from, const glm::vec3& d_in, float length, bool cross_seams, Walk& w) const {
+  w.length = 0.0f;
+  w.stopped = false;
+  w.seams = 0;
+  w.pieces.clear();
   w.end = from;
   Location& at = w.end;
   UvPiece piece{uv(at), uv(at)};
@@ -316,22 +345,22 @@ Walk Surface::walk(const Location& from, const glm::vec3& d_in, float length, bo
     glm::vec3 m1 = glm::cross(ev, normal_[nt]);
     if (glm::dot(m1, opp_new - pos_[pa]) < 0.0f) m1 = -m1;
     d = glm::dot(d, ev) * ev + std::max(0.0f, glm::dot(d, m0)) * m1;
-    if (seam) {
-      piece.b = uv(at);
-      w.pieces.push_back(piece);
-      ++w.seams;
-    }
+    // The walk is straight on the surface but bends in UV wherever the next triangle maps differently:
+    // a piece ends at every edge (pieces that carry on in a straight line are joined again below).
+    piece.b = uv(at);
+    w.pieces.push_back(piece);
+    w.seams += seam ? 1 : 0;
     Location in{nt, glm::vec3(0.0f)};
     for (int k = 0; k < 3; ++k) {
       if (corners_[nt][k] == pa) in.bary[k] = sa;
       if (corners_[nt][k] == pb) in.bary[k] = sb;
     }
     at = in;
-    if (seam) piece.a = uv(at);
+    piece.a = uv(at);
   }
   piece.b = uv(at);
   w.pieces.push_back(piece);
-  return w;
+  join_straight(w.pieces);
 }
 
 }  // namespace growbench::vines

@@ -31,7 +31,8 @@ struct Walk {
   float length = 0.0f;   // surface distance covered (less than asked when the walk was stopped)
   bool stopped = false;  // by a boundary, by a seam (when not crossing them) or by a degenerate triangle
   int seams = 0;         // UV seams crossed
-  // The walk in UV, one piece per chart it passed through, in order (for drawing).
+  // The walk in UV, in order (for drawing): a piece for each run of triangles it crossed in a straight
+  // line in UV, so one for most steps, and a new one at every seam.
   std::vector<UvPiece> pieces;
 };
 
@@ -67,6 +68,8 @@ class Surface {
   // Walks `length` along the surface from `from`, starting along d's tangential part. With cross_seams,
   // an edge whose two triangles lie apart in UV is crossed like any other; without, the walk stops there.
   [[nodiscard]] Walk walk(const Location& from, const glm::vec3& d, float length, bool cross_seams) const;
+  // The same into `out`, reusing its memory (a grower's step, thousands per iteration).
+  void walk(const Location& from, const glm::vec3& d, float length, bool cross_seams, Walk& out) const;
 
  private:
   Surface() = default;

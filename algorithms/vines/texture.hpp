@@ -34,7 +34,7 @@ enum class Style { Lines, Dots };  // dots: a disc at every segment's child end 
 struct DrawOptions {
   int size = 1024;  // the texture is size x size pixels
   Style style = Style::Lines;
-  glm::vec3 vine_colour{0.2f, 0.33f, 0.1f};  // sRGB in [0, 1]
+  glm::vec3 vine_colour{0.2f, 0.33f, 0.1f};   // sRGB in [0, 1]
   glm::vec3 leaf_colour{0.3f, 0.55f, 0.18f};  // the built-in sprite's
   // A user's leaf sprite (PNG, transparent around the leaf), drawn like the built-in one: unrotated it
   // hangs down with its stem at the top centre. "" uses the built-in sprite.

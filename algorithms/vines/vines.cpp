@@ -334,11 +334,22 @@ class Vines final : public GrowthAlgorithm {
     growers_grid_ = std::make_unique<vines::CellTable>(reach_);
   }
 
-  // Where the space colonization measures a point: its 3D position in cells (metric=surface) or its UV
-  // position in cells (metric=uv).
+  // Where the space colonization measures a point, in cells: its UV position (metric=uv), its place in
+  // the canvas's plane (a canvas is flat, so that is its 3D distance, in two coordinates), or its 3D
+  // position on a mesh.
   glm::vec3 metric_position(const Location& l) const {
     if (cfg_.metric == Metric::Uv) return glm::vec3(surface_->uv(l) * static_cast<float>(cfg_.resolution), 0.0f);
+    if (mesh_ == kNone)
+      return glm::vec3(surface_->uv(l) * glm::vec2(glm::length(canvas_.u_axis), glm::length(canvas_.v_axis)) / cell_m_,
+                       0.0f);
     return surface_->position(l) / cell_m_;
+  }
+  // Whether metric positions lie in the plane z = 0 (the grid then looks at one layer of cells).
+  bool planar() const { return cfg_.metric == Metric::Uv || mesh_ == kNone; }
+  // A direction in metric space as a direction on the surface in 3D.
+  glm::vec3 surface_direction(const glm::vec3& d) const {
+    if (mesh_ != kNone) return d;
+    return d.x * glm::normalize(canvas_.u_axis) + d.y * glm::normalize(canvas_.v_axis);
   }
 
   // Where a surface point is in the scene: on the mesh, or for a canvas, where the plane's point projects
@@ -361,6 +372,8 @@ class Vines final : public GrowthAlgorithm {
   // A node's position: off the surface by its radius, so its tube stays outside the solid; less where
   // that would enter another solid (the ground a mesh stands on), and on the surface at worst.
   glm::vec3 lifted(const Placed& at, float radius) const {
+    // A canvas node is lifted back along the ray that found it, through free space: no test needed.
+    if (mesh_ == kNone) return at.position + (radius + 1e-4f * cell_m_) * at.normal;
     for (const float k : {1.0f, 0.25f}) {
       const glm::vec3 p = at.position + k * (radius + 1e-4f * cell_m_) * at.normal;
       if (!query_->inside(p)) return p;
@@ -409,7 +422,7 @@ class Vines final : public GrowthAlgorithm {
     const float turn =
         phase_[a] + 2.0f * std::numbers::pi_v<float> * static_cast<float>(iteration_) / cfg_.wiggle_period;
     glm::vec3 t1(1, 0, 0), t2(0, 1, 0);
-    if (cfg_.metric == Metric::Surface) {
+    if (!planar()) {
       const glm::vec3 n = surface_->normal(attractor_tri_[a]);
       t1 = safe_normalize(glm::cross(n, std::abs(n.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0)));
       t2 = glm::cross(n, t1);
@@ -423,7 +436,7 @@ class Vines final : public GrowthAlgorithm {
   template <class F>
   void visit_cells(const vines::CellTable& table, const glm::vec3& p, F&& f) const {
     const glm::ivec3 c = table.cell_of(p);
-    const int dz = cfg_.metric == Metric::Uv ? 0 : 1;
+    const int dz = planar() ? 0 : 1;
     for (int z = -dz; z <= dz; ++z)
       for (int y = -1; y <= 1; ++y)
         for (int x = -1; x <= 1; ++x) {
@@ -460,7 +473,7 @@ class Vines final : public GrowthAlgorithm {
     kills_now_.resize(active_.size());
     pull_from_.resize(active_.size());
     const float k2 = cfg_.kill * cfg_.kill;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, active_.size(), 256), [&](const auto& range) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, active_.size(), 1024), [&](const auto& range) {
       for (std::size_t k = range.begin(); k < range.end(); ++k) {
         const std::uint32_t a = active_[k];
         glm::vec3 p = center_[a];
@@ -507,16 +520,16 @@ class Vines final : public GrowthAlgorithm {
     return killed;
   }
 
+  // A grower's next child: where the step from it ends, and the step's pieces in UV (walk.end etc.).
   struct Child {
     bool ok = false;
-    Location at;
-    std::vector<vines::UvPiece> pieces;
-    int seams = 0;
+    vines::Walk walk;
   };
-  Child child_of(std::size_t g, const glm::vec3& pull) const;
+  void child_of(std::size_t g, const glm::vec3& pull, Child& c) const;
   bool repeats(std::size_t g, const glm::vec3& m) const;
+  void reserve_growers(std::size_t n);
   void grow_children();
-  std::int32_t add_grower(const Location& at, std::int32_t parent, int tag, std::vector<vines::UvPiece> pieces);
+  std::int32_t add_grower(const Location& at, std::int32_t parent, int tag, const std::vector<vines::UvPiece>& pieces);
   void activate(std::size_t from);
 
   // ---------- the plant and its drawing ----------
@@ -589,12 +602,12 @@ class Vines final : public GrowthAlgorithm {
   std::vector<std::uint8_t> kills_now_;
   std::vector<glm::vec3> pull_from_, pulls_;
   std::vector<std::vector<std::pair<std::uint32_t, float>>> found_;
+  std::vector<Child> children_;
 
   // The plant, assembled on demand (and cached) from the growers.
   bool finished_ = false;
   mutable bool plant_stale_ = true;
   mutable Plant plant_;
-  mutable std::vector<Placed> placed_;
 };
 
 void Vines::place_attractors(const vines::Mask* mask) {
@@ -747,10 +760,23 @@ void Vines::place_roots(const std::string& text, const vines::Mask* mask) {
   if (roots.empty())
     throw InputError(
         fmt::format("algorithm 'vines': no root grower could be placed on scene '{}' (give roots=u,v)", scene_->name));
+  // Room for about one grower per attractor, so the arrays are not copied over and over as they grow.
+  reserve_growers(roots.size() + alive_.size());
   for (const auto& [l, tag] : roots) add_grower(snapped(l), kNone, tag, {});
 }
 
-std::int32_t Vines::add_grower(const Location& at, std::int32_t parent, int tag, std::vector<vines::UvPiece> pieces) {
+void Vines::reserve_growers(std::size_t n) {
+  growers_.reserve(n);
+  mpos_.reserve(n);
+  for (auto* v : {&parent_, &first_child_, &next_sibling_, &last_child_, &kills_, &grid_next_}) v->reserve(n);
+  tag_.reserve(n);
+  for (auto* v : {&birth_, &shoot_, &piece_end_}) v->reserve(n);
+  order_.reserve(n);
+  pieces_.reserve(n);
+}
+
+std::int32_t Vines::add_grower(const Location& at, std::int32_t parent, int tag,
+                               const std::vector<vines::UvPiece>& pieces) {
   const auto g = static_cast<std::int32_t>(growers_.size());
   growers_.push_back(at);
   mpos_.push_back(metric_position(at));
@@ -802,34 +828,36 @@ bool Vines::repeats(std::size_t g, const glm::vec3& m) const {
   return false;
 }
 
-Vines::Child Vines::child_of(std::size_t g, const glm::vec3& pull) const {
-  Child c;
+void Vines::child_of(std::size_t g, const glm::vec3& pull, Child& c) const {
+  c.ok = false;
   const Location& from = growers_[g];
+  auto in_uv = [&](const glm::vec2& a, const glm::vec2& b) {  // a straight step in UV, where it lands
+    const auto l = surface_->locate(b);
+    if (!l) return;  // off every chart: the seed's vines stop at chart borders
+    c.ok = true;
+    c.walk.end = *l;
+    c.walk.seams = 0;
+    c.walk.pieces.assign(1, {a, b});
+  };
+  const glm::vec2 a = surface_->uv(from);
   if (cfg_.grid_nodes) {  // a king's move to the neighbouring cell the pull points at most
-    glm::vec2 d = cfg_.metric == Metric::Uv ? glm::vec2(pull) : surface_->to_uv(from.tri, pull);
+    glm::vec2 d = cfg_.metric == Metric::Uv ? glm::vec2(pull) : surface_->to_uv(from.tri, surface_direction(pull));
     const float len = glm::length(d);
-    if (!(len > 0.0f)) return c;
+    if (!(len > 0.0f)) return;
     d /= len;
     const float res = static_cast<float>(cfg_.resolution), lean = 0.3827f;  // sin(22.5 deg)
     const glm::vec2 move(std::abs(d.x) > lean ? std::copysign(1.0f, d.x) : 0.0f,
                          std::abs(d.y) > lean ? std::copysign(1.0f, d.y) : 0.0f);
-    const glm::vec2 a = surface_->uv(from), b = (glm::floor(a * res) + 0.5f + move) / res;
-    const auto l = surface_->locate(b);
-    if (!l) return c;
-    return {true, *l, {{a, b}}, 0};
+    in_uv(a, (glm::floor(a * res) + 0.5f + move) / res);
+    return;
   }
   if (cfg_.metric == Metric::Uv) {
     const glm::vec2 d = glm::vec2(pull);
-    if (!(glm::length(d) > 0.0f)) return c;
-    const glm::vec2 a = surface_->uv(from),
-                    b = a + glm::normalize(d) * (cfg_.step / static_cast<float>(cfg_.resolution));
-    const auto l = surface_->locate(b);
-    if (!l) return c;  // off every chart: the seed's vines stop at chart borders
-    return {true, *l, {{a, b}}, 0};
+    if (glm::length(d) > 0.0f) in_uv(a, a + glm::normalize(d) * (cfg_.step / static_cast<float>(cfg_.resolution)));
+    return;
   }
-  const vines::Walk w = surface_->walk(from, pull, cfg_.step * cell_m_, cfg_.cross_seams);
-  if (w.length < 0.25f * cfg_.step * cell_m_) return c;  // held at a border right away
-  return {true, w.end, w.pieces, w.seams};
+  surface_->walk(from, surface_direction(pull), cfg_.step * cell_m_, cfg_.cross_seams, c.walk);
+  c.ok = c.walk.length >= 0.25f * cfg_.step * cell_m_;  // not when held at a border right away
 }
 
 void Vines::grow_children() {
@@ -837,20 +865,21 @@ void Vines::grow_children() {
   std::vector<std::size_t> order(influenced_.size());
   for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
   std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return influenced_[a] < influenced_[b]; });
-  std::vector<Child> children(order.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), 64), [&](const auto& r) {
+  if (children_.size() < order.size()) children_.resize(order.size());  // never shrunk: its walks keep their memory
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), 128), [&](const auto& r) {
     for (std::size_t i = r.begin(); i < r.end(); ++i) {
       const std::size_t k = order[i];
       const glm::vec3 d = safe_normalize(pulls_[k]);
-      if (glm::dot(d, d) > 0.0f) children[i] = child_of(static_cast<std::size_t>(influenced_[k]), d);
+      children_[i].ok = false;
+      if (glm::dot(d, d) > 0.0f) child_of(static_cast<std::size_t>(influenced_[k]), d, children_[i]);
     }
   });
   for (std::size_t i = 0; i < order.size(); ++i) {
-    Child& c = children[i];
+    const Child& c = children_[i];
     const auto g = static_cast<std::size_t>(influenced_[order[i]]);
-    if (!c.ok || repeats(g, metric_position(c.at))) continue;
-    seam_crossings_ += static_cast<std::size_t>(c.seams);
-    add_grower(c.at, static_cast<std::int32_t>(g), tag_[g], std::move(c.pieces));
+    if (!c.ok || repeats(g, metric_position(c.walk.end))) continue;
+    seam_crossings_ += static_cast<std::size_t>(c.walk.seams);
+    add_grower(c.walk.end, static_cast<std::int32_t>(g), tag_[g], c.walk.pieces);
   }
 }
 
@@ -861,7 +890,7 @@ void Vines::activate(std::size_t from) {
   const std::size_t n = growers_.size() - from;
   if (found_.size() < n) found_.resize(n);
   const float reach2 = reach_ * reach_;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 32), [&](const auto& r) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 128), [&](const auto& r) {
     for (std::size_t k = r.begin(); k < r.end(); ++k) {
       const std::size_t g = from + k;
       auto& out = found_[k];
@@ -896,13 +925,19 @@ void Vines::activate(std::size_t from) {
 
 // ---------- the plant ----------
 
-// Vine widths in cells: the pipe model over the growers, capped.
+// Vine widths in cells: the plant's radii once it is finished; during growth (a frame's texture) the
+// pipe model over the growers so far.
 std::vector<float> Vines::widths_cells() const {
+  std::vector<float> w(growers_.size());
+  if (finished_) {
+    const Plant& p = plant();
+    for (std::size_t g = 0; g < w.size(); ++g) w[g] = 2.0f * p.nodes[g].radius / cell_m_;
+    return w;
+  }
   Plant skeleton;
   skeleton.nodes.resize(growers_.size());
   for (std::size_t g = 0; g < growers_.size(); ++g) skeleton.nodes[g].parent = parent_[g];
   assign_pipe_radii(skeleton, 0.5f * cfg_.tip_width, cfg_.pipe_exponent);
-  std::vector<float> w(growers_.size());
   for (std::size_t g = 0; g < w.size(); ++g) w[g] = std::min(2.0f * skeleton.nodes[g].radius, cfg_.max_width);
   return w;
 }
@@ -955,28 +990,25 @@ std::vector<Vines::Leaf> Vines::leaves() const {
 
 void Vines::build_plant() const {
   plant_stale_ = false;
-  const std::size_t n = growers_.size(), done = plant_.nodes.size();
-  placed_.resize(n);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(done, n, 256), [&](const auto& r) {
-    for (std::size_t g = r.begin(); g < r.end(); ++g) placed_[g] = place(growers_[g]);
-  });
+  const std::size_t n = growers_.size(), from = finished_ ? 0 : plant_.nodes.size();
   plant_.nodes.resize(n);
-  // Nodes rest on the surface, lifted by their radius so their tubes stay outside the solid.
-  const std::vector<float> w = finished_ ? widths_cells() : std::vector<float>(n, cfg_.tip_width);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(finished_ ? 0 : done, n, 256), [&](const auto& r) {
-    for (std::size_t g = r.begin(); g < r.end(); ++g) {
-      PlantNode& node = plant_.nodes[g];
-      node.radius = 0.5f * w[g] * cell_m_;
-      node.position = lifted(placed_[g], node.radius);
-    }
-  });
-  for (std::size_t g = finished_ ? 0 : done; g < n; ++g) {
+  for (std::size_t g = from; g < n; ++g) {
     PlantNode& node = plant_.nodes[g];
     node.parent = parent_[g];
     node.order = order_[g];
     node.shoot = shoot_[g];
     node.birth_step = birth_[g];
+    node.radius = 0.5f * cfg_.tip_width * cell_m_;
   }
+  if (finished_) {  // the pipe model, capped
+    assign_pipe_radii(plant_, 0.5f * cfg_.tip_width * cell_m_, cfg_.pipe_exponent);
+    for (auto& node : plant_.nodes) node.radius = std::min(node.radius, 0.5f * cfg_.max_width * cell_m_);
+  }
+  // Nodes rest on the surface, lifted by their radius so their tubes stay outside the solid.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(from, n, 256), [&](const auto& r) {
+    for (std::size_t g = r.begin(); g < r.end(); ++g)
+      plant_.nodes[g].position = lifted(place(growers_[g]), plant_.nodes[g].radius);
+  });
   // Per-node attributes: where each grower is in the texture, and its tag.
   plant_.node_attributes.assign(2, {});
   plant_.node_attributes[0] = {"uv", 2, std::vector<float>(2 * n)};
@@ -992,7 +1024,7 @@ void Vines::build_plant() const {
   // Leaves lie on the surface, their blades along their direction in the texture.
   for (const Leaf& leaf : leaves()) {
     const std::uint32_t g = leaf.grower;
-    const glm::vec3 n3 = placed_[g].normal;
+    const glm::vec3 n3 = place(growers_[g]).normal;
     glm::vec3 blade = mesh_ != kNone ? surface_->uv_to_3d(growers_[g].tri, leaf.direction)
                                      : leaf.direction.x * canvas_.u_axis + leaf.direction.y * canvas_.v_axis;
     blade = safe_normalize(blade - glm::dot(blade, n3) * n3);
@@ -1043,8 +1075,9 @@ std::vector<OutputFile> Vines::write_outputs(const OutputRequest& r) const {
   png("texture.png", texture);
   if (r.frame) return out;
   png("texture_normal.png", vines::normal_map(texture));
+  // The skeleton alone: leaves would multiply a print figure's size for little it shows.
   const std::string svg = r.prefix + "skeleton.svg";
-  out.push_back({svg, vines::write_svg((dir / svg).string(), strokes, stamps, options)});
+  out.push_back({svg, vines::write_svg((dir / svg).string(), strokes, {}, options)});
   return out;
 }
 
