@@ -56,7 +56,7 @@ struct SurfaceDecal {
   std::string image;  // PNG file name, relative to the directory of the file that holds the plant
   // mesh >= 0: the image follows that scene mesh's texture coordinates (TriangleMesh::uvs).
   // mesh == kPlanarDecal: (u, v) sits at origin + u * u_axis + v * v_axis and is projected along
-  // u_axis x v_axis onto the climbable meshes.
+  // u_axis x v_axis onto the climbable meshes; in a scene with none, that rectangle itself wears it.
   std::int32_t mesh = -1;
   glm::vec3 origin{0.0f}, u_axis{1.0f, 0.0f, 0.0f}, v_axis{0.0f, 1.0f, 0.0f};
 };

@@ -310,6 +310,24 @@ void write_scene_meshes(Out out, const Scene& scene, const std::vector<SurfaceDe
   }
 }
 
+// In a scene with nothing to climb a planar decal stands free: its rectangle itself wears the image, seen
+// through where the image is transparent.
+void write_free_decals(Out out, const Scene& scene, const std::vector<SurfaceDecal>& decals) {
+  if (std::any_of(scene.meshes.begin(), scene.meshes.end(), [](const TriangleMesh& m) { return m.climbable; })) return;
+  for (const SurfaceDecal& d : decals) {
+    if (d.mesh != kPlanarDecal) continue;
+    const std::vector<glm::vec3> corners = {d.origin, d.origin + d.u_axis, d.origin + d.u_axis + d.v_axis,
+                                            d.origin + d.v_axis};
+    const std::vector<glm::uvec3> triangles = {{0, 1, 2}, {0, 2, 3}};
+    const std::vector<glm::vec2> uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    const MeshUvs uv{uvs, triangles};
+    fmt::format_to(out, "// decal '{}' standing free: the scene has nothing to climb\n", d.image);
+    write_mesh2(out, corners, {}, triangles, 0, 2, &uv);
+    write_uv_decal_layer(out, d);
+    fmt::format_to(out, "}}\n");
+  }
+}
+
 // Branches as cones between each node and its parent, with a sphere at each joint and tip.
 void write_cones(Out out, const Plant& plant) {
   std::vector<std::uint8_t> has_child(plant.nodes.size(), 0);
@@ -455,6 +473,7 @@ std::uint64_t write_pov(const std::string& path, const Scene& scene, const Plant
       throw InputError(fmt::format("{}: cannot draw the plant's decals: {}", path, bad));
   const std::vector<SurfaceDecal> no_decals;
   write_scene_meshes(out, scene, decals ? plant.decals : no_decals);
+  write_free_decals(out, scene, decals ? plant.decals : no_decals);
   // A plant with decals is drawn by them (CONTRIBUTING.md, Rendering): its branches, organs and polygons
   // are not drawn again on top.
   if (o.draw_plant && !decals) {
