@@ -12,8 +12,10 @@
 namespace growbench::vines {
 
 Mask Mask::read(const std::string& path, const std::string& key) {
-  if (!std::filesystem::is_regular_file(path))
+  if (!std::filesystem::exists(path))
     throw InputError(fmt::format("{}={}: no such file (expected a PNG inclusion/exclusion map)", key, path));
+  if (!std::filesystem::is_regular_file(path))
+    throw InputError(fmt::format("{}={}: not a file (expected a PNG inclusion/exclusion map)", key, path));
   int w = 0, h = 0, channels = 0;
   // Refuse absurd sizes before decoding: a map is looked up per attractor candidate, never needs more.
   if (stbi_info(path.c_str(), &w, &h, &channels) == 0)

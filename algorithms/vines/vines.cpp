@@ -53,7 +53,7 @@ const AlgorithmInfo kInfo = {
                 .doc("uv: the texture space of the scene mesh's texture coordinates; canvas: a unit square laid on "
                      "the scene's main climbable face; auto: uv when a scene mesh has texture coordinates"),
             param::integer("resolution", 256)
-                .range(8, 8192)
+                .range(8, 4096)
                 .doc("vine resolution: attractors are spread over resolution x resolution candidate cells, and "
                      "lengths are in cells (1/resolution of the texture)"),
             param::real("density", 1.0 / 3.0).range(1e-4, 1).doc("chance that a candidate cell holds an attractor"),
@@ -123,7 +123,7 @@ const AlgorithmInfo kInfo = {
                 .doc("leaf sprite PNG, hanging down with its stem at the top centre "
                      "(empty: the built-in leaf)"),
             param::integer("texture_size", 1024)
-                .range(16, 16384)
+                .range(16, 8192)
                 .unit("px")
                 .doc("texture.png is this many pixels "
                      "square"),
@@ -297,8 +297,10 @@ class Vines final : public GrowthAlgorithm {
 
   static void check_png(const std::string& path, const char* key) {
     int w = 0, h = 0, n = 0;
-    if (!std::filesystem::is_regular_file(path))
+    if (!std::filesystem::exists(path))
       throw InputError(fmt::format("{}={}: no such file (expected a PNG)", key, path));
+    if (!std::filesystem::is_regular_file(path))
+      throw InputError(fmt::format("{}={}: not a file (expected a PNG)", key, path));
     if (stbi_info(path.c_str(), &w, &h, &n) == 0 || w <= 0 || h <= 0)
       throw InputError(
           fmt::format("{}={}: not a readable image ({}); expected a PNG", key, path, stbi_failure_reason()));
@@ -650,6 +652,13 @@ void Vines::place_attractors(const vines::Mask* mask) {
     phase_.insert(phase_.end(), row.phase.begin(), row.phase.end());
     tags_.insert(tags_.end(), row.tags.begin(), row.tags.end());
   }
+  if (center_.empty())
+    throw InputError(fmt::format(
+        "algorithm 'vines': no attractor could be placed on scene '{}'{} (every candidate cell fell outside the "
+        "texture's charts, the climbable surfaces, the mask's allowed area or the include zones)",
+        scene_->name,
+        mask ? fmt::format(" with mask={} (mask_mode={})", mask_path_, cfg_.mask_include ? "include" : "exclude")
+             : ""));
   alive_.assign(center_.size(), 1);
   active_flag_.assign(center_.size(), 0);
   nearest_.assign(center_.size(), kNone);
