@@ -33,6 +33,19 @@ struct AlgorithmInfo {
   std::vector<std::string> test_params;
 };
 
+// A file an algorithm writes beside the plant's meshes (GrowthAlgorithm::write_outputs).
+struct OutputFile {
+  std::string name;  // as written into the directory asked for
+  std::uint64_t bytes = 0;
+};
+
+// Where and what GrowthAlgorithm::write_outputs writes.
+struct OutputRequest {
+  std::string dir;     // exists
+  std::string prefix;  // put before every file name: "" for a run's files, "step_000010." for a frame's
+  bool frame = false;  // a growth frame: only the images plant().decals name (what renders of it need)
+};
+
 class GrowthAlgorithm {
  public:
   virtual ~GrowthAlgorithm() = default;
@@ -55,6 +68,10 @@ class GrowthAlgorithm {
   virtual void finish() {}
   // Algorithm-specific figures for the trial record (e.g. attraction points left).
   [[nodiscard]] virtual std::vector<std::pair<std::string, double>> stats() const { return {}; }
+  // Files only this algorithm makes, for the plant as it is now (the vines' texture, its normal map and
+  // its skeleton as SVG). The image of each of plant().decals must be among them, named prefix + image.
+  // Called in the export phase (timed there) and, for each growth frame, with frame set.
+  [[nodiscard]] virtual std::vector<OutputFile> write_outputs(const OutputRequest& /*request*/) const { return {}; }
 
  private:
   std::optional<std::chrono::steady_clock::time_point> deadline_;

@@ -117,6 +117,14 @@ std::string Plant::validate() const {
     if (o.node != kNoParent && (o.node < 0 || static_cast<std::size_t>(o.node) >= nodes.size()))
       return fmt::format("organ {} refers to node {} of {}", i, o.node, nodes.size());
   }
+  for (std::size_t i = 0; i < decals.size(); ++i) {
+    const auto& d = decals[i];
+    // A plain file name: renders hand it to POV-Ray, which reads only below its working directory.
+    if (d.image.empty() || d.image.find_first_of("/\\\"") != std::string::npos || d.image.front() == '.')
+      return fmt::format("decal {} has image name '{}' (expected a plain file name)", i, d.image);
+    if (d.mesh < kPlanarDecal || !finite(d.origin) || !finite(d.u_axis) || !finite(d.v_axis))
+      return fmt::format("decal {} has mesh {} or a non-finite mapping", i, d.mesh);
+  }
   if (!node_groups.empty() && node_groups.size() != nodes.size())
     return fmt::format("{} node groups for {} nodes", node_groups.size(), nodes.size());
   for (const auto& a : node_attributes)

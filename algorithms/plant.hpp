@@ -49,10 +49,24 @@ struct NodeAttribute {
   std::vector<float> values;
 };
 
+// An image an algorithm paints over the scene's surfaces (the vines' texture). Renders lay it over the
+// surfaces' own material, and it stands for the plant there: a plant with decals is drawn by them.
+// The image's (u, v) cover [0, 1]^2 with v up: its top row is v = 1, as in OBJ texture coordinates.
+struct SurfaceDecal {
+  std::string image;  // PNG file name, relative to the directory of the file that holds the plant
+  // mesh >= 0: the image follows that scene mesh's texture coordinates (TriangleMesh::uvs).
+  // mesh == kPlanarDecal: (u, v) sits at origin + u * u_axis + v * v_axis and is projected along
+  // u_axis x v_axis onto the climbable meshes; in a scene with none, that rectangle itself wears it.
+  std::int32_t mesh = -1;
+  glm::vec3 origin{0.0f}, u_axis{1.0f, 0.0f, 0.0f}, v_axis{0.0f, 1.0f, 0.0f};
+};
+constexpr std::int32_t kPlanarDecal = -1;
+
 struct Plant {
   std::vector<PlantNode> nodes;
   std::vector<Organ> organs;
   std::vector<PlantPolygon> polygons;
+  std::vector<SurfaceDecal> decals;
   // Optional per-node data, empty unless an algorithm fills it (one entry per node when present):
   std::vector<std::int32_t> node_groups;  // group number (-1: none); L-system g
   std::vector<NodeAttribute> node_attributes;
@@ -61,6 +75,7 @@ struct Plant {
     nodes.clear();
     organs.clear();
     polygons.clear();
+    decals.clear();
     node_groups.clear();
     node_attributes.clear();
   }

@@ -27,6 +27,7 @@ import html
 import json
 import math
 import os
+import re
 import shutil
 import sys
 
@@ -469,7 +470,59 @@ def figures(cells, out, formats):
     axes[0][0].legend(fontsize=7)
     fig.tight_layout()
     save(fig, "fig-growth-curves", "Growth curves: plant nodes after each step (lowest seed of each cell).")
+    sweep_figures(good, labels, colours, markers, plt, np, save)
     return written
+
+
+def swept_numbers(cells):
+    """The sweep keys whose values are numbers and take at least two values across these cells."""
+    keys = ordered(k for c in cells for k in (c.t.get("sweep") or {}))
+    out = []
+    for k in keys:
+        vals = {c.t["sweep"].get(k) for c in cells if k in (c.t.get("sweep") or {})}
+        if len(vals) > 1 and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in vals):
+            out.append(k)
+    return out
+
+
+def sweep_figures(good, labels, colours, markers, plt, np, save):
+    """One figure per swept numeric parameter: growth time against it, one line per entry and scene (the
+    seed's Figure 16 for the vines' resolution, and any other sweep)."""
+    for key in swept_numbers(good):
+        fig, ax = plt.subplots(figsize=(6.4, 4.4))
+        spans = []
+        for i, label in enumerate(labels):
+            for scene in ordered(c.scene for c in good if c.label == label):
+                # Per value: the lowest seed's cell (several seeds would zigzag one line).
+                by_value = {}
+                for c in good:
+                    if c.label == label and c.scene == scene and key in (c.t.get("sweep") or {}):
+                        v = float(c.t["sweep"][key])
+                        if v not in by_value or c.seed < by_value[v].seed:
+                            by_value[v] = c
+                if len(by_value) < 2:
+                    continue
+                x = np.array(sorted(by_value))
+                pts = [by_value[v] for v in x]
+                med = np.array([c.growth_median() for c in pts])
+                lo = med - np.array([c.growth_summary["lo"] if c.growth_summary else m for c, m in zip(pts, med)])
+                hi = np.array([c.growth_summary["hi"] if c.growth_summary else m for c, m in zip(pts, med)]) - med
+                ax.errorbar(x, med, yerr=[lo, hi], fmt="-" + markers[i % len(markers)], color=colours[label], ms=4,
+                            capsize=2, lw=1, label=f"{label} on {scene}")
+                spans.append(x.max() / max(x.min(), 1e-300))
+        if not spans:
+            plt.close(fig)
+            continue
+        if max(spans) >= 4:
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+        ax.set_xlabel(key)
+        ax.set_ylabel("growth wall time (s), median and 95% interval")
+        ax.set_title(f"Growth time against {key}")
+        ax.legend(fontsize=7, loc="best")
+        save(fig, f"fig-sweep-{re.sub(r'[^A-Za-z0-9_]+', '-', key)}",
+             f"Growth wall time against the swept parameter {key}: one line per algorithm entry and scene (its lowest "
+             f"seed), points are the median over repetitions, bars its distribution-free 95% interval.")
 
 
 # ---------------------------------------------------------------- HTML

@@ -43,6 +43,16 @@ bool TriangleMesh::is_closed() const {
 }
 
 void TriangleMesh::append(const TriangleMesh& other) {
+  // Texture coordinates survive only when both parts have them: a half-mapped mesh has no mapping.
+  const bool uv = (triangles.empty() || has_uvs()) && other.has_uvs();
+  if (!uv) {
+    uvs.clear();
+    uv_triangles.clear();
+  } else {
+    const auto uv_base = static_cast<unsigned>(uvs.size());
+    uvs.insert(uvs.end(), other.uvs.begin(), other.uvs.end());
+    for (const auto& t : other.uv_triangles) uv_triangles.emplace_back(t + glm::uvec3(uv_base));
+  }
   const auto base = static_cast<unsigned>(vertices.size());
   vertices.insert(vertices.end(), other.vertices.begin(), other.vertices.end());
   for (const auto& t : other.triangles) triangles.emplace_back(t + glm::uvec3(base));
@@ -51,8 +61,10 @@ void TriangleMesh::append(const TriangleMesh& other) {
 void TriangleMesh::transform(const glm::mat4& m) {
   for (auto& v : vertices) v = glm::vec3(m * glm::vec4(v, 1.0f));
   // A mirroring transform flips orientation: swap winding to keep faces outward.
-  if (glm::determinant(glm::mat3(m)) < 0.0f)
+  if (glm::determinant(glm::mat3(m)) < 0.0f) {
     for (auto& t : triangles) std::swap(t.y, t.z);
+    for (auto& t : uv_triangles) std::swap(t.y, t.z);
+  }
 }
 
 Aabb Shape::bounds() const {
@@ -143,6 +155,12 @@ struct Hasher {
     bytes(m.vertices.data(), m.vertices.size() * sizeof(glm::vec3));
     pod(m.triangles.size());
     bytes(m.triangles.data(), m.triangles.size() * sizeof(glm::uvec3));
+    // Texture coordinates only when present, so a mesh without them keeps the hash it always had.
+    if (m.has_uvs()) {
+      pod(m.uvs.size());
+      bytes(m.uvs.data(), m.uvs.size() * sizeof(glm::vec2));
+      bytes(m.uv_triangles.data(), m.uv_triangles.size() * sizeof(glm::uvec3));
+    }
   }
   void shape(const Shape& s) {
     pod(s.kind);

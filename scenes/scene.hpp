@@ -41,6 +41,13 @@ struct TriangleMesh {
   std::vector<glm::uvec3> triangles;
   // Plants may climb it and surface attraction points are sampled on it (the ground is not climbable).
   bool climbable = true;
+  // Texture coordinates (OBJ `vt`), when the mesh has them: corner k of triangles[i] has
+  // uvs[uv_triangles[i][k]]. Both are empty when it has none. v points up the image (OpenGL's and OBJ's
+  // convention: the image's top row is v = 1).
+  std::vector<glm::vec2> uvs;
+  std::vector<glm::uvec3> uv_triangles;
+
+  [[nodiscard]] bool has_uvs() const { return !uv_triangles.empty(); }
 
   [[nodiscard]] Aabb bounds() const;
   [[nodiscard]] double area() const;

@@ -69,30 +69,62 @@ TriangleMesh load_obj(const std::string& path) {
       throw InputError(fmt::format("{}: vertex {} has a non-finite coordinate", path, i + 1));
     m.vertices.push_back(v);
   }
+  const std::size_t nt = attrib.texcoords.size() / 2;
+  m.uvs.reserve(nt);
+  for (std::size_t i = 0; i < nt; ++i) {
+    const glm::vec2 uv(attrib.texcoords[2 * i], attrib.texcoords[2 * i + 1]);
+    if (!std::isfinite(uv.x) || !std::isfinite(uv.y))
+      throw InputError(fmt::format("{}: texture coordinate (vt) {} is not finite", path, i + 1));
+    m.uvs.push_back(uv);
+  }
+  // Texture coordinates are kept only when every face has them: a mesh half mapped has no mapping.
+  bool every_face_uv = nt > 0;
   for (const auto& shape : reader.GetShapes()) {
     std::size_t offset = 0;
     for (const auto fv : shape.mesh.num_face_vertices) {
       if (fv == 3) {
-        glm::uvec3 t;
+        glm::uvec3 t, tt;
         for (int k = 0; k < 3; ++k) {
-          const int idx = shape.mesh.indices[offset + static_cast<std::size_t>(k)].vertex_index;
+          const auto& corner = shape.mesh.indices[offset + static_cast<std::size_t>(k)];
+          const int idx = corner.vertex_index;
           if (idx < 0 || static_cast<std::size_t>(idx) >= nv)
             throw InputError(fmt::format("{}: shape '{}' has a face with vertex index {} out of range (1..{})", path,
                                          shape.name, idx + 1, nv));
           t[k] = static_cast<unsigned>(idx);
+          const int ti = corner.texcoord_index;
+          if (ti >= 0 && static_cast<std::size_t>(ti) >= nt)
+            throw InputError(fmt::format("{}: shape '{}' has a face with texture index {} out of range (1..{})", path,
+                                         shape.name, ti + 1, nt));
+          if (ti < 0) every_face_uv = false;
+          tt[k] = ti < 0 ? 0u : static_cast<unsigned>(ti);
         }
-        if (t.x != t.y && t.y != t.z && t.x != t.z) m.triangles.push_back(t);
+        if (t.x != t.y && t.y != t.z && t.x != t.z) {
+          m.triangles.push_back(t);
+          m.uv_triangles.push_back(tt);
+        }
       }
       offset += fv;
     }
   }
   if (m.triangles.empty()) throw InputError(fmt::format("{}: the OBJ file has no faces", path));
+  if (!every_face_uv) {
+    m.uvs.clear();
+    m.uv_triangles.clear();
+  }
   return m;
 }
 
 TriangleMesh load_scene_obj(const std::string& path) {
   TriangleMesh m = load_obj(path);
+  const std::size_t before = m.triangles.size();
   geom::fill_small_holes(m);  // leaves an open or badly holed mesh as it is: it has no inside
+  if (m.has_uvs() && m.triangles.size() > before) {
+    // The patches have no place in the texture: all their corners get one coordinate outside the unit
+    // square, a triangle of no area in UV, which no texture lookup finds.
+    const auto none = static_cast<unsigned>(m.uvs.size());
+    m.uvs.emplace_back(-1.0f, -1.0f);
+    m.uv_triangles.resize(m.triangles.size(), glm::uvec3(none));
+  }
   return m;
 }
 

@@ -58,8 +58,10 @@ void print_record(const TrialRecord& rec, const TrialSpec& spec, const std::stri
       "MiB\n",
       ph.scene_load.value().wall_s, ph.query_build.value().wall_s, ph.growth.value().wall_s, ph.meshing.value().wall_s,
       ph.exporting.value().wall_s, static_cast<double>(rec.peak_rss_bytes) / (1024.0 * 1024.0));
-  fmt::print("  wrote {}/plant.obj, plant.ply, plant.glb, skeleton.obj, record.json (geometry hash {})\n", out_dir,
-             rec.geometry_hash);
+  std::string own;  // the algorithm's own files (the vines' texture), as the record lists them
+  for (const auto& [name, bytes] : rec.output_bytes.algorithm_files) own += ", " + name;
+  fmt::print("  wrote {}/plant.obj, plant.ply, plant.glb, skeleton.obj{}, record.json (geometry hash {})\n", out_dir,
+             own, rec.geometry_hash);
   if (rec.frames)
     fmt::print("  kept {} frames in {}/frames (capture took {:.3f} s, not counted in growth)\n", rec.frames->count,
                out_dir, ph.growth.value().frame_capture_wall_s.value());

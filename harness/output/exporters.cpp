@@ -9,6 +9,7 @@
 #include <iterator>
 #include <map>
 #include <memory>
+#include <stdexcept>
 #include <type_traits>
 
 #include <fmt/format.h>
@@ -306,6 +307,14 @@ class SnapshotReader {
       throw InputError(fmt::format("{}: plant snapshot count {} at byte {} exceeds the file", path_, n, pos_ - 8));
     return static_cast<std::size_t>(n);
   }
+  // `n` bytes as a string; n comes from count(1), so it is within the file.
+  std::string text(std::size_t n) {
+    if (pos_ + n > data_.size())
+      throw InputError(fmt::format("{}: plant snapshot cut short at byte {} of {}", path_, pos_, data_.size()));
+    std::string s = data_.substr(pos_, n);
+    pos_ += n;
+    return s;
+  }
   [[nodiscard]] bool at_end() const { return pos_ == data_.size(); }
 
  private:
@@ -313,9 +322,20 @@ class SnapshotReader {
   std::size_t pos_ = 0;
 };
 
+// The smallest record of a decal: an empty name's length, mesh, origin and both axes.
+constexpr std::size_t kDecalMinBytes = 8 + 4 + 3 * 12;
+
 }  // namespace
 
-std::uint64_t write_plant_snapshot(const std::string& path, const Plant& plant) {
+std::uint64_t write_plant_snapshot(const std::string& path, const Plant& plant, const std::string& image_prefix) {
+  if (!image_prefix.empty() && !plant.decals.empty()) {
+    // Checked before anything is written: the reader would refuse a name the prefix made invalid.
+    Plant names;
+    names.decals = plant.decals;
+    for (auto& d : names.decals) d.image = image_prefix + d.image;
+    if (const std::string bad = names.validate(); !bad.empty())
+      throw std::invalid_argument(fmt::format("{}: image prefix '{}': {}", path, image_prefix, bad));
+  }
   auto file = std::make_unique<AtomicFile>(path);  // its buffer on the heap, not on a worker's stack
   AtomicFile& b = *file;
   b.bytes(kSnapshotMagic, sizeof(kSnapshotMagic));
@@ -344,6 +364,18 @@ std::uint64_t write_plant_snapshot(const std::string& path, const Plant& plant) 
   for (const auto& p : plant.polygons) {
     put<std::uint64_t>(b, p.vertices.size());
     for (const auto& v : p.vertices) put(b, v);
+  }
+  if (!plant.decals.empty()) {
+    put<std::uint64_t>(b, plant.decals.size());
+    for (const auto& d : plant.decals) {
+      const std::string name = image_prefix + d.image;
+      put<std::uint64_t>(b, name.size());
+      b.bytes(name.data(), name.size());
+      put(b, d.mesh);
+      put(b, d.origin);
+      put(b, d.u_axis);
+      put(b, d.v_axis);
+    }
   }
   return b.finish();
 }
@@ -385,6 +417,17 @@ Plant read_plant_snapshot(const std::string& path) {
   for (auto& p : plant.polygons) {
     p.vertices.resize(r.count(12));
     for (auto& v : p.vertices) v = r.vec3();
+  }
+  // Snapshots written before decals end here.
+  if (!r.at_end()) {
+    plant.decals.resize(r.count(kDecalMinBytes));
+    for (auto& d : plant.decals) {
+      d.image = r.text(r.count(1));
+      d.mesh = r.get<std::int32_t>();
+      d.origin = r.vec3();
+      d.u_axis = r.vec3();
+      d.v_axis = r.vec3();
+    }
   }
   if (!r.at_end()) throw InputError(fmt::format("{}: plant snapshot has trailing bytes", path));
   if (const std::string bad = plant.validate(); !bad.empty())

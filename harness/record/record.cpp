@@ -290,6 +290,7 @@ json to_json(const OutputBytes& v) {
   put(j, "ply", v.ply);
   put(j, "glb", v.glb);
   put(j, "skeleton_obj", v.skeleton_obj);
+  if (!v.algorithm_files.empty()) put(j, "algorithm_files", v.algorithm_files);
   return j;
 }
 void read(const Node& n, OutputBytes& v) {
@@ -298,6 +299,7 @@ void read(const Node& n, OutputBytes& v) {
   f.field("ply", v.ply);
   f.field("glb", v.glb);
   f.field("skeleton_obj", v.skeleton_obj);
+  f.field("algorithm_files", v.algorithm_files);
   f.done();
 }
 

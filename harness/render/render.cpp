@@ -77,17 +77,53 @@ std::vector<glm::vec3> smooth_normals(const TriangleMesh& m) {
   return n;
 }
 
-void write_mesh2(Out out, const std::vector<glm::vec3>& vertices, const std::vector<glm::vec3>& normals,
-                 const std::vector<glm::uvec3>& triangles, std::uint32_t first, std::uint32_t count) {
-  // Only the vertices the triangles use, renumbered.
-  std::vector<std::int64_t> remap(vertices.size(), -1);
-  std::vector<std::uint32_t> used;
+// Texture coordinates for write_mesh2: corner k of triangle t has uvs[triangles[t][k]] (TriangleMesh's).
+struct MeshUvs {
+  const std::vector<glm::vec2>& uvs;
+  const std::vector<glm::uvec3>& triangles;
+};
+
+// The items triangles[first, first + count) use, renumbered in order of first use: `used` lists them, and
+// the result maps an item to its new number (-1: unused).
+std::vector<std::int64_t> renumber(std::size_t items, const std::vector<glm::uvec3>& triangles, std::uint32_t first,
+                                   std::uint32_t count, std::vector<std::uint32_t>& used) {
+  std::vector<std::int64_t> remap(items, -1);
   for (std::uint32_t t = first; t < first + count; ++t)
     for (int k = 0; k < 3; ++k)
       if (remap[triangles[t][k]] < 0) {
         remap[triangles[t][k]] = static_cast<std::int64_t>(used.size());
         used.push_back(triangles[t][k]);
       }
+  return remap;
+}
+
+// `uv_vectors` and `uv_indices`, the two parts of a mesh2's texture coordinates, the used ones renumbered.
+void write_uv_vectors(Out out, const MeshUvs& uv, std::uint32_t first, std::uint32_t count) {
+  std::vector<std::uint32_t> used;
+  renumber(uv.uvs.size(), uv.triangles, first, count, used);
+  fmt::format_to(out, "  uv_vectors {{ {}", used.size());
+  for (std::size_t i = 0; i < used.size(); ++i)
+    fmt::format_to(out, "{}<{:.7g},{:.7g}>", i % 6 == 0 ? ",\n    " : ", ", uv.uvs[used[i]].x, uv.uvs[used[i]].y);
+  fmt::format_to(out, "\n  }}\n");
+}
+void write_uv_indices(Out out, const MeshUvs& uv, std::uint32_t first, std::uint32_t count) {
+  std::vector<std::uint32_t> used;
+  const std::vector<std::int64_t> remap = renumber(uv.uvs.size(), uv.triangles, first, count, used);
+  fmt::format_to(out, "  uv_indices {{ {}", count);
+  for (std::uint32_t t = first; t < first + count; ++t)
+    fmt::format_to(out, "{}<{},{},{}>", (t - first) % 6 == 0 ? ",\n    " : ", ", remap[uv.triangles[t].x],
+                   remap[uv.triangles[t].y], remap[uv.triangles[t].z]);
+  fmt::format_to(out, "\n  }}\n");
+}
+
+// An open mesh2 (the caller adds its texture and the closing brace), with texture coordinates when `uv`
+// is given.
+void write_mesh2(Out out, const std::vector<glm::vec3>& vertices, const std::vector<glm::vec3>& normals,
+                 const std::vector<glm::uvec3>& triangles, std::uint32_t first, std::uint32_t count,
+                 const MeshUvs* uv = nullptr) {
+  // Only the vertices the triangles use, renumbered.
+  std::vector<std::uint32_t> used;
+  const std::vector<std::int64_t> remap = renumber(vertices.size(), triangles, first, count, used);
   fmt::format_to(out, "mesh2 {{\n  vertex_vectors {{ {}", used.size());
   for (std::size_t i = 0; i < used.size(); ++i) {
     fmt::format_to(out, "{}", i % 4 == 0 ? ",\n    " : ", ");
@@ -102,11 +138,13 @@ void write_mesh2(Out out, const std::vector<glm::vec3>& vertices, const std::vec
     }
     fmt::format_to(out, "\n  }}\n");
   }
+  if (uv) write_uv_vectors(out, *uv, first, count);  // POV-Ray's order: after the normals, before the faces
   fmt::format_to(out, "  face_indices {{ {}", count);
   for (std::uint32_t t = first; t < first + count; ++t)
     fmt::format_to(out, "{}<{},{},{}>", (t - first) % 6 == 0 ? ",\n    " : ", ", remap[triangles[t].x],
                    remap[triangles[t].y], remap[triangles[t].z]);
   fmt::format_to(out, "\n  }}\n");
+  if (uv) write_uv_indices(out, *uv, first, count);
 }
 
 // A group of objects with one texture: a union when there are two or more (POV-Ray warns about a union
@@ -133,10 +171,11 @@ glm::vec3 any_perpendicular(const glm::vec3& d) {
 void write_settings(Out out, const Scene& scene, const Plant& plant, const RenderOptions& o, float diag) {
   const bool paper = o.quality == RenderQuality::Paper;
   fmt::format_to(out,
-                 "// growbench render: scene '{}', {} nodes, {} organs, quality {}\n"
+                 "// growbench render: scene '{}', {} nodes, {} organs{}, quality {}\n"
                  "#version 3.7;\n"
                  "global_settings {{\n  assumed_gamma 1.0\n  max_trace_level 8\n",
-                 scene.name, plant.nodes.size(), plant.organs.size(), to_string(o.quality));
+                 scene.name, plant.nodes.size(), plant.organs.size(),
+                 plant.decals.empty() ? "" : fmt::format(", {} decals", plant.decals.size()), to_string(o.quality));
   if (paper)
     fmt::format_to(out,
                    "  radiosity {{ pretrace_start 0.08 pretrace_end 0.01 count 60 nearest_count 5 error_bound 0.8\n"
@@ -205,12 +244,87 @@ void write_lights(Out out, const Scene& scene, const glm::vec3& centre, float di
   }
 }
 
-void write_scene_meshes(Out out, const Scene& scene) {
-  for (const auto& m : scene.meshes) {
+// True when every triangle of `m` has texture coordinates that exist.
+bool has_valid_uvs(const TriangleMesh& m) {
+  if (!m.has_uvs() || m.uv_triangles.size() != m.triangles.size()) return false;
+  for (const auto& t : m.uv_triangles)
+    for (int k = 0; k < 3; ++k)
+      if (t[k] >= m.uvs.size()) return false;
+  return true;
+}
+
+// The decal layer's finish: the default's, with no highlight, which would shine through where the image
+// is transparent (a layer's highlight is not weighted by its transparency).
+constexpr const char* kDecalFinish = "finish { specular 0 }";
+
+// A decal laid over a scene mesh: the image through the mesh's texture coordinates, on top of the
+// textures before it; its transparent pixels show them (POV-Ray reads a PNG's alpha as transmit).
+// uv_mapping modifies the pigment: on the texture it would make a patterned texture, which POV-Ray
+// refuses as a layer.
+void write_uv_decal_layer(Out out, const SurfaceDecal& d) {
+  fmt::format_to(out, "  texture {{ pigment {{ uv_mapping image_map {{ png \"{}\" once interpolate 2 }} }} {} }}\n",
+                 d.image, kDecalFinish);
+}
+
+// A planar decal: image_map's projection of the unit square in x-y along z, carried by the matrix to
+// (x, y, z) -> origin + x u_axis + y v_axis + z n (n the unit normal u_axis x v_axis), all in POV-Ray's
+// coordinates. Row i of POV-Ray's matrix is the image of axis i.
+void write_planar_decal_layer(Out out, const SurfaceDecal& d) {
+  // Negated zeros written as 0, for the reader of the file.
+  auto row = [](const glm::vec3& a) {
+    return glm::vec3(a.x == 0.0f ? 0.0f : a.x, a.y == 0.0f ? 0.0f : a.y, a.z == 0.0f ? 0.0f : a.z);
+  };
+  const glm::vec3 u = row(pov(d.u_axis)), v = row(pov(d.v_axis));
+  const glm::vec3 n = row(pov(glm::normalize(glm::cross(d.u_axis, d.v_axis)))), o = row(pov(d.origin));
+  fmt::format_to(
+      out,
+      "  texture {{ pigment {{ image_map {{ png \"{}\" once interpolate 2 }} }} {}\n"
+      "    matrix <{:.7g},{:.7g},{:.7g}, {:.7g},{:.7g},{:.7g}, {:.7g},{:.7g},{:.7g}, {:.7g},{:.7g},{:.7g}> }}\n",
+      d.image, kDecalFinish, u.x, u.y, u.z, v.x, v.y, v.z, n.x, n.y, n.z, o.x, o.y, o.z);
+}
+
+// The scene's meshes, each with its texture and, on top, the decals laid over it: those that follow its
+// texture coordinates and, on a climbable mesh, the planar ones. write_pov has checked the decals.
+void write_scene_meshes(Out out, const Scene& scene, const std::vector<SurfaceDecal>& decals) {
+  for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
+    const TriangleMesh& m = scene.meshes[i];
     if (m.triangles.empty()) continue;
-    fmt::format_to(out, "// scene mesh '{}': {} triangles\n", m.name, m.triangles.size());
-    write_mesh2(out, m.vertices, smooth_normals(m), m.triangles, 0, static_cast<std::uint32_t>(m.triangles.size()));
-    fmt::format_to(out, "  texture {{ {} }}\n}}\n", m.climbable ? "GB_Surface" : "GB_Ground");
+    std::vector<const SurfaceDecal*> uv_decals, planar;
+    for (const auto& d : decals) {
+      if (d.mesh == kPlanarDecal && m.climbable) planar.push_back(&d);
+      if (d.mesh >= 0 && static_cast<std::size_t>(d.mesh) == i) uv_decals.push_back(&d);
+    }
+    fmt::format_to(out, "// scene mesh '{}': {} triangles", m.name, m.triangles.size());
+    if (!uv_decals.empty() || !planar.empty())
+      fmt::format_to(out, ", {} decal{} on top", uv_decals.size() + planar.size(),
+                     uv_decals.size() + planar.size() == 1 ? "" : "s");
+    fmt::format_to(out, "\n");
+    const MeshUvs uv{m.uvs, m.uv_triangles};
+    write_mesh2(out, m.vertices, smooth_normals(m), m.triangles, 0, static_cast<std::uint32_t>(m.triangles.size()),
+                uv_decals.empty() ? nullptr : &uv);
+    // Layered textures: the first is the bottom layer, each later one lies on top of those before it.
+    fmt::format_to(out, "  texture {{ {} }}\n", m.climbable ? "GB_Surface" : "GB_Ground");
+    for (const SurfaceDecal* d : uv_decals) write_uv_decal_layer(out, *d);
+    for (const SurfaceDecal* d : planar) write_planar_decal_layer(out, *d);
+    fmt::format_to(out, "}}\n");
+  }
+}
+
+// In a scene with nothing to climb a planar decal stands free: its rectangle itself wears the image, seen
+// through where the image is transparent.
+void write_free_decals(Out out, const Scene& scene, const std::vector<SurfaceDecal>& decals) {
+  if (std::any_of(scene.meshes.begin(), scene.meshes.end(), [](const TriangleMesh& m) { return m.climbable; })) return;
+  for (const SurfaceDecal& d : decals) {
+    if (d.mesh != kPlanarDecal) continue;
+    const std::vector<glm::vec3> corners = {d.origin, d.origin + d.u_axis, d.origin + d.u_axis + d.v_axis,
+                                            d.origin + d.v_axis};
+    const std::vector<glm::uvec3> triangles = {{0, 1, 2}, {0, 2, 3}};
+    const std::vector<glm::vec2> uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    const MeshUvs uv{uvs, triangles};
+    fmt::format_to(out, "// decal '{}' standing free: the scene has nothing to climb\n", d.image);
+    write_mesh2(out, corners, {}, triangles, 0, 2, &uv);
+    write_uv_decal_layer(out, d);
+    fmt::format_to(out, "}}\n");
   }
 }
 
@@ -250,7 +364,9 @@ void write_cones(Out out, const Plant& plant) {
 // Branches as RenderOptions::branches asks: cone chains, or the mesher's tubes as one mesh2.
 void write_branches(Out out, const Plant& plant, const RenderOptions& o) {
   if (o.branches == "mesh") {
-    const OutputMesh tubes = mesh_plant(Plant{plant.nodes, {}, {}, {}, {}}, o.mesher);
+    Plant branches;
+    branches.nodes = plant.nodes;
+    const OutputMesh tubes = mesh_plant(branches, o.mesher);
     if (!tubes.triangles.empty()) {
       fmt::format_to(out, "// branches: {} nodes as one mesh2\n", plant.nodes.size());
       write_mesh2(out, tubes.positions, tubes.normals, tubes.triangles, 0,
@@ -315,6 +431,26 @@ void write_polygons(Out out, const Plant& plant) {
 
 }  // namespace
 
+std::string decal_problem(const Scene& scene, const Plant& plant) {
+  for (std::size_t i = 0; i < plant.decals.size(); ++i) {
+    const SurfaceDecal& d = plant.decals[i];
+    // The name goes into a POV-Ray string as it is.
+    if (std::any_of(d.image.begin(), d.image.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20; }))
+      return fmt::format("decal {}: its image name has a control character", i);
+    if (d.mesh == kPlanarDecal) {
+      if (!(glm::length(glm::cross(d.u_axis, d.v_axis)) > 0.0f))
+        return fmt::format("decal {} ({}): its u_axis and v_axis span no plane", i, d.image);
+    } else if (d.mesh < 0 || static_cast<std::size_t>(d.mesh) >= scene.meshes.size()) {
+      return fmt::format("decal {} ({}) is on mesh {}, but scene '{}' has {} meshes", i, d.image, d.mesh, scene.name,
+                         scene.meshes.size());
+    } else if (!has_valid_uvs(scene.meshes[static_cast<std::size_t>(d.mesh)])) {
+      return fmt::format("decal {} ({}) follows the texture coordinates of mesh {} ('{}'), which has none", i, d.image,
+                         d.mesh, scene.meshes[static_cast<std::size_t>(d.mesh)].name);
+    }
+  }
+  return "";
+}
+
 std::uint64_t write_pov(const std::string& path, const Scene& scene, const Plant& plant, const RenderOptions& o) {
   fmt::memory_buffer b;
   auto out = std::back_inserter(b);
@@ -331,8 +467,16 @@ std::uint64_t write_pov(const std::string& path, const Scene& scene, const Plant
   write_lights(out, scene, bounds.center(), diag, o.quality == RenderQuality::Paper);
   // Ground: a plane under everything (the scene's own ground mesh, when it has one, sits on it).
   fmt::format_to(out, "plane {{ y, {:.6g} texture {{ GB_Ground }} }}\n", bounds.min.y - 1e-3f);
-  write_scene_meshes(out, scene);
-  if (o.draw_plant) {
+  const bool decals = o.draw_plant && !plant.decals.empty();
+  if (decals)
+    if (const std::string bad = decal_problem(scene, plant); !bad.empty())
+      throw InputError(fmt::format("{}: cannot draw the plant's decals: {}", path, bad));
+  const std::vector<SurfaceDecal> no_decals;
+  write_scene_meshes(out, scene, decals ? plant.decals : no_decals);
+  write_free_decals(out, scene, decals ? plant.decals : no_decals);
+  // A plant with decals is drawn by them (CONTRIBUTING.md, Rendering): its branches, organs and polygons
+  // are not drawn again on top.
+  if (o.draw_plant && !decals) {
     write_branches(out, plant, o);
     write_organs(out, plant, o.mesher);
     write_polygons(out, plant);
@@ -455,8 +599,40 @@ RenderResult run_povray(const std::string& pov_path, const std::string& png_path
   return r;
 }
 
+namespace {
+
+// Why the plant's decals cannot be rendered into png_path ("" when they can): a decal the scene cannot
+// hold, or an image missing from the render's directory, where POV-Ray runs and reads them.
+std::string decal_render_problem(const Scene& scene, const Plant& plant, const std::string& png_path,
+                                 const RenderOptions& o) {
+  if (!o.draw_plant || plant.decals.empty()) return "";
+  if (std::string bad = decal_problem(scene, plant); !bad.empty()) return bad;
+  const fs::path dir = fs::absolute(png_path).parent_path();
+  for (std::size_t i = 0; i < plant.decals.size(); ++i)
+    if (!fs::is_regular_file(dir / plant.decals[i].image))
+      return fmt::format("decal {}: its image {} is missing (a render reads decal images from its own directory)", i,
+                         (dir / plant.decals[i].image).string());
+  return "";
+}
+
+}  // namespace
+
 RenderResult render_plant(const Scene& scene, const Plant& plant, const std::string& pov_path,
                           const std::string& png_path, const RenderOptions& o) {
+  // A decal that cannot be drawn fails the render rather than leaving the plant out of it: a render
+  // without the plant would pass for one of a plant that grew nothing.
+  if (const std::string bad = decal_render_problem(scene, plant, png_path, o); !bad.empty()) {
+    std::error_code ec;
+    fs::remove(png_path, ec);  // an earlier render's image would pass for this one's
+    RenderResult r;
+    r.status = "failed";
+    r.message = fmt::format("cannot render {}: {}", png_path, bad);
+    r.pov = pov_path;
+    r.png = png_path;
+    r.width = render_width(o);
+    r.height = render_height(o);
+    return r;
+  }
   const auto t0 = std::chrono::steady_clock::now();
   std::uint64_t bytes = 0;
   try {

@@ -45,7 +45,14 @@ struct RenderOptions {
 // Writes a POV-Ray 3.7 scene file (`#version 3.7`, `assumed_gamma 1.0`): the scene's meshes as mesh2,
 // the plant's branches, its leaves and flowers instanced from one declared mesh each, the scene camera
 // and light, a sky and a ground plane. Returns the bytes written.
+// A plant with decals is drawn by them instead: each image is a texture layer on top of the meshes it
+// lies on (through a mesh's texture coordinates, or projected onto every climbable mesh), its alpha
+// showing the surface below. Their names are written as they are, so POV-Ray reads them from its working
+// directory, the image's (run_povray); InputError when a decal cannot be drawn (decal_problem).
 std::uint64_t write_pov(const std::string& path, const Scene& scene, const Plant& plant, const RenderOptions& options);
+// Why the plant's decals cannot be drawn in `scene`: a mesh it does not have, or one without texture
+// coordinates, or a planar decal whose axes span no plane. "" when they can.
+std::string decal_problem(const Scene& scene, const Plant& plant);
 
 struct RenderResult {
   std::string status = "ok";          // ok | failed | timeout | no_povray
@@ -69,7 +76,9 @@ std::string povray_version();
 // failure: the result's status and message say what happened. Safe to call from several threads.
 RenderResult run_povray(const std::string& pov_path, const std::string& png_path, const RenderOptions& options);
 
-// write_pov, then run_povray. The .pov file is kept beside the image for inspection.
+// write_pov, then run_povray. The .pov file is kept beside the image for inspection. The images of the
+// plant's decals must be in PNG_PATH's directory: when one is missing or cannot be drawn, the result is
+// "failed" with a message saying which, and POV-Ray is not run.
 RenderResult render_plant(const Scene& scene, const Plant& plant, const std::string& pov_path,
                           const std::string& png_path, const RenderOptions& options);
 

@@ -37,7 +37,8 @@ struct Job {
   RenderResult result;
 };
 
-// The frames of a trial directory, in step order.
+// The frames of a trial directory, in step order (their names, step_NNNNNN.gbplant, sort by step). Only
+// snapshots: the images their decals name end in .png.
 std::vector<fs::path> frame_snapshots(const fs::path& trial_dir) {
   std::vector<fs::path> out;
   const fs::path d = trial_dir / "frames";
@@ -48,27 +49,37 @@ std::vector<fs::path> frame_snapshots(const fs::path& trial_dir) {
   return out;
 }
 
-// ffmpeg: frames/step_*.png to animation.mp4 (H.264, even dimensions). Returns a record of the attempt.
+// The rendered frames, and only they: a frame's snapshot is step_NNNNNN.gbplant (six digits, as the trial
+// names it, so names sort in step order) and renders to step_NNNNNN.png, while the images its decals name
+// sit beside it as step_NNNNNN.IMAGE (step_000010.texture.png), which this must not match.
+constexpr const char* kFrameGlob = "frames/step_[0-9][0-9][0-9][0-9][0-9][0-9].png";
+
+// ffmpeg: the rendered frames (kFrameGlob) to animation.mp4 (H.264, even dimensions). Returns a record of
+// the attempt.
 AnimationRecord make_animation(const fs::path& trial_dir, std::size_t frames) {
   AnimationRecord a;
   a.frames = frames;
-  a.frame_pattern = "frames/step_*.png";
+  a.frame_pattern = kFrameGlob;
   const std::string ffmpeg = find_program("ffmpeg");
   if (ffmpeg.empty()) {
     a.status = "no_ffmpeg";
     a.message = "ffmpeg is not installed: the numbered PNG frames are the animation";
     return a;
   }
+  // `-f image2`: ffmpeg picks its image reader from the name only when the name holds *, ? or {, and
+  // kFrameGlob has none of them.
   std::vector<std::string> args = {ffmpeg,
                                    "-y",
                                    "-loglevel",
                                    "error",
                                    "-framerate",
                                    "12",
+                                   "-f",
+                                   "image2",
                                    "-pattern_type",
                                    "glob",
                                    "-i",
-                                   "frames/step_*.png",
+                                   kFrameGlob,
                                    "-vf",
                                    "pad=ceil(iw/2)*2:ceil(ih/2)*2",
                                    "-pix_fmt",
@@ -86,7 +97,9 @@ AnimationRecord make_animation(const fs::path& trial_dir, std::size_t frames) {
   return a;
 }
 
-// A trial's render and its frames' (when it kept a plant snapshot); false when it has none.
+// A trial's render and its frames' (when it kept a plant snapshot); false when it has none. Each render
+// sits beside its snapshot, so the decal images the snapshot names (relative to its directory) are in
+// the directory POV-Ray runs in and reads them from.
 bool add_trial(std::vector<Job>& jobs, const std::string& key, const fs::path& tdir, const std::string& scene_spec,
                const std::vector<std::string>& scene_params, const std::string& leaf_obj) {
   if (!fs::exists(tdir / "plant.gbplant")) return false;

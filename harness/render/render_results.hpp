@@ -20,8 +20,8 @@ struct RenderDirOptions {
 // DIR holds results.json (a suite: renders each trial to trials/ID/render.png, writes grid.png with
 // algorithms as rows and scenes as columns, grid-SCENE.png per scene, and records every render in
 // results.json under "renders" and each trial's "render") or record.json (one run: render.png, recorded
-// in record.json). Frames captured with --frames (frames/step_*.gbplant) become frames/step_*.png and,
-// when ffmpeg is installed, animation.mp4. A failed render is recorded, never fatal; results already
+// in record.json). Frames captured with --frames (frames/step_NNNNNN.gbplant) become frames/step_NNNNNN.png
+// and, when ffmpeg is installed, animation.mp4. A failed render is recorded, never fatal; results already
 // written are kept. Throws InputError when DIR is neither (or its file does not read as one). Returns the
 // "renders" summary.
 RenderSummary render_directory_record(const std::string& dir, const RenderDirOptions& options);

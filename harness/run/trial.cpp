@@ -5,6 +5,7 @@
 #include <unistd.h>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -13,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <stdexcept>
 #include <thread>
 #include <vector>
 
@@ -361,9 +363,24 @@ void load_scene_and_query(const TrialSpec& spec, TrialState& st, PhaseTimer& tim
       spec.scene_params};
 }
 
-// Frame capture (growth animations): OUT/frames/step_NNNNNN.gbplant, its cost measured to be taken out of
-// the growth phase. It takes the algorithm, not its plant: some algorithms build their plant on demand,
-// and that must not happen inside the growth phase unless a frame is kept.
+// The algorithm's own files for `plant` (its plant as it is now), as `request` asks. Each decal's image
+// must be among them: a render of the plant reads it from beside the snapshot that names it.
+std::vector<OutputFile> algorithm_outputs(const GrowthAlgorithm& algo, const Plant& plant,
+                                          const OutputRequest& request) {
+  std::vector<OutputFile> files = algo.write_outputs(request);
+  for (const auto& d : plant.decals) {
+    const std::string want = request.prefix + d.image;
+    if (std::none_of(files.begin(), files.end(), [&](const OutputFile& f) { return f.name == want; }))
+      throw std::logic_error(fmt::format("algorithm '{}' wrote no {} for its decal (write_outputs into {})",
+                                         algo.describe().name, want, request.dir));
+  }
+  return files;
+}
+
+// Frame capture (growth animations): OUT/frames/step_NNNNNN.gbplant, and the files its decals name
+// (step_NNNNNN.IMAGE, from the algorithm's write_outputs), their cost measured to be taken out of the
+// growth phase. It takes the algorithm, not its plant: some algorithms build their plant on demand, and
+// that must not happen inside the growth phase unless a frame is kept.
 struct FrameCapture {
   const TrialSpec& spec;
   int frames = 0, last_frame = -1;
@@ -377,7 +394,11 @@ struct FrameCapture {
       std::filesystem::remove_all(d);
       std::filesystem::create_directories(d);
     }
-    write_plant_snapshot((d / fmt::format("step_{:06d}.gbplant", step)).string(), algo.plant());
+    const Plant& plant = algo.plant();
+    // The frame's prefix keeps its images apart from the other frames' and from the run's own.
+    const std::string prefix = fmt::format("step_{:06d}.", step);
+    algorithm_outputs(algo, plant, {d.string(), prefix, true});
+    write_plant_snapshot((d / (prefix + "gbplant")).string(), plant, prefix);
     ++frames;
     last_frame = step;
     wall_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
@@ -463,6 +484,8 @@ void mesh_export_measure(const TrialSpec& spec, const MesherOptions& mesher, Tri
     rec.output_bytes.ply = write_ply((d / "plant.ply").string(), st.mesh);
     rec.output_bytes.glb = write_glb((d / "plant.glb").string(), st.mesh);
     rec.output_bytes.skeleton_obj = write_skeleton_obj((d / "skeleton.obj").string(), plant);
+    for (const auto& f : algorithm_outputs(*st.algo, plant, {d.string(), "", false}))
+      rec.output_bytes.algorithm_files[f.name] = f.bytes;
   });
   if (spec.metrics) {
     MetricOptions metric_options;

@@ -34,8 +34,9 @@ struct TrialSpec {
   double budget_length_m = 0.0;
   bool metrics = true;  // compute the quality metrics (harness/output/metrics.hpp)
   // Growth animation: every this many steps (and after the last) the plant is written to
-  // OUT/frames/step_NNNNNN.gbplant for `growbench render` (0: no frames). The time this takes is
-  // recorded and taken out of the growth phase's wall and CPU time.
+  // OUT/frames/step_NNNNNN.gbplant for `growbench render`, with the images its decals name as
+  // step_NNNNNN.IMAGE (0: no frames). The time this takes is recorded and taken out of the growth
+  // phase's wall and CPU time.
   int frame_every = 0;
   bool context = true;  // add run_context() to the record (suites record it once instead)
   // Leave the trial's big objects (scene, query, plant, mesh) allocated at the end: for a forked suite

@@ -30,7 +30,7 @@ TEST(Cli, HelpAndLists) {
   EXPECT_EQ(r.status, 0);
   for (const char* s : {"wall", "facade", "column", "corner", "pergola", "boulder", "trunk", "envelope", "mesh:PATH"})
     EXPECT_NE(r.out.find(s), std::string::npos) << s;
-  EXPECT_NE(r.out.find("(cow, spot, stanford-bunny, suzanne, teapot)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("(cow, spot, stanford-bunny, suzanne, teapot, uv-cube)"), std::string::npos) << r.out;
   r = growbench("run -a ivy -s mesh:bunny -o " + test::temp_dir("cli_badmesh").string());
   EXPECT_EQ(r.status, 2) << r.out;
   EXPECT_NE(r.out.find("unknown mesh 'bunny' (did you mean 'stanford-bunny'?)"), std::string::npos) << r.out;

@@ -2,8 +2,10 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -202,6 +204,133 @@ TEST(Exporters, SkeletonHasNodesAndPolylines) {
   ASSERT_EQ(l.size(), 2u);
   EXPECT_EQ(l[0], "l 1 2 3");
   EXPECT_EQ(l[1], "l 2 4");
+}
+
+// y_plant with two decals: one on scene mesh 2's texture coordinates, one planar with axes that are
+// neither unit nor axis-aligned (so a field read into the wrong place shows).
+Plant decal_plant() {
+  Plant p = y_plant();
+  SurfaceDecal uv;
+  uv.image = "texture.png";
+  uv.mesh = 2;
+  SurfaceDecal planar;
+  planar.image = "wall-vines.png";
+  planar.mesh = kPlanarDecal;
+  planar.origin = {-1.5f, 0.25f, 2.0f};
+  planar.u_axis = {3.0f, 0.0f, 0.5f};
+  planar.v_axis = {0.0f, 2.5f, -0.125f};
+  p.decals = {uv, planar};
+  return p;
+}
+
+std::string file_text(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+template <class T>
+void append(std::string& s, const T& v) {
+  s.append(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+
+TEST(PlantSnapshot, DecalsRoundTripWithTheImagePrefix) {
+  const auto dir = test::temp_dir("snapshot_decals");
+  const Plant p = decal_plant();
+  const auto bytes = write_plant_snapshot((dir / "p.gbplant").string(), p);
+  Plant without = p;
+  without.decals.clear();
+  const auto base = write_plant_snapshot((dir / "base.gbplant").string(), without);
+  // The section after the polygons: a count, then per decal its name's length and bytes, mesh, origin
+  // and the two axes.
+  EXPECT_EQ(bytes, base + 8 + (8 + 11 + 4 + 36) + (8 + 14 + 4 + 36));
+  const Plant q = read_plant_snapshot((dir / "p.gbplant").string());
+  EXPECT_EQ(q.geometry_hash(), p.geometry_hash());
+  ASSERT_EQ(q.decals.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(q.decals[i].image, p.decals[i].image);
+    EXPECT_EQ(q.decals[i].mesh, p.decals[i].mesh);
+    EXPECT_EQ(q.decals[i].origin, p.decals[i].origin);
+    EXPECT_EQ(q.decals[i].u_axis, p.decals[i].u_axis);
+    EXPECT_EQ(q.decals[i].v_axis, p.decals[i].v_axis);
+  }
+  // A frame's snapshot names the images written beside it with the frame's prefix; nothing else changes.
+  write_plant_snapshot((dir / "step_000010.gbplant").string(), p, "step_000010.");
+  const Plant f = read_plant_snapshot((dir / "step_000010.gbplant").string());
+  ASSERT_EQ(f.decals.size(), 2u);
+  EXPECT_EQ(f.decals[0].image, "step_000010.texture.png");
+  EXPECT_EQ(f.decals[1].image, "step_000010.wall-vines.png");
+  EXPECT_EQ(f.decals[1].u_axis, p.decals[1].u_axis);
+  EXPECT_EQ(f.geometry_hash(), p.geometry_hash());
+  // A prefix that would make the stored names other than plain file names is refused before writing.
+  EXPECT_THROW(write_plant_snapshot((dir / "bad.gbplant").string(), p, "frames/"), std::invalid_argument);
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad.gbplant"));
+}
+
+TEST(PlantSnapshot, SnapshotsWrittenBeforeDecalsStillRead) {
+  // The layout before decals, byte by byte: the magic, one node, no organs, one triangle.
+  std::string old = "GBPLANT1";
+  append<std::uint64_t>(old, 1);
+  append(old, glm::vec3(0.5f, 1.0f, -2.0f));
+  append(old, 0.25f);
+  append<std::int32_t>(old, kNoParent);
+  append<std::uint16_t>(old, 0);
+  append<std::uint32_t>(old, 7);
+  append<std::uint32_t>(old, 3);
+  append<std::uint64_t>(old, 0);
+  append<std::uint64_t>(old, 1);
+  append<std::uint64_t>(old, 3);
+  for (const glm::vec3 v : {glm::vec3(0, 0, 0), glm::vec3(1, 0, 0), glm::vec3(0, 1, 0)}) append(old, v);
+  const auto dir = test::temp_dir("snapshot_old");
+  test::write_text(dir / "old.gbplant", old);
+  const Plant p = read_plant_snapshot((dir / "old.gbplant").string());
+  ASSERT_EQ(p.nodes.size(), 1u);
+  EXPECT_EQ(p.nodes[0].position, glm::vec3(0.5f, 1.0f, -2.0f));
+  EXPECT_EQ(p.nodes[0].shoot, 7u);
+  EXPECT_EQ(p.nodes[0].birth_step, 3u);
+  ASSERT_EQ(p.polygons.size(), 1u);
+  EXPECT_EQ(p.polygons[0].vertices[2], glm::vec3(0, 1, 0));
+  EXPECT_TRUE(p.decals.empty());
+  // And a plant without decals is written in that layout, so older builds read it too.
+  write_plant_snapshot((dir / "new.gbplant").string(), p);
+  EXPECT_EQ(file_text(dir / "new.gbplant"), old);
+}
+
+TEST(PlantSnapshot, CorruptDecalsAreErrorsNamingTheFile) {
+  const auto dir = test::temp_dir("snapshot_decals_bad");
+  Plant without = decal_plant();
+  without.decals.clear();
+  const std::size_t at = write_plant_snapshot((dir / "base.gbplant").string(), without);  // the decal section
+  write_plant_snapshot((dir / "p.gbplant").string(), decal_plant());
+  const std::string good = file_text(dir / "p.gbplant");
+  auto error_with = [&](const std::string& name, const std::string& data) {
+    test::write_text(dir / name, data);
+    return test::error_of([&] { read_plant_snapshot((dir / name).string()); });
+  };
+  // A count, or a name's length, larger than the rest of the file: refused before anything is allocated.
+  std::string data = good;
+  const std::uint64_t huge = std::uint64_t{1} << 60;
+  std::memcpy(data.data() + at, &huge, 8);
+  std::string e = error_with("count.gbplant", data);
+  EXPECT_NE(e.find("count.gbplant: plant snapshot count"), std::string::npos) << e;
+  EXPECT_NE(e.find("exceeds the file"), std::string::npos) << e;
+  data = good;
+  std::memcpy(data.data() + at + 8, &huge, 8);
+  e = error_with("length.gbplant", data);
+  EXPECT_NE(e.find("length.gbplant: plant snapshot count"), std::string::npos) << e;
+  // Cut inside the second decal.
+  e = error_with("cut.gbplant", good.substr(0, good.size() - 20));
+  EXPECT_NE(e.find("cut.gbplant: plant snapshot cut short"), std::string::npos) << e;
+  // A name that is not a plain file name: the plant's own check, through the reader.
+  data = good;
+  data[at + 8 + 8 + 4] = '/';  // "text/re.png"
+  e = error_with("name.gbplant", data);
+  EXPECT_NE(e.find("name.gbplant: plant snapshot holds an invalid plant: decal 0 has image name"), std::string::npos)
+      << e;
+  // Bytes after the decals.
+  e = error_with("trailing.gbplant", good + "x");
+  EXPECT_NE(e.find("trailing.gbplant: plant snapshot has trailing bytes"), std::string::npos) << e;
 }
 
 TEST(Exporters, UnwritableDirectoryIsAClearError) {

@@ -109,6 +109,39 @@ TEST(Record, PartialFilesReadWithDefaults) {
   EXPECT_EQ(r.mode, "timing");
 }
 
+TEST(Record, AlgorithmFilesRoundTripAndAreLeftOutWhenNone) {
+  const auto dir = test::temp_dir("record_algorithm_files");
+  TrialRecord rec;
+  rec.output_bytes.obj = 100;
+  rec.output_bytes.algorithm_files = {{"texture.png", 5000000000u}, {"skeleton.svg", 7}};
+  const json j = to_json(rec);
+  EXPECT_EQ(j["output_bytes"]["algorithm_files"], json({{"skeleton.svg", 7}, {"texture.png", 5000000000u}}));
+  // Read back from a record file, as `growbench render` and the suite read them.
+  const TrialRecord back = read_trial_record(test::write_text(dir / "record.json", j.dump()));
+  EXPECT_EQ(back.output_bytes.algorithm_files, rec.output_bytes.algorithm_files);
+  EXPECT_EQ(back.output_bytes.obj, 100u);
+  // A suite cell carries them in its results.
+  ResultsFile r = small_results();
+  r.trials[0].results.output_bytes = rec.output_bytes;
+  const json rj = to_json(r);
+  EXPECT_EQ(rj["trials"][0]["output_bytes"]["algorithm_files"]["texture.png"], 5000000000u);
+  EXPECT_EQ(to_json(from_json<ResultsFile>(rj, "results.json")), rj);
+  // An algorithm that writes no files of its own leaves the key out, as records before it did.
+  rec.output_bytes.algorithm_files.clear();
+  EXPECT_FALSE(to_json(rec)["output_bytes"].contains("algorithm_files"));
+  // A size that is not a byte count is an error at its path.
+  json bad = j;
+  bad["output_bytes"]["algorithm_files"]["texture.png"] = "5 GB";
+  try {
+    (void)from_json<TrialRecord>(bad, "record.json");
+    FAIL() << "a size as a string was read";
+  } catch (const InputError& e) {
+    EXPECT_EQ(
+        std::string(e.what()),
+        "record.json: at output_bytes.algorithm_files.texture.png: expected a non-negative integer, got \"5 GB\"");
+  }
+}
+
 TEST(Record, PhasesInTheOrderTheJsonHoldsThem) {
   Phases p;
   p.scene_load = PhaseMeasures{};

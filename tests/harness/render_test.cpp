@@ -6,6 +6,7 @@
 #include <regex>
 #include <sstream>
 
+#include <cairo.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <stb_image.h>
@@ -108,6 +109,101 @@ std::size_t count_of(const std::string& text, const std::string& what) {
   return n;
 }
 
+// A 64 x 64 decal image written with cairo: its top-left quadrant opaque red (u < 0.5 and v > 0.5, the
+// image's top row being v = 1), the rest fully transparent.
+void write_decal_png(const std::filesystem::path& path) {
+  cairo_surface_t* surface = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, 64, 64);  // starts transparent
+  cairo_t* c = cairo_create(surface);
+  cairo_set_source_rgba(c, 1, 0, 0, 1);
+  cairo_rectangle(c, 0, 0, 32, 32);
+  cairo_fill(c);
+  cairo_destroy(c);
+  EXPECT_EQ(cairo_surface_write_to_png(surface, path.c_str()), CAIRO_STATUS_SUCCESS) << path;
+  cairo_surface_destroy(surface);
+}
+
+// Where point p appears in a w x h render from `camera`, as the writer sets POV-Ray's camera up (vertical
+// field of view, square pixels, the image not mirrored): (column, row).
+glm::ivec2 pixel_of(const Camera& camera, int w, int h, const glm::vec3& p) {
+  const glm::vec3 f = glm::normalize(camera.look_at - camera.position);
+  const glm::vec3 r = glm::normalize(glm::cross(f, glm::vec3(0, 1, 0)));
+  const glm::vec3 u = glm::cross(r, f);
+  const glm::vec3 d = p - camera.position;
+  const float t = std::tan(0.5f * glm::radians(camera.fov_deg));
+  const float x = glm::dot(d, r) / glm::dot(d, f) / (t * static_cast<float>(w) / static_cast<float>(h));
+  const float y = glm::dot(d, u) / glm::dot(d, f) / t;
+  return {static_cast<int>(0.5f * (x + 1.0f) * static_cast<float>(w)),
+          static_cast<int>(0.5f * (1.0f - y) * static_cast<float>(h))};
+}
+
+glm::ivec3 rgb_at(const Image& im, const glm::ivec2& px) {
+  if (px.x < 0 || px.y < 0 || px.x >= im.w || px.y >= im.h) {
+    ADD_FAILURE() << "pixel (" << px.x << ", " << px.y << ") is outside the image";
+    return glm::ivec3(-1000);
+  }
+  const std::size_t i = 3 * (static_cast<std::size_t>(px.y) * static_cast<std::size_t>(im.w) + px.x);
+  return {im.rgb[i], im.rgb[i + 1], im.rgb[i + 2]};
+}
+
+bool is_red(const glm::ivec3& c) {
+  return c.r > 100 && c.g < 40 && c.b < 40;
+}
+
+int max_difference(const glm::ivec3& a, const glm::ivec3& b) {
+  const glm::ivec3 d = glm::abs(a - b);
+  return std::max({d.r, d.g, d.b});
+}
+
+std::string show(const glm::ivec3& c) {
+  return "(" + std::to_string(c.r) + ", " + std::to_string(c.g) + ", " + std::to_string(c.b) + ")";
+}
+
+// A quad 2 m wide and 2 m high in the plane z = 0, facing the camera, its texture coordinates mirrored
+// left to right (u = 1 at x = -1): an image lands where only the coordinates put it.
+Scene uv_quad_scene() {
+  TriangleMesh quad;
+  quad.name = "quad";
+  quad.vertices = {{-1, 0, 0}, {1, 0, 0}, {1, 2, 0}, {-1, 2, 0}};
+  quad.triangles = {{0, 1, 2}, {0, 2, 3}};
+  quad.uvs = {{1, 0}, {0, 0}, {0, 1}, {1, 1}};
+  quad.uv_triangles = quad.triangles;
+  Scene s = test::scene_with(quad);
+  s.name = "quad";
+  s.camera = {{0.0f, 1.0f, 4.0f}, {0.0f, 1.0f, 0.0f}, 45.0f};
+  return s;
+}
+
+// A climbable wall whose face is the plane z = -0.5 and, in front of it, a post that is not climbable.
+Scene planar_scene() {
+  Scene s = test::scene_with(geom::make_box("wall", {-2.0f, 0.0f, -1.5f}, {2.0f, 2.0f, -0.5f}));
+  TriangleMesh post = geom::make_box("post", {-0.5f, 1.2f, -0.4f}, {-0.1f, 1.8f, 0.0f});
+  post.climbable = false;
+  s.meshes.push_back(post);
+  s.name = "planar";
+  s.camera = {{0.0f, 1.0f, 4.0f}, {0.0f, 1.0f, 0.0f}, 45.0f};
+  return s;
+}
+
+// A planar decal tilted out of the wall's plane (u_axis leans along z), so its projection onto the wall
+// depends on z being carried into POV-Ray's coordinates: on the face z = -0.5, image u = (x + 0.75) / 2.5
+// and v = y / 2.
+SurfaceDecal tilted_planar_decal(const std::string& image) {
+  SurfaceDecal d;
+  d.image = image;
+  d.mesh = kPlanarDecal;
+  d.origin = {-1.0f, 0.0f, 0.0f};
+  d.u_axis = {2.0f, 0.0f, 1.0f};
+  d.v_axis = {0.0f, 2.0f, 0.0f};
+  return d;
+}
+
+SurfaceDecal uv_decal(const std::string& image, std::int32_t mesh) {
+  SurfaceDecal d;
+  d.image = image;
+  d.mesh = mesh;
+  return d;
+}
+
 TEST(PlantSnapshot, RoundTripsBitForBit) {
   const auto dir = test::temp_dir("snapshot");
   const Plant p = tiny_plant();
@@ -170,6 +266,148 @@ TEST(PovWriter, WritesEveryPartInPovRayHandedness) {
   EXPECT_NE(
       test::error_of([&] { write_pov((dir / "x.pov").string(), tiny_scene(), p, o); }).find("expected cones or mesh"),
       std::string::npos);
+}
+
+TEST(PovWriter, APlantWithDecalsIsDrawnByThem) {
+  const auto dir = test::temp_dir("pov_decals");
+  Scene scene = uv_quad_scene();
+  TriangleMesh ground = geom::make_box("ground", {-3.0f, -0.1f, -3.0f}, {3.0f, 0.0f, 3.0f});
+  ground.climbable = false;
+  scene.meshes.push_back(ground);
+  Plant p = tiny_plant();
+  p.decals = {uv_decal("a.png", 0), tilted_planar_decal("b.png")};
+  p.decals[1].origin.z = 0.5f;
+  RenderOptions o;
+  write_pov((dir / "d.pov").string(), scene, p, o);
+  const std::string pov = read_file(dir / "d.pov");
+  // The plant's branches, organs and polygons are left out: the decals stand for it.
+  EXPECT_EQ(count_of(pov, "cone {"), 0u);
+  EXPECT_EQ(count_of(pov, "\n  sphere {"), 0u);
+  EXPECT_EQ(count_of(pov, "GB_OrganShape"), 0u);
+  EXPECT_EQ(count_of(pov, "// polygons"), 0u);
+  // The quad carries its texture coordinates, in its own corner order.
+  EXPECT_EQ(count_of(pov, "uv_vectors { 4,\n    <1,0>, <0,0>, <0,1>, <1,1>"), 1u) << pov;
+  EXPECT_EQ(count_of(pov, "uv_indices { 2,\n    <0,1,2>, <0,2,3>"), 1u);
+  // Two layers on the quad (its decal and the planar one), none on the ground, which is not climbable;
+  // the surface's own texture at the bottom, then the layers in the plant's order.
+  EXPECT_EQ(count_of(pov, "image_map"), 2u);
+  const auto surface = pov.find("texture { GB_Surface }"), a = pov.find("png \"a.png\""), b = pov.find("png \"b.png\"");
+  ASSERT_NE(b, std::string::npos);
+  EXPECT_LT(surface, a);
+  EXPECT_LT(a, b);
+  EXPECT_NE(pov.find("pigment { uv_mapping image_map { png \"a.png\" once interpolate 2 } }"), std::string::npos);
+  // The planar matrix in POV-Ray's coordinates: rows u_axis, v_axis, the normal and the origin, z negated.
+  EXPECT_NE(pov.find("matrix <2,0,-1, 0,2,0, -0.447"), std::string::npos) << pov;
+  EXPECT_NE(pov.find(", -1,0,-0.5>"), std::string::npos);
+  // Without the plant the scene is as it always was: no layers, no texture coordinates.
+  o.draw_plant = false;
+  write_pov((dir / "bare.pov").string(), scene, p, o);
+  const std::string bare = read_file(dir / "bare.pov");
+  EXPECT_EQ(count_of(bare, "image_map"), 0u);
+  EXPECT_EQ(count_of(bare, "uv_vectors"), 0u);
+}
+
+TEST(PovRender, UvDecalFollowsTheMeshTextureCoordinates) {
+  ASSERT_FALSE(find_povray().empty()) << "povray is not installed (scripts/install-deps installs it)";
+  const auto dir = test::temp_dir("decal_uv");
+  write_decal_png(dir / "vine.png");
+  const Scene scene = uv_quad_scene();
+  Plant plant = tiny_plant();  // its stem stands in front of the quad, and must not be drawn
+  plant.decals = {uv_decal("vine.png", 0)};
+  RenderOptions o;
+  o.width = 160;
+  o.height = 120;
+  const RenderResult with = render_plant(scene, plant, (dir / "with.pov").string(), (dir / "with.png").string(), o);
+  ASSERT_TRUE(with.ok()) << with.message;
+  EXPECT_TRUE(with.warnings.empty()) << with.warnings.front();
+  o.draw_plant = false;
+  const RenderResult bare = render_plant(scene, plant, (dir / "bare.pov").string(), (dir / "bare.png").string(), o);
+  ASSERT_TRUE(bare.ok()) << bare.message;
+  const Image a = load_png(with.png), b = load_png(bare.png);
+  auto at = [&](const Image& im, const glm::vec3& p) {
+    return rgb_at(im, pixel_of(scene.camera, o.width, o.height, p));
+  };
+  // The image's red top-left quadrant lands where the mirrored coordinates put it: the quad's top right.
+  const glm::vec3 red_spot(0.5f, 1.5f, 0.0f);
+  EXPECT_TRUE(is_red(at(a, red_spot))) << show(at(a, red_spot));
+  EXPECT_FALSE(is_red(at(b, red_spot))) << show(at(b, red_spot));
+  // Where the image is transparent the surface shows as it does without the decal: the top left (a
+  // projection ignoring the coordinates would put the red there) and the bottom (v flipped would).
+  for (const glm::vec3 p : {glm::vec3(-0.5f, 1.5f, 0.0f), glm::vec3(0.5f, 0.5f, 0.0f), glm::vec3(-0.5f, 0.5f, 0.0f)})
+    EXPECT_LE(max_difference(at(a, p), at(b, p)), 12) << show(at(a, p)) << " against " << show(at(b, p));
+  // The stem is not drawn over it.
+  const glm::vec3 stem(0.0f, 0.5f, 0.2f);
+  EXPECT_LE(max_difference(at(a, stem), at(b, stem)), 12) << show(at(a, stem)) << " against " << show(at(b, stem));
+}
+
+TEST(PovRender, PlanarDecalIsProjectedOntoTheClimbableMeshes) {
+  ASSERT_FALSE(find_povray().empty()) << "povray is not installed (scripts/install-deps installs it)";
+  const auto dir = test::temp_dir("decal_planar");
+  write_decal_png(dir / "vine.png");
+  const Scene scene = planar_scene();
+  Plant plant;
+  plant.decals = {tilted_planar_decal("vine.png")};
+  RenderOptions o;
+  o.width = 160;
+  o.height = 120;
+  const RenderResult with = render_plant(scene, plant, (dir / "with.pov").string(), (dir / "with.png").string(), o);
+  ASSERT_TRUE(with.ok()) << with.message;
+  EXPECT_TRUE(with.warnings.empty()) << with.warnings.front();
+  o.draw_plant = false;
+  const RenderResult bare = render_plant(scene, plant, (dir / "bare.pov").string(), (dir / "bare.png").string(), o);
+  ASSERT_TRUE(bare.ok()) << bare.message;
+  const Image a = load_png(with.png), b = load_png(bare.png);
+  auto at = [&](const Image& im, const glm::vec3& p) {
+    return rgb_at(im, pixel_of(scene.camera, o.width, o.height, p));
+  };
+  // On the wall's face, u = (x + 0.75) / 2.5 and v = y / 2: x = 0.25 is u = 0.4, in the red quadrant.
+  const glm::vec3 red_spot(0.25f, 1.5f, -0.5f);
+  EXPECT_TRUE(is_red(at(a, red_spot))) << show(at(a, red_spot));
+  EXPECT_FALSE(is_red(at(b, red_spot))) << show(at(b, red_spot));
+  // The surface shows at u = -0.1 (outside the image; with z mirrored it would be u = 0.1, red), at
+  // u = 0.7 and at v = 0.25 (the transparent parts), and on the post, which is not climbable (were it
+  // painted, u = 0.28 and v = 0.75 there: red).
+  for (const glm::vec3 p : {glm::vec3(-1.0f, 1.5f, -0.5f), glm::vec3(1.0f, 1.5f, -0.5f), glm::vec3(0.25f, 0.5f, -0.5f),
+                            glm::vec3(-0.3f, 1.5f, 0.0f)})
+    EXPECT_LE(max_difference(at(a, p), at(b, p)), 12) << show(at(a, p)) << " against " << show(at(b, p));
+}
+
+TEST(PovRender, DecalsThatCannotBeDrawnFailTheRenderWithTheReason) {
+  const auto dir = test::temp_dir("decal_fail");
+  Plant p = tiny_plant();
+  p.decals = {uv_decal("vine.png", 0)};
+  RenderOptions o;
+  o.width = 32;
+  o.height = 24;
+  // The image is not beside the render: recorded as failed, naming the file, without running POV-Ray
+  // (and an earlier render's image is not left to pass for this one's).
+  test::write_text(dir / "a.png", "an earlier render");
+  RenderResult r = render_plant(uv_quad_scene(), p, (dir / "a.pov").string(), (dir / "a.png").string(), o);
+  EXPECT_EQ(r.status, "failed");
+  EXPECT_NE(r.message.find((dir / "vine.png").string() + " is missing"), std::string::npos) << r.message;
+  EXPECT_FALSE(std::filesystem::exists(dir / "a.png"));
+  // The image is there, but the scene's mesh has no texture coordinates (tiny_scene's wall).
+  write_decal_png(dir / "vine.png");
+  r = render_plant(tiny_scene(), p, (dir / "b.pov").string(), (dir / "b.png").string(), o);
+  EXPECT_EQ(r.status, "failed");
+  EXPECT_NE(r.message.find("decal 0 (vine.png) follows the texture coordinates of mesh 0 ('wall'), which has none"),
+            std::string::npos)
+      << r.message;
+  EXPECT_NE(test::error_of([&] { write_pov((dir / "c.pov").string(), tiny_scene(), p, o); }).find("which has none"),
+            std::string::npos);
+  // A mesh the scene does not have, and a planar decal whose axes span no plane.
+  p.decals[0].mesh = 3;
+  EXPECT_NE(decal_problem(tiny_scene(), p).find("is on mesh 3, but scene 'tiny' has 1 meshes"), std::string::npos);
+  p.decals[0] = tilted_planar_decal("vine.png");
+  p.decals[0].v_axis = 2.0f * p.decals[0].u_axis;
+  EXPECT_NE(decal_problem(tiny_scene(), p).find("span no plane"), std::string::npos);
+  // Drawn without the plant, its decals are not drawn either, and nothing they name is needed.
+  p.decals[0].image = "gone.png";
+  o.draw_plant = false;
+  if (!find_povray().empty()) {
+    r = render_plant(tiny_scene(), p, (dir / "d.pov").string(), (dir / "d.png").string(), o);
+    EXPECT_TRUE(r.ok()) << r.message;
+  }
 }
 
 TEST(PovRender, TinySceneRendersWithThePlantInFrameAndNoWarnings) {
@@ -273,6 +511,55 @@ TEST(RenderCli, RunRendersThePlantAndItsGrowthFrames) {
   const auto bad = test::run_growbench("render " + test::temp_dir("cli_render_empty").string());
   EXPECT_EQ(bad.status, 2);
   EXPECT_NE(bad.out.find("neither a suite results directory"), std::string::npos) << bad.out;
+}
+
+TEST(RenderCli, DecalImagesAreReadBesideTheirSnapshotsAndAreNotAnimationFrames) {
+  const auto dir = test::temp_dir("cli_render_decals");
+  const auto run = test::run_growbench(
+      "run -q -a spacecol -s wall --set point_count=300 --max-steps 20 --frames 10 -o " + dir.string());
+  ASSERT_EQ(run.status, 0) << run.out;
+  // Decals on the plant and its frames, as an algorithm that paints them leaves them: the run's image
+  // beside plant.gbplant, each frame's as step_NNNNNN.IMAGE beside its snapshot.
+  SurfaceDecal d = tilted_planar_decal("vine.png");
+  Plant plant = read_plant_snapshot((dir / "plant.gbplant").string());
+  plant.decals = {d};
+  write_plant_snapshot((dir / "plant.gbplant").string(), plant);
+  write_decal_png(dir / "vine.png");
+  std::size_t frames = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir / "frames")) {
+    if (e.path().extension() != ".gbplant") continue;
+    const std::string prefix = e.path().stem().string() + ".";
+    Plant f = read_plant_snapshot(e.path().string());
+    f.decals = {d};
+    write_plant_snapshot(e.path().string(), f, prefix);
+    write_decal_png(dir / "frames" / (prefix + "vine.png"));
+    ++frames;
+  }
+  ASSERT_GE(frames, 2u);
+  RenderDirOptions ro;
+  ro.render.width = 64;
+  ro.render.height = 48;
+  ro.quiet = true;
+  const RenderSummary summary = render_directory_record(dir.string(), ro);
+  EXPECT_EQ(summary.failed, 0u);
+  EXPECT_EQ(summary.ok, frames + 1);
+  EXPECT_EQ(summary.warnings, 0u);
+  EXPECT_NE(read_file(dir / "frames" / "step_000010.pov").find("png \"step_000010.vine.png\""), std::string::npos);
+  EXPECT_NE(read_file(dir / "render.pov").find("png \"vine.png\""), std::string::npos);
+  std::ifstream in(dir / "record.json");
+  const auto rec = nlohmann::json::parse(in);
+  EXPECT_EQ(rec["render"]["status"], "ok") << rec["render"].dump();
+  if (std::system("command -v ffmpeg > /dev/null && command -v ffprobe > /dev/null") != 0) return;
+  // The animation is made of the rendered frames alone, not of the decal images beside them.
+  EXPECT_EQ(rec["animation"]["status"], "ok") << rec["animation"].dump();
+  EXPECT_EQ(rec["animation"]["frames"], frames);
+  const std::string probe = (dir / "probe.txt").string();
+  ASSERT_EQ(std::system(("ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames,width "
+                         "-of csv=p=0 " +
+                         (dir / "animation.mp4").string() + " > " + probe)
+                            .c_str()),
+            0);
+  EXPECT_EQ(read_file(probe), "64," + std::to_string(frames) + "\n");
 }
 
 }  // namespace

@@ -64,6 +64,18 @@ out = run(growbench, "run", "-q", "-a", "spacecol", "-s", "wall", "--set", "poin
 check(out.returncode == 0, f"growbench run: {out.stdout}{out.stderr}")
 run_record = json.load(open(os.path.join(work, "run", "record.json")))
 check(errors(run_record, "trial_record") == [], f"growbench run's record.json validates: {errors(run_record, 'trial_record')[:5]}")
+# No built-in algorithm writes files of its own yet: the record of one that does, by hand. Sizes by file
+# name validate; a size that is not a count, or the object written empty (the writer leaves it out), do not.
+with_files = copy.deepcopy(run_record)
+with_files["output_bytes"]["algorithm_files"] = {"texture.png": 123456, "skeleton.svg": 789}
+check(errors(with_files, "trial_record") == [], f"algorithm_files validates: {errors(with_files, 'trial_record')[:5]}")
+bad_files = copy.deepcopy(with_files)
+bad_files["output_bytes"]["algorithm_files"]["texture.png"] = "big"
+check(any(e.startswith("output_bytes/algorithm_files/texture.png:") for e in errors(bad_files, "trial_record")),
+      f"a size that is not a count fails: {errors(bad_files, 'trial_record')[:3]}")
+bad_files["output_bytes"]["algorithm_files"] = {}
+check(any(e.startswith("output_bytes/algorithm_files:") for e in errors(bad_files, "trial_record")),
+      "an empty algorithm_files fails (it is left out when there are none)")
 baseline = json.load(open(os.path.join(ROOT, "reports", "baselines", "quick.json")))
 check(errors(baseline, "baseline") == [], f"the committed baseline validates: {errors(baseline, 'baseline')[:5]}")
 

@@ -77,7 +77,8 @@ TEST(MeshScene, FittedToStandardSizeOnAGroundWithSeedAtTheFootOfItsLitSide) {
 }
 
 TEST(MeshScene, BundledMeshesByNameAreTheRepositorysFiles) {
-  EXPECT_EQ(bundled_meshes(), (std::vector<std::string>{"cow", "spot", "stanford-bunny", "suzanne", "teapot"}));
+  EXPECT_EQ(bundled_meshes(),
+            (std::vector<std::string>{"cow", "spot", "stanford-bunny", "suzanne", "teapot", "uv-cube"}));
   const std::string file = std::string(GROWBENCH_SOURCE_DIR) + "/scenes/meshes/suzanne.obj";
   EXPECT_EQ(mesh_path("suzanne"), file);
   EXPECT_EQ(mesh_path("./suzanne"), "./suzanne");  // a path stays a path
