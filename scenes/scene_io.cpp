@@ -100,7 +100,7 @@ TriangleMesh load_obj(const std::string& path) {
         }
         if (t.x != t.y && t.y != t.z && t.x != t.z) {
           m.triangles.push_back(t);
-          m.uv_triangles.push_back(tt);
+          if (every_face_uv) m.uv_triangles.push_back(tt);  // nothing to keep for a mesh without them
         }
       }
       offset += fv;

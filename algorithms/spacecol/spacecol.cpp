@@ -23,6 +23,7 @@
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
 
+#include "algorithms/colonization.hpp"
 #include "core/kdtree.hpp"
 #include "core/random.hpp"
 
@@ -116,10 +117,7 @@ CollectWithin<Keep> collect_within(float r2, std::vector<std::pair<std::uint32_t
   return CollectWithin<Keep>{r2, &out, keep};
 }
 
-glm::vec3 safe_normalize(const glm::vec3& v, const glm::vec3& fallback) {
-  const float len = glm::length(v);
-  return len > 1e-20f ? v / len : fallback;
-}
+using colonization::safe_normalize;
 
 using spacecol::Leaves;
 using spacecol::Points;
@@ -202,22 +200,7 @@ class SpaceColonization final : public PortableGrowthAlgorithm {
  private:
   // ---------- attraction points ----------
   bool accept_point(const glm::vec3& q) const {
-    bool include_ok = true, any_include = false;
-    for (const auto& z : scene_->zones) {
-      if (z.kind == Zone::Kind::Include) {
-        any_include = true;
-        include_ok = false;
-      }
-    }
-    for (std::size_t zi = 0; zi < scene_->zones.size(); ++zi) {
-      const Zone& z = scene_->zones[zi];
-      const bool in = query_->inside_shape(static_cast<int>(zi), q);
-      if (in && (z.kind == Zone::Kind::Exclude || z.kind == Zone::Kind::Repel)) return false;
-      if (in && z.kind == Zone::Kind::Include) include_ok = true;
-    }
-    if (any_include && !include_ok) return false;
-    if (query_->inside(q)) return false;  // never inside a solid
-    return true;
+    return colonization::zones_allow(*scene_, *query_, q) && !query_->inside(q);  // never inside a solid
   }
 
   // Fills pts_ with `count` accepted candidates, generated in parallel in index order.

@@ -33,6 +33,7 @@
 #include <stb_image.h>
 #include <tbb/parallel_for.h>
 
+#include "algorithms/colonization.hpp"
 #include "algorithms/vines/grid.hpp"
 #include "algorithms/vines/mask.hpp"
 #include "algorithms/vines/surface.hpp"
@@ -146,10 +147,7 @@ constexpr std::uint64_t kStreamAttractor = 0xA77Aull, kStreamRoot = 0x2007ull, k
                         kStreamKills = 0x4111ull;
 constexpr float kStallFraction = 0.2f;  // a child this close (times the step) to a sibling repeats it
 
-glm::vec3 safe_normalize(const glm::vec3& v) {
-  const float l = glm::length(v);
-  return l > 1e-20f ? v / l : glm::vec3(0.0f);
-}
+using colonization::safe_normalize;
 
 // The unit square laid on a scene's main climbable face: the climbable meshes' extent as the camera
 // sees it, in the plane facing the camera at their front, above any ground.
@@ -383,20 +381,6 @@ class Vines final : public GrowthAlgorithm {
     return at.position;
   }
 
-  bool zones_allow(const glm::vec3& q) const {
-    bool any_include = false, included = false;
-    for (std::size_t zi = 0; zi < scene_->zones.size(); ++zi) {
-      const Zone& z = scene_->zones[zi];
-      const bool in = query_->inside_shape(z.shape, q);
-      if (z.kind == Zone::Kind::Include) {
-        any_include = true;
-        included = included || in;
-      }
-      if (in && (z.kind == Zone::Kind::Exclude || z.kind == Zone::Kind::Repel)) return false;
-    }
-    return !any_include || included;
-  }
-
   // Whether an attractor may rest at a UV point: on the surface (and, for a canvas, over a climbable
   // mesh), where the mask allows, outside exclusion zones.
   std::optional<Location> attractor_site(const glm::vec2& uv, double chance, const vines::Mask* mask) const {
@@ -408,7 +392,7 @@ class Vines final : public GrowthAlgorithm {
     if (chance >= cfg_.density * weight) return std::nullopt;
     if (mask && mask->zone(uv) != cfg_.mask_include) return std::nullopt;
     const Placed at = place(*l);
-    if (!at.on_scene || !zones_allow(at.position)) return std::nullopt;
+    if (!at.on_scene || !colonization::zones_allow(*scene_, query_->host_queries(), at.position)) return std::nullopt;
     return l;
   }
 
