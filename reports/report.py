@@ -491,8 +491,10 @@ def sweep_figures(good, labels, colours, markers, plt, np, save):
     for key in swept_numbers(good):
         fig, ax = plt.subplots(figsize=(6.4, 4.4))
         spans = []
+        scenes = ordered(c.scene for c in good)
         for i, label in enumerate(labels):
             for scene in ordered(c.scene for c in good if c.label == label):
+                j = scenes.index(scene)  # the scene picks the marker and dash, the entry the colour
                 # Per value: the lowest seed's cell (several seeds would zigzag one line).
                 by_value = {}
                 for c in good:
@@ -507,8 +509,8 @@ def sweep_figures(good, labels, colours, markers, plt, np, save):
                 med = np.array([c.growth_median() for c in pts])
                 lo = med - np.array([c.growth_summary["lo"] if c.growth_summary else m for c, m in zip(pts, med)])
                 hi = np.array([c.growth_summary["hi"] if c.growth_summary else m for c, m in zip(pts, med)]) - med
-                ax.errorbar(x, med, yerr=[lo, hi], fmt="-" + markers[i % len(markers)], color=colours[label], ms=4,
-                            capsize=2, lw=1, label=f"{label} on {scene}")
+                ax.errorbar(x, med, yerr=[lo, hi], fmt=markers[j % len(markers)], ls=["-", "--", ":", "-."][j % 4],
+                            color=colours[label], ms=4, capsize=2, lw=1, label=f"{label} on {scene}")
                 spans.append(x.max() / max(x.min(), 1e-300))
         if not spans:
             plt.close(fig)
