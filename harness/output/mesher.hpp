@@ -25,6 +25,9 @@ struct OutputMesh {
   std::vector<glm::vec3> normals;
   std::vector<glm::uvec3> triangles;
   std::vector<MeshGroup> groups;
+  // Linear RGB per vertex: empty when nothing in the plant is coloured, else one per position (organ
+  // petal colours with their jitter, the L-system's a("Cd", r, g, b)); exporters write them when present.
+  std::vector<glm::vec3> colors;
 };
 
 struct MesherOptions {
