@@ -1,5 +1,6 @@
 #include "algorithms/plant.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -83,6 +84,21 @@ std::string Plant::geometry_hash() const {
     put(o.node);
     put(o.stamp);
   }
+  // Shapes and tints enter only when some organ has them, so plants without stay as they hashed before.
+  const bool styled = !organ_shapes.empty() || std::any_of(organs.begin(), organs.end(), [](const Organ& o) {
+    return o.shape != kKindShape || o.tint != glm::vec3(1.0f);
+  });
+  if (styled) {
+    put(organ_shapes.size());
+    for (const auto& name : organ_shapes) {
+      put(name.size());
+      bytes(name.data(), name.size());
+    }
+    for (const auto& o : organs) {
+      put(o.shape);
+      put(o.tint);
+    }
+  }
   put(polygons.size());
   for (const auto& p : polygons) {
     put(p.vertices.size());
@@ -116,7 +132,16 @@ std::string Plant::validate() const {
       return fmt::format("organ {} has a non-finite position or a bad size", i);
     if (o.node != kNoParent && (o.node < 0 || static_cast<std::size_t>(o.node) >= nodes.size()))
       return fmt::format("organ {} refers to node {} of {}", i, o.node, nodes.size());
+    if (o.shape != kKindShape && o.shape >= organ_shapes.size())
+      return fmt::format("organ {} has shape {} of {}", i, o.shape, organ_shapes.size());
+    if (!finite(o.tint) || glm::any(glm::lessThan(o.tint, glm::vec3(0.0f))) ||
+        glm::any(glm::greaterThan(o.tint, glm::vec3(4.0f))))
+      return fmt::format("organ {} has tint ({}, {}, {}) outside [0, 4]", i, o.tint.x, o.tint.y, o.tint.z);
   }
+  if (organ_shapes.size() >= kKindShape)
+    return fmt::format("{} organ shapes (at most {})", organ_shapes.size(), kKindShape - 1);
+  for (std::size_t i = 0; i < organ_shapes.size(); ++i)
+    if (organ_shapes[i].empty()) return fmt::format("organ shape {} has no name", i);
   for (std::size_t i = 0; i < decals.size(); ++i) {
     const auto& d = decals[i];
     // A plain file name: renders hand it to POV-Ray, which reads only below its working directory.

@@ -26,6 +26,9 @@ struct PlantNode {
 enum class OrganKind : std::uint8_t { Leaf, YoungLeaf, Flower, Bud };
 const char* to_string(OrganKind k);
 
+// Organ::shape when the organ takes its kind's default shape (algorithms/organ_shapes.hpp).
+constexpr std::uint16_t kKindShape = 0xFFFF;
+
 // A leaf or flower. Local frame: +Z along the blade (from the stalk to the tip), +Y the upper-side
 // normal, +X across; `size` is the blade length.
 struct Organ {
@@ -33,8 +36,10 @@ struct Organ {
   glm::quat orientation{1.0f, 0.0f, 0.0f, 0.0f};
   float size = 0.0f;
   OrganKind kind = OrganKind::Leaf;
-  std::int32_t node = kNoParent;  // the node it grows from (or kNoParent)
-  std::array<float, 3> stamp{};   // user values carried to the instanced geometry (L-system J/K/M a, b, c)
+  std::int32_t node = kNoParent;     // the node it grows from (or kNoParent)
+  std::array<float, 3> stamp{};      // user values carried to the instanced geometry (L-system J/K/M a, b, c)
+  std::uint16_t shape = kKindShape;  // index into Plant::organ_shapes, or kKindShape
+  glm::vec3 tint{1.0f};              // factor on its shape's colour (colour jitter), each in [0, 4]
 };
 
 // A planar polygon (L-system { . } blocks).
@@ -67,6 +72,9 @@ struct Plant {
   std::vector<Organ> organs;
   std::vector<PlantPolygon> polygons;
   std::vector<SurfaceDecal> decals;
+  // The shapes organs name by Organ::shape: a built-in shape's name or an OBJ file's path
+  // (algorithms/organ_shapes.hpp resolves them). Empty when every organ takes its kind's shape.
+  std::vector<std::string> organ_shapes;
   // Optional per-node data, empty unless an algorithm fills it (one entry per node when present):
   std::vector<std::int32_t> node_groups;  // group number (-1: none); L-system g
   std::vector<NodeAttribute> node_attributes;
@@ -76,6 +84,7 @@ struct Plant {
     organs.clear();
     polygons.clear();
     decals.clear();
+    organ_shapes.clear();
     node_groups.clear();
     node_attributes.clear();
   }

@@ -22,6 +22,7 @@
 #include <stb_image.h>
 
 #include "algorithms/lsystem/derive.hpp"
+#include "algorithms/organ_shapes.hpp"
 #include "algorithms/lsystem/grammar.hpp"
 #include "algorithms/lsystem/turtle.hpp"
 #include "core/data_path.hpp"
@@ -98,6 +99,14 @@ const AlgorithmInfo kInfo = {
                 .doc("what in(x,y,z) tests: the scene envelope, the scene's solids, or auto (envelope if any, else "
                      "solids)"),
             param::text("pic_image").doc("image read by pic(u, v, plane) (PNG, JPEG, ...)"),
+            param::text("organ_j").doc("J's geometry: a built-in shape (leaf, blossom, half_bloom, bud; `growbench "
+                                       "list organs`) or an OBJ file; empty: its kind's shape, or --leaf-obj"),
+            param::text("organ_k").doc("K's geometry, as organ_j"),
+            param::text("organ_m").doc("M's geometry, as organ_j"),
+            param::choice("kind_j", "leaf", {"leaf", "young_leaf", "flower", "bud"})
+                .doc("what J places, for the metrics, mesh groups and materials"),
+            param::choice("kind_k", "flower", {"leaf", "young_leaf", "flower", "bud"}).doc("what K places"),
+            param::choice("kind_m", "bud", {"leaf", "young_leaf", "flower", "bud"}).doc("what M places"),
             param::integer("max_symbols", 50'000'000)
                 .range(1, 2e9)
                 .doc("a generation that would exceed this many symbols stops the run with an error"),
@@ -184,9 +193,39 @@ struct Setup {
   lsys::DeriveSettings derive;
   lsys::TurtleSettings turtle;
   std::unique_ptr<Host> host;
-  int rewrites = 0;       // whole generations, plus one for a fractional part
-  double fraction = 0.0;  // the fractional part (0: none); the last rewrite is drawn scaled by it
+  int rewrites = 0;                       // whole generations, plus one for a fractional part
+  double fraction = 0.0;                  // the fractional part (0: none); the last rewrite is drawn scaled by it
+  std::vector<std::string> organ_shapes;  // Plant::organ_shapes: J/K/M's shapes by name
 };
+
+// An organ OBJ named by a grammar file is found beside the file, as its author wrote it.
+std::string organ_relative_to(const std::string& key, const std::string& value, const std::string& grammar) {
+  namespace fs = std::filesystem;
+  if (key.rfind("organ_", 0) != 0 || value.empty() || fs::path(value).is_absolute()) return value;
+  const fs::path beside = fs::path(grammar).parent_path() / value;
+  std::error_code ec;
+  return fs::is_regular_file(beside, ec) ? beside.string() : value;
+}
+
+// J, K and M's kinds and shapes; the shapes' names are checked now, before anything grows.
+void organ_setup(const Params& p, Setup& s) {
+  static const char* const kSymbols[3] = {"j", "k", "m"};
+  for (std::size_t i = 0; i < 3; ++i) {
+    const std::string& kind = p.text(fmt::format("kind_{}", kSymbols[i]));
+    s.turtle.organ_kind[i] = kind == "leaf"         ? OrganKind::Leaf
+                             : kind == "young_leaf" ? OrganKind::YoungLeaf
+                             : kind == "flower"     ? OrganKind::Flower
+                                                    : OrganKind::Bud;
+    const std::string key = fmt::format("organ_{}", kSymbols[i]);
+    const std::string& name = p.text(key);
+    s.turtle.organ_shape[i] = kKindShape;
+    if (name.empty()) continue;
+    (void)organ_shape_named(name, fmt::format("parameter {}", key));
+    const auto it = std::find(s.organ_shapes.begin(), s.organ_shapes.end(), name);
+    s.turtle.organ_shape[i] = static_cast<std::uint16_t>(it - s.organ_shapes.begin());
+    if (it == s.organ_shapes.end()) s.organ_shapes.push_back(name);
+  }
+}
 
 Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* query) {
   Setup s;
@@ -199,7 +238,7 @@ Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* quer
     for (const auto& st : file->settings) {
       if (p.was_set(st.key)) continue;
       try {
-        p.set(st.key, st.value);
+        p.set(st.key, organ_relative_to(st.key, st.value, file->path));
       } catch (const InputError& e) {
         throw InputError(fmt::format("{}:{}: {}", file->path, st.line, e.what()));
       }
@@ -312,7 +351,10 @@ Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* quer
       .wrap = p.text("surface") == "wrap" ? query : nullptr,
       .wrap_offset = p.real("wrap_offset"),
       .birth_step = 0,
+      .organ_kind = {},
+      .organ_shape = {},
   };
+  organ_setup(p, s);
   const double generations = p.real("generations");
   const int full = static_cast<int>(std::floor(generations + 1e-9));
   s.fraction = generations - full < 1e-6 ? 0.0 : generations - full;
@@ -410,6 +452,7 @@ class LSystem final : public GrowthAlgorithm {
   void redraw() {
     const auto t0 = std::chrono::steady_clock::now();
     plant_.clear();
+    plant_.organ_shapes = setup_.organ_shapes;
     for (auto& pl : plants_) {
       if (!pl.started) continue;
       lsys::TurtleSettings ts = setup_.turtle;

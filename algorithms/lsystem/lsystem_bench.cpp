@@ -121,7 +121,9 @@ void BM_LsysTurtle(benchmark::State& state) {
                              .heading = glm::dvec3(0.0, 1.0, 0.0),
                              .wrap = nullptr,
                              .wrap_offset = 0.0,
-                             .birth_step = 0};
+                             .birth_step = 0,
+                             .organ_kind = {OrganKind::Leaf, OrganKind::Flower, OrganKind::Bud},
+                             .organ_shape = {kKindShape, kKindShape, kKindShape}};
   std::size_t nodes = 0;
   Plant reused;
   for (auto _ : state) {

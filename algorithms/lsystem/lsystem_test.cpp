@@ -10,6 +10,7 @@
 #include "algorithms/lsystem/derive.hpp"
 #include "algorithms/lsystem/expr.hpp"
 #include "algorithms/lsystem/lsystem.hpp"
+#include "algorithms/organ_shapes.hpp"
 #include "core/errors.hpp"
 #include "scenes/scene_library.hpp"
 #include "test_util.hpp"
@@ -323,6 +324,31 @@ TEST_F(LSystemTurtle, PitchRollAndTurnAround) {
   const Plant q = grow("F(2)+(90)H", "", 0, {"convention=abop"});
   EXPECT_NEAR(q.nodes[1].position.y, 2.0f, 1e-6f);
   EXPECT_NEAR(q.nodes[2].position.x, -0.5f, 1e-6f);
+}
+
+// The grammar a Houdini user wrote for a cherry branch: J places flowers and K leaves. kind_j and kind_k
+// say so, organ_j names J's geometry, and each comes out labelled and shaped as asked.
+TEST_F(LSystemTurtle, PerSymbolKindsAndShapes) {
+  const Plant p = grow("FJ(0.2)K(0.3)M", "", 0, {"kind_j=flower", "kind_k=leaf", "organ_j=blossom:petals=6"});
+  ASSERT_EQ(p.organs.size(), 3u);
+  EXPECT_EQ(p.organs[0].kind, OrganKind::Flower);
+  EXPECT_EQ(p.organs[1].kind, OrganKind::Leaf);
+  EXPECT_EQ(p.organs[2].kind, OrganKind::Bud);  // M keeps its default
+  ASSERT_EQ(p.organ_shapes, std::vector<std::string>{"blossom:petals=6"});
+  EXPECT_EQ(p.organs[0].shape, 0u);
+  EXPECT_EQ(p.organs[1].shape, kKindShape);  // K: a leaf's own shape
+  EXPECT_FLOAT_EQ(p.organs[0].size, 0.2f);
+  const OrganShapes shapes(p);
+  EXPECT_EQ(shapes.of(p.organs[0]).mesh.triangles.size(), 60u);  // six petals of ten triangles
+  EXPECT_EQ(shapes.of(p.organs[1]).name, "leaf");
+  EXPECT_EQ(shapes.of(p.organs[2]).name, "bud");
+  // An unknown shape is refused before anything grows, naming the parameter and the choices.
+  const std::string e = test::error_of([&] { (void)grow("FJ", "", 0, {"organ_j=tulip"}); });
+  EXPECT_NE(e.find("parameter organ_j: unknown organ shape 'tulip'; expected one of leaf, blossom, half_bloom, bud"),
+            std::string::npos)
+      << e;
+  const std::string f = test::error_of([&] { (void)grow("FJ", "", 0, {"organ_k=/no/such/petal.obj"}); });
+  EXPECT_NE(f.find("/no/such/petal.obj"), std::string::npos) << f;
 }
 
 TEST_F(LSystemTurtle, DollarLevelsTheLeftVector) {

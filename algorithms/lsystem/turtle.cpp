@@ -119,7 +119,9 @@ class Interpreter {
           double size = k > 0 ? a[0] : t.length;
           if (fresh && s_.continuous_length) size *= s_.fraction;
           o.size = static_cast<float>(std::max(0.0, size));
-          o.kind = c == 'J' ? OrganKind::Leaf : c == 'K' ? OrganKind::Flower : OrganKind::Bud;
+          const std::size_t which = c == 'J' ? 0 : c == 'K' ? 1 : 2;
+          o.kind = s_.organ_kind[which];
+          o.shape = s_.organ_shape[which];
           o.node = t.node;
           for (int q = 2; q < k && q < 5; ++q) o.stamp[static_cast<std::size_t>(q - 2)] = a[q];
           plant_.organs.push_back(o);

@@ -8,12 +8,13 @@
 //
 // Geometry. F and H draw (a node at the new position, parented to the last one; the first F after the
 // start, an f or an h puts a root node where it begins); G moves and keeps drawing from the last vertex
-// without recording one; f and h move without drawing. Node radius = width / 2. J, K, M place a leaf,
-// a flower and a bud (blade +Z along H, +Y along U), scaled by their first parameter (default: the
-// current step length) and stamped with their third to fifth parameters. '%' skips to the end of the
-// branch (the reference's "cut off remainder of branch", applied when drawing).
+// without recording one; f and h move without drawing. Node radius = width / 2. J, K, M place the organs
+// their kinds and shapes name, by default a leaf, a flower and a bud (blade +Z along H, +Y along U), scaled by their
+// first parameter (default: the current step length) and stamped with their third to fifth parameters. '%' skips to the
+// end of the branch (the reference's "cut off remainder of branch", applied when drawing).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -53,6 +54,8 @@ struct TurtleSettings {
   const SceneQuery* wrap;  // when set: every move is mapped onto the nearest surface
   double wrap_offset;
   std::uint32_t birth_step;
+  std::array<OrganKind, 3> organ_kind;       // what J, K and M place
+  std::array<std::uint16_t, 3> organ_shape;  // their shapes: Plant::organ_shapes indices, or kKindShape
 };
 
 struct TurtleResult {

@@ -11,6 +11,8 @@
 #include "algorithms/plugins/loader.hpp"
 #include "harness/cli/command.hpp"
 #include "harness/cli/param_table.hpp"
+#include "harness/organs/options.hpp"
+#include "algorithms/organ_shapes.hpp"
 
 namespace growbench::cli {
 
@@ -56,8 +58,29 @@ std::string markdown_of(const AlgorithmInfo& info) {
   return out;
 }
 
+// The organ pass's table and the built-in organ shapes: every algorithm's plant goes through them.
+void print_organs(bool markdown) {
+  const auto& names = builtin_organ_shape_names();
+  const auto& docs = builtin_organ_shape_docs();
+  if (markdown) {
+    fmt::print("{}\nBuilt-in organ shapes (organ_j=NAME, or NAME:key=value,... to change a setting):\n\n",
+               param_table_markdown(organ_param_specs()));
+    for (std::size_t i = 0; i < names.size(); ++i) fmt::print("- {}: {}\n", markdown_code(names[i]), docs[i]);
+    return;
+  }
+  fmt::print(
+      "organs  [every algorithm]\n  the organ pass after growth: --organ key=value (a suite entry's \"organs\")\n");
+  print_param_table(organ_param_specs());
+  fmt::print("  built-in organ shapes (NAME, or NAME:key=value,... to change a setting):\n");
+  for (std::size_t i = 0; i < names.size(); ++i) fmt::print("    {:<12} {}\n", names[i], docs[i]);
+}
+
 int list_algorithms(const ListArgs& a) {
   load_plugins(a.plugins);
+  if (a.name == "organs") {
+    print_organs(a.markdown);
+    return 0;
+  }
   if (!a.name.empty()) {
     const AlgorithmEntry& e = find_algorithm(a.name);
     if (a.markdown)
@@ -76,6 +99,7 @@ int list_algorithms(const ListArgs& a) {
       print_text(*e);
     first = false;
   }
+  if (!a.markdown) print_organs(false);
   return 0;
 }
 
@@ -84,7 +108,7 @@ int list_algorithms(const ListArgs& a) {
 Command add_list(CLI::App& app) {
   auto* cmd = app.add_subcommand("list", "List the algorithms and their parameter tables");
   auto a = std::make_shared<ListArgs>();
-  cmd->add_option("name", a->name, "only this algorithm");
+  cmd->add_option("name", a->name, "only this algorithm (or organs: the organ pass and shapes every algorithm shares)");
   add_plugin_option(cmd, a->plugins);
   cmd->add_flag("--markdown", a->markdown,
                 "the parameter tables as Markdown (name, type, default, allowed, unit, doc), as the algorithms' "

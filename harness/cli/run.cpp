@@ -139,8 +139,12 @@ Command add_run(CLI::App& app) {
       ->default_val(6)
       ->check(CLI::Range(3, 64));
   run->add_option("--leaf-obj", spec.mesher.leaf_obj,
-                  "a custom leaf for every leaf and flower: an OBJ with the blade along +Z from the stem at z = 0 and "
-                  "its upper side toward +Y (scaled to unit length; the organ's size sizes it)");
+                  "a custom organ for every leaf, flower and bud whose plant names no shape: an OBJ with the blade "
+                  "along +Z from the stem at z = 0 and its upper side toward +Y (scaled to unit length; the organ's "
+                  "size sizes it)");
+  run->add_option("--organ", spec.organs,
+                  "organ pass after growth, key=value (repeatable): placement=avoid, variation, fallbacks; "
+                  "`growbench list organs` lists them");
   run->add_option("-o,--out", a->out_dir, "output directory (default: out/ALGORITHM-SCENE)");
   run->add_flag("-q,--quiet", a->quiet, "no progress line");
   run->add_option("--render", a->render, "render the plant with POV-Ray afterwards: preview or paper (render.png)");

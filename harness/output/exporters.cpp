@@ -307,6 +307,13 @@ class SnapshotReader {
       throw InputError(fmt::format("{}: plant snapshot count {} at byte {} exceeds the file", path_, n, pos_ - 8));
     return static_cast<std::size_t>(n);
   }
+  // Consumes `tag` when the next bytes are it.
+  template <std::size_t N>
+  bool tag(const char (&t)[N]) {
+    if (data_.size() - pos_ < N || std::memcmp(data_.data() + pos_, t, N) != 0) return false;
+    pos_ += N;
+    return true;
+  }
   // `n` bytes as a string; n comes from count(1), so it is within the file.
   std::string text(std::size_t n) {
     if (pos_ + n > data_.size())
@@ -324,6 +331,7 @@ class SnapshotReader {
 
 // The smallest record of a decal: an empty name's length, mesh, origin and both axes.
 constexpr std::size_t kDecalMinBytes = 8 + 4 + 3 * 12;
+constexpr char kOrganStyleTag[8] = {'O', 'R', 'G', 'A', 'N', 'S', '1', '\0'};
 
 }  // namespace
 
@@ -365,7 +373,10 @@ std::uint64_t write_plant_snapshot(const std::string& path, const Plant& plant, 
     put<std::uint64_t>(b, p.vertices.size());
     for (const auto& v : p.vertices) put(b, v);
   }
-  if (!plant.decals.empty()) {
+  const bool styled = !plant.organ_shapes.empty() ||
+                      std::any_of(plant.organs.begin(), plant.organs.end(),
+                                  [](const Organ& o) { return o.shape != kKindShape || o.tint != glm::vec3(1.0f); });
+  if (!plant.decals.empty() || styled) {
     put<std::uint64_t>(b, plant.decals.size());
     for (const auto& d : plant.decals) {
       const std::string name = image_prefix + d.image;
@@ -375,6 +386,18 @@ std::uint64_t write_plant_snapshot(const std::string& path, const Plant& plant, 
       put(b, d.origin);
       put(b, d.u_axis);
       put(b, d.v_axis);
+    }
+  }
+  if (styled) {  // a tag, the organ shapes' names, then each organ's shape and tint
+    b.bytes(kOrganStyleTag, sizeof(kOrganStyleTag));
+    put<std::uint64_t>(b, plant.organ_shapes.size());
+    for (const auto& name : plant.organ_shapes) {
+      put<std::uint64_t>(b, name.size());
+      b.bytes(name.data(), name.size());
+    }
+    for (const auto& o : plant.organs) {
+      put(b, o.shape);
+      put(b, o.tint);
     }
   }
   return b.finish();
@@ -427,6 +450,15 @@ Plant read_plant_snapshot(const std::string& path) {
       d.origin = r.vec3();
       d.u_axis = r.vec3();
       d.v_axis = r.vec3();
+    }
+  }
+  // Snapshots of plants without organ shapes or tints end here.
+  if (!r.at_end() && r.tag(kOrganStyleTag)) {
+    plant.organ_shapes.resize(r.count(9));
+    for (auto& name : plant.organ_shapes) name = r.text(r.count(1));
+    for (auto& o : plant.organs) {
+      o.shape = r.get<std::uint16_t>();
+      o.tint = r.vec3();
     }
   }
   if (!r.at_end()) throw InputError(fmt::format("{}: plant snapshot has trailing bytes", path));

@@ -114,58 +114,48 @@ void add_tube(OutputMesh& m, const Plant& plant, const std::vector<std::int32_t>
   }
 }
 
-void add_organ(OutputMesh& m, const Organ& organ, const TriangleMesh& shape) {
+void add_organ(OutputMesh& m, const Organ& organ, const OrganShape& shape, const glm::vec3* color) {
   const auto base = static_cast<std::uint32_t>(m.positions.size());
-  const glm::vec3 n = glm::mat3_cast(organ.orientation) * glm::vec3(0, 1, 0);
-  for (const auto& v : shape.vertices) {
-    m.positions.push_back(organ_point(organ, v));
-    m.normals.push_back(n);
+  const glm::mat3 r = glm::mat3_cast(organ.orientation);
+  for (std::size_t k = 0; k < shape.mesh.vertices.size(); ++k) {
+    m.positions.push_back(organ_point(organ, shape.mesh.vertices[k]));
+    m.normals.push_back(r * shape.normals[k]);
   }
-  for (const auto& t : shape.triangles) m.triangles.push_back(t + glm::uvec3(base));
+  if (color) m.colors.resize(m.positions.size(), *color);
+  for (const auto& t : shape.mesh.triangles) m.triangles.push_back(t + glm::uvec3(base));
 }
 
 }  // namespace
 
-glm::vec3 organ_point(const Organ& organ, const glm::vec3& local) {
-  return organ.position + glm::mat3_cast(organ.orientation) * (local * organ.size);
-}
-
-TriangleMesh load_leaf_mesh(const std::string& path) {
-  TriangleMesh m = load_obj(path);  // InputError without faces
-  float lo = std::numeric_limits<float>::max(), hi = std::numeric_limits<float>::lowest();
-  for (const auto& v : m.vertices) lo = std::min(lo, v.z), hi = std::max(hi, v.z);
-  if (!(hi - lo > 1e-6f))
-    throw InputError(
-        fmt::format("{}: the leaf has no length along z; expected its blade along +Z from the stem", path));
-  for (auto& v : m.vertices) v = glm::vec3(v.x, v.y, v.z - lo) / (hi - lo);
-  m.name = "leaf_obj";
-  return m;
-}
-
 MesherOptions with_leaf_mesh(MesherOptions o) {
-  if (!o.leaf_obj.empty() && o.leaf_mesh.triangles.empty()) o.leaf_mesh = load_leaf_mesh(o.leaf_obj);
+  if (!o.leaf_obj.empty() && !o.leaf) o.leaf = std::make_shared<const OrganShape>(load_organ_obj(o.leaf_obj));
   return o;
 }
 
-TriangleMesh organ_shape(const MesherOptions& o) {
-  if (!o.leaf_mesh.triangles.empty()) return o.leaf_mesh;
-  TriangleMesh shape;
-  shape.name = o.leaf_shape;
-  if (o.leaf_shape == "quad") {
-    shape.vertices = {{-0.25f, 0, 0}, {0.25f, 0, 0}, {0.25f, 0, 1}, {-0.25f, 0, 1}};
-  } else {
-    shape.vertices = {{0, 0, 0}, {0.25f, 0, 0.4f}, {0, 0, 1}, {-0.25f, 0, 0.4f}};
-  }
-  shape.triangles = {{0, 2, 1}, {0, 3, 2}};
-  return shape;
+OrganShapes organ_shapes(const Plant& plant, const MesherOptions& o) {
+  return OrganShapes(plant, o.leaf.get());
+}
+
+glm::vec3 material_srgb(std::string_view material) {
+  if (material == "bark") return {0.40f, 0.27f, 0.17f};
+  if (material == "flower") return organ_kind_srgb(OrganKind::Flower);
+  return organ_kind_srgb(OrganKind::Leaf);
 }
 
 OutputMesh mesh_plant(const Plant& plant, const MesherOptions& o) {
   OutputMesh m;
-  const TriangleMesh shape = organ_shape(o);
+  const OrganShapes shapes = organ_shapes(plant, o);
+  // Vertex colours only when some organ has a colour of its own; then every vertex has one, its organ's
+  // or its group's material colour.
+  const bool colored = shapes.any_color(plant);
+  auto organ_mesh = [&](const Organ& organ) {
+    const glm::vec3 c = shapes.linear_color(organ);
+    add_organ(m, organ, shapes.of(organ), colored ? &c : nullptr);
+  };
   auto group = [&](const char* name, const char* material, auto&& body) {
     const auto first = static_cast<std::uint32_t>(m.triangles.size());
     body();
+    if (colored) m.colors.resize(m.positions.size(), srgb_to_linear(material_srgb(material)));
     const auto count = static_cast<std::uint32_t>(m.triangles.size()) - first;
     if (count > 0) m.groups.push_back({name, material, first, count});
   };
@@ -174,11 +164,11 @@ OutputMesh mesh_plant(const Plant& plant, const MesherOptions& o) {
   });
   group("leaves", "leaf", [&] {
     for (const auto& organ : plant.organs)
-      if (organ.kind == OrganKind::Leaf || organ.kind == OrganKind::YoungLeaf) add_organ(m, organ, shape);
+      if (organ.kind == OrganKind::Leaf || organ.kind == OrganKind::YoungLeaf) organ_mesh(organ);
   });
   group("flowers", "flower", [&] {
     for (const auto& organ : plant.organs)
-      if (organ.kind == OrganKind::Flower || organ.kind == OrganKind::Bud) add_organ(m, organ, shape);
+      if (organ.kind == OrganKind::Flower || organ.kind == OrganKind::Bud) organ_mesh(organ);
   });
   group("polygons", "leaf", [&] {
     for (const auto& poly : plant.polygons) {

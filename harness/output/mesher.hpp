@@ -3,12 +3,15 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 #include "algorithms/plant.hpp"
+#include "algorithms/organ_shapes.hpp"
 #include "scenes/scene.hpp"
 
 namespace growbench {
@@ -31,33 +34,24 @@ struct OutputMesh {
 };
 
 struct MesherOptions {
-  int sides = 6;                       // tube cross-section sides (3..64)
-  bool caps = true;                    // close tube ends
-  float min_radius = 0.0f;             // radii below this are raised to it (0: as given; zero-radius nodes get 1e-4 m)
-  std::string leaf_shape = "diamond";  // "diamond", "quad"; ignored when leaf_mesh has triangles
-  TriangleMesh leaf_mesh;              // optional instanced leaf: local frame as Organ (+Z blade, +Y up), unit length
-  std::string leaf_obj;                // an OBJ to load into leaf_mesh (load_leaf_mesh) when a trial or render starts
+  int sides = 6;            // tube cross-section sides (3..64)
+  bool caps = true;         // close tube ends
+  float min_radius = 0.0f;  // radii below this are raised to it (0: as given; zero-radius nodes get 1e-4 m)
+  // A custom organ OBJ (--leaf-obj): the shape of every leaf, flower and bud whose plant names none.
+  std::string leaf_obj;
+  std::shared_ptr<const OrganShape> leaf;  // leaf_obj, loaded by with_leaf_mesh
 };
 
-// A custom leaf from an OBJ file, as every algorithm's leaves and flowers are instanced: authored in the
-// organ's frame, the blade along +Z from the stem and the upper side toward +Y. It is moved so its lowest
-// z is 0 and scaled so its length along z is 1 (the organ's size then sizes it). InputError naming the
-// file when it cannot be read, has no faces, or has no length along z.
-TriangleMesh load_leaf_mesh(const std::string& path);
-
-// options with leaf_mesh loaded from leaf_obj (when it names a file and leaf_mesh is empty).
+// options with `leaf` loaded from leaf_obj (when it names a file and nothing is loaded yet).
 MesherOptions with_leaf_mesh(MesherOptions options);
 
+// The shape of each of the plant's organs under these options (algorithms/organ_shapes.hpp).
+OrganShapes organ_shapes(const Plant& plant, const MesherOptions& options = {});
+
+// The sRGB base colour of a mesh group's material ("bark", "leaf", "flower"), as the renders draw it.
+glm::vec3 material_srgb(std::string_view material);
+
 OutputMesh mesh_plant(const Plant& plant, const MesherOptions& options = {});
-
-// The shape every leaf and flower is instanced from (options.leaf_mesh, else the named leaf_shape), in
-// the organ's local frame at unit length. Shared with the POV-Ray writer so renders match the meshes.
-TriangleMesh organ_shape(const MesherOptions& options = {});
-
-// A point of an organ's shape (its local frame, unit length) placed in the world: scaled by the organ's
-// size, turned by its orientation, moved to its position. Meshes, renders, the metrics' leaf overlap and
-// self-shadowing all place organs through it, so they judge the organs that are exported.
-glm::vec3 organ_point(const Organ& organ, const glm::vec3& local);
 
 // Chains of nodes along which tubes run: each starts at a root or a branching point and follows the
 // main child (the one that continues the parent's shoot, else the first). Shared with the skeleton

@@ -255,9 +255,10 @@ class MetricsPass {
 
   void leaf_metrics() {
     // Leaves: their blades as exported (the organ shape placed by organ_point), and light.
-    const TriangleMesh shape = o.organ_shape.triangles.empty() ? organ_shape() : o.organ_shape;
+    const OrganShapes shapes(plant, o.custom_leaf.get());
     auto organ_triangle = [&](const Organ& org, const glm::uvec3& t, glm::vec3(&v)[3]) {
-      for (int k = 0; k < 3; ++k) v[k] = organ_point(org, shape.vertices[t[k]]);
+      const auto& vertices = shapes.of(org).mesh.vertices;
+      for (int k = 0; k < 3; ++k) v[k] = organ_point(org, vertices[t[k]]);
     };
     for (std::uint32_t i = 0; i < plant.organs.size(); ++i)
       if (is_leaf(plant.organs[i])) leaf.push_back(i);
@@ -266,7 +267,8 @@ class MetricsPass {
     std::vector<float> bradius(leaf.size(), 0.0f);
     std::vector<Aabb> lbox(leaf.size());
     for (std::size_t i = 0; i < leaf.size(); ++i) {
-      for (const auto& v : shape.vertices) lbox[i].extend(organ_point(plant.organs[leaf[i]], v));
+      for (const auto& v : shapes.of(plant.organs[leaf[i]]).mesh.vertices)
+        lbox[i].extend(organ_point(plant.organs[leaf[i]], v));
       // Padded by the overlap test's tolerance, so blades coplanar within it are not kept apart here.
       const glm::vec3 far = glm::max(glm::abs(lbox[i].min), glm::abs(lbox[i].max));
       const float reach = std::max({far.x, far.y, far.z});
@@ -280,10 +282,11 @@ class MetricsPass {
       const Aabb &a = lbox[i], &b = lbox[j];
       if (glm::any(glm::lessThan(a.max, b.min)) || glm::any(glm::lessThan(b.max, a.min))) return false;
       glm::vec3 ta[3], tb[3];
-      for (const auto& t : shape.triangles) {
-        organ_triangle(plant.organs[leaf[i]], t, ta);
-        for (const auto& u : shape.triangles) {
-          organ_triangle(plant.organs[leaf[j]], u, tb);
+      const Organ &oi = plant.organs[leaf[i]], &oj = plant.organs[leaf[j]];
+      for (const auto& t : shapes.of(oi).mesh.triangles) {
+        organ_triangle(oi, t, ta);
+        for (const auto& u : shapes.of(oj).mesh.triangles) {
+          organ_triangle(oj, u, tb);
           if (geom::triangles_overlap(ta, tb)) return true;
         }
       }
@@ -305,9 +308,8 @@ class MetricsPass {
                             std::max(nodes[static_cast<std::size_t>(nodes[s].parent)].radius, 1e-4f),
                             std::max(nodes[s].radius, 1e-4f)});
       std::vector<Occluder::Triangle> tris;
-      tris.reserve(plant.organs.size() * shape.triangles.size());
       for (std::uint32_t i = 0; i < plant.organs.size(); ++i)
-        for (const auto& t : shape.triangles) {
+        for (const auto& t : shapes.of(plant.organs[i]).mesh.triangles) {
           Occluder::Triangle ot;
           organ_triangle(plant.organs[i], t, ot.v);
           ot.owner = i;

@@ -3,10 +3,12 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "algorithms/organ_shapes.hpp"
 #include "algorithms/plant.hpp"
 #include "scenes/scene_query.hpp"
 
@@ -19,9 +21,9 @@ struct MetricOptions {
   float attach_distance = 0.02f;  // a node within this of a surface is attached (m)
   int segment_samples = 3;        // interior points per segment tested for penetration
   float light_bias = 1e-3f;       // a leaf's light ray leaves from this far above its centre (m)
-  // The shape leaves and flowers are instanced from (organ_shape() of the trial's mesher options); empty:
-  // the mesher's default. Leaf overlap and self-shadowing judge the organs as they are exported.
-  TriangleMesh organ_shape;
+  // The trial's custom organ (MesherOptions::leaf), or null. Leaf overlap and self-shadowing take each
+  // organ's shape as the mesher does (organ_shapes), so they judge the organs as they are exported.
+  std::shared_ptr<const OrganShape> custom_leaf;
 };
 
 // The verdict on every item behind the figures, for tests that check them one by one.

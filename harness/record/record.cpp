@@ -208,6 +208,7 @@ PhaseMeasures* Phases::find(std::string_view name) {
   std::optional<PhaseMeasures>* p = name == "scene_load"    ? &scene_load
                                     : name == "query_build" ? &query_build
                                     : name == "growth"      ? &growth
+                                    : name == "organs"      ? &organs
                                     : name == "meshing"     ? &meshing
                                     : name == "export"      ? &exporting
                                     : name == "metrics"     ? &metrics
@@ -257,6 +258,7 @@ void read(const Node& n, Phases& v) {
   f.field("scene_load", v.scene_load);
   f.field("query_build", v.query_build);
   f.field("growth", v.growth);
+  f.field("organs", v.organs);
   f.field("meshing", v.meshing);
   f.field("export", v.exporting);
   f.field("metrics", v.metrics);
@@ -339,6 +341,18 @@ void read(const Node& n, FramesInfo& v) {
   f.field("every", v.every);
   f.field("count", v.count);
   f.field("dir", v.dir);
+  f.done();
+}
+
+json to_json(const OrganPassRecord& v) {
+  return {{"options", v.options}, {"placed", v.placed}, {"fallen_back", v.fallen_back}, {"dropped", v.dropped}};
+}
+void read(const Node& n, OrganPassRecord& v) {
+  Fields f(n);
+  f.field("options", v.options);
+  f.field("placed", v.placed);
+  f.field("fallen_back", v.fallen_back);
+  f.field("dropped", v.dropped);
   f.done();
 }
 
@@ -468,6 +482,7 @@ json to_json(const TrialRecord& v) {
             {"algorithm_stats", to_json_value(v.algorithm_stats)},
             {"peak_rss_bytes", v.peak_rss_bytes}};
   put(j, "leaf_obj", v.leaf_obj);
+  put(j, "organs", v.organs);
   put(j, "frames", v.frames);
   put(j, "snapshot_bytes", v.snapshot_bytes);
   put(j, "metrics", v.metrics);
@@ -488,6 +503,7 @@ void read(const Node& n, TrialRecord& v) {
   f.field("scene", v.scene);
   f.field("params", v.params);
   f.field("leaf_obj", v.leaf_obj);
+  f.field("organs", v.organs);
   f.field("frames", v.frames);
   f.field("steps", v.steps);
   f.field("stopped_by", v.stopped_by);
@@ -526,6 +542,7 @@ json to_json(const TrialSpecRecord& v) {
             {"frame_every", v.frame_every},
             {"fault", v.fault}};
   put(j, "leaf_obj", v.leaf_obj);
+  put(j, "organs", v.organs);
   put(j, "out_dir", v.out_dir);
   put(j, "context", v.context);
   put(j, "skip_teardown", v.skip_teardown);
@@ -551,6 +568,7 @@ void read(const Node& n, TrialSpecRecord& v) {
   f.field("frame_every", v.frame_every);
   f.field("fault", v.fault);
   f.field("leaf_obj", v.leaf_obj);
+  f.field("organs", v.organs);
   f.field("out_dir", v.out_dir);
   f.field("context", v.context);
   f.field("skip_teardown", v.skip_teardown);
@@ -1020,6 +1038,7 @@ GROWBENCH_RECORD_TYPE(OutputBytes)
 GROWBENCH_RECORD_TYPE(Curve)
 GROWBENCH_RECORD_TYPE(SceneInfo)
 GROWBENCH_RECORD_TYPE(FramesInfo)
+GROWBENCH_RECORD_TYPE(OrganPassRecord)
 GROWBENCH_RECORD_TYPE(RunContext)
 GROWBENCH_RECORD_TYPE(RenderRecord)
 GROWBENCH_RECORD_TYPE(AnimationRecord)

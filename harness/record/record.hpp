@@ -54,7 +54,7 @@ struct PhaseMeasures {
 // A trial's phases, each absent when it did not run (metrics with metrics off; all of them in a hand-written
 // sample). `exporting` is the JSON's "export" (a C++ keyword).
 struct Phases {
-  std::optional<PhaseMeasures> scene_load, query_build, growth, meshing, exporting, metrics;
+  std::optional<PhaseMeasures> scene_load, query_build, growth, organs, meshing, exporting, metrics;
   // The phase of that JSON name, or null (absent or unknown).
   [[nodiscard]] const PhaseMeasures* find(std::string_view name) const;
   [[nodiscard]] PhaseMeasures* find(std::string_view name);
@@ -65,8 +65,8 @@ struct Phases {
     for (const std::string_view name : kNames)
       if (const PhaseMeasures* p = find(name)) f(name, *p);
   }
-  static constexpr std::array<std::string_view, 6> kNames = {"export",  "growth",      "meshing",
-                                                             "metrics", "query_build", "scene_load"};
+  static constexpr std::array<std::string_view, 7> kNames = {"export", "growth",      "meshing",   "metrics",
+                                                             "organs", "query_build", "scene_load"};
 };
 
 struct Counts {
@@ -141,6 +141,12 @@ struct AnimationRecord {
 };
 
 // record.json: one trial (run_trial in harness/run/trial.hpp).
+// The organ pass after growth (harness/organs/): its settings and what placement did.
+struct OrganPassRecord {
+  nlohmann::json options = nlohmann::json::object();  // every organ option with its effective value
+  std::uint64_t placed = 0, fallen_back = 0, dropped = 0;
+};
+
 struct TrialRecord {
   int schema_version = kSchemaVersion;
   std::string status = "ok";
@@ -152,6 +158,7 @@ struct TrialRecord {
   SceneInfo scene;
   nlohmann::json params = nlohmann::json::object();  // the algorithm's effective parameters by name
   std::optional<std::string> leaf_obj;
+  std::optional<OrganPassRecord> organs;  // only when the pass ran (an organ option was given)
   std::optional<FramesInfo> frames;
   int steps = 0;
   std::string stopped_by;
@@ -186,7 +193,8 @@ struct TrialSpecRecord {
   bool metrics = true;
   int frame_every = 0;
   std::string fault;
-  std::optional<std::string> leaf_obj;  // only when given: older specs stay as they were
+  std::optional<std::string> leaf_obj;             // only when given: older specs stay as they were
+  std::optional<std::vector<std::string>> organs;  // --organ key=value; only when given
   // Only in the job a suite sends a trial's process (never in results).
   std::optional<std::string> out_dir;
   std::optional<bool> context, skip_teardown;
@@ -393,6 +401,7 @@ nlohmann::json to_json(const OutputBytes& v);
 nlohmann::json to_json(const Curve& v);
 nlohmann::json to_json(const SceneInfo& v);
 nlohmann::json to_json(const FramesInfo& v);
+nlohmann::json to_json(const OrganPassRecord& v);
 nlohmann::json to_json(const RunContext& v);
 nlohmann::json to_json(const RenderRecord& v);
 nlohmann::json to_json(const AnimationRecord& v);

@@ -190,8 +190,9 @@ void write_settings(Out out, const Scene& scene, const Plant& plant, const Rende
       "#declare GB_Leaf = texture {{ pigment {{ srgb <0.24,0.52,0.16> }} finish {{ specular 0.15 roughness 0.04 }} }}\n"
       "#declare GB_YoungLeaf = texture {{ pigment {{ srgb <0.52,0.72,0.24> }} finish {{ specular 0.15 roughness 0.04 "
       "}} }}\n"
-      "#declare GB_Flower = texture {{ pigment {{ srgb <0.95,0.80,0.88> }} finish {{ specular 0.1 roughness 0.05 }} "
-      "}}\n"
+      "#declare GB_OrganFinish = finish {{ specular 0.1 roughness 0.05 }}\n"
+      "#declare GB_Flower = texture {{ pigment {{ srgb <0.95,0.80,0.88> }} finish {{ GB_OrganFinish }} }}\n"
+      "#declare GB_Bud = texture {{ pigment {{ srgb <0.85,0.36,0.50> }} finish {{ GB_OrganFinish }} }}\n"
       "#declare GB_Surface = texture {{ pigment {{ srgb <0.80,0.78,0.74> }} }}\n"
       "#declare GB_Ground = texture {{ pigment {{ checker srgb <0.56,0.55,0.52> srgb <0.62,0.61,0.58> scale {:.4g} }} "
       "}}\n",
@@ -343,7 +344,9 @@ void write_cones(Out out, const Plant& plant) {
         if (glm::length(n.position - p.position) > 1e-5f) {
           fmt::format_to(o2, "  cone {{ ");
           vec(o2, pov(p.position));
-          fmt::format_to(o2, ",{:.5g},", std::max(p.radius, kMinRadius));
+          // A lateral branch starts with its own radius, as the mesher's tubes do, not its parent's.
+          const float base = n.shoot != p.shoot ? std::min(p.radius, n.radius) : p.radius;
+          fmt::format_to(o2, ",{:.5g},", std::max(base, kMinRadius));
           vec(o2, pov(n.position));
           fmt::format_to(o2, ",{:.5g} }}\n", r);
           ++count;
@@ -380,14 +383,23 @@ void write_branches(Out out, const Plant& plant, const RenderOptions& o) {
   }
 }
 
-// Leaves and flowers: one declared mesh, instanced with matrices (column i of the instance's linear map
-// is row i of POV-Ray's matrix; both sides converted to POV-Ray's handedness).
+// Leaves and flowers: one declared mesh per shape (algorithms/organ_shapes.hpp), instanced with matrices
+// (column i of the instance's linear map is row i of POV-Ray's matrix; both sides converted to
+// POV-Ray's handedness). An organ whose colour is not its kind's plain material (a blossom's petals,
+// colour jitter) carries its own pigment.
 void write_organs(Out out, const Plant& plant, const MesherOptions& mesher) {
   if (plant.organs.empty()) return;
-  TriangleMesh shape = organ_shape(mesher);
-  fmt::format_to(out, "#declare GB_OrganShape =\n");
-  write_mesh2(out, shape.vertices, {}, shape.triangles, 0, static_cast<std::uint32_t>(shape.triangles.size()));
-  fmt::format_to(out, "}}\n");
+  const OrganShapes shapes = organ_shapes(plant, mesher);
+  std::vector<std::uint8_t> used(shapes.all().size(), 0);
+  for (const auto& organ : plant.organs) used[shapes.index_of(organ)] = 1;
+  for (std::size_t k = 0; k < used.size(); ++k) {
+    if (!used[k]) continue;
+    const TriangleMesh& m = shapes.all()[k].mesh;
+    fmt::format_to(out, "#declare GB_Organ{} =  // {}\n", k, shapes.all()[k].name);
+    write_mesh2(out, m.vertices, shapes.all()[k].normals, m.triangles, 0,
+                static_cast<std::uint32_t>(m.triangles.size()));
+    fmt::format_to(out, "}}\n");
+  }
   const glm::mat3 flip(glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, 0, -1));
   auto organs = [&](std::initializer_list<OrganKind> kinds, const char* comment, const char* texture) {
     group(out, comment, texture, [&](Out o2) {
@@ -396,10 +408,18 @@ void write_organs(Out out, const Plant& plant, const MesherOptions& mesher) {
         if (std::find(kinds.begin(), kinds.end(), organ.kind) == kinds.end() || !(organ.size > 0.0f)) continue;
         const glm::mat3 a = flip * glm::mat3_cast(organ.orientation) * flip * organ.size;
         const glm::vec3 t = pov(organ.position);
+        const OrganShape& shape = shapes.of(organ);
+        std::string pigment;
+        if (organ.tint != glm::vec3(1.0f) || (shape.has_color && shape.srgb != organ_kind_srgb(organ.kind))) {
+          const glm::vec3 c = shapes.linear_color(organ);
+          pigment = fmt::format(" texture {{ pigment {{ rgb <{:.4f},{:.4f},{:.4f}> }} finish {{ GB_OrganFinish }} }}",
+                                c.x, c.y, c.z);
+        }
         fmt::format_to(o2,
-                       "  object {{ GB_OrganShape matrix <{:.5g},{:.5g},{:.5g}, {:.5g},{:.5g},{:.5g}, "
+                       "  object {{ GB_Organ{}{} matrix <{:.5g},{:.5g},{:.5g}, {:.5g},{:.5g},{:.5g}, "
                        "{:.5g},{:.5g},{:.5g}, {:.6g},{:.6g},{:.6g}> }}\n",
-                       a[0].x, a[0].y, a[0].z, a[1].x, a[1].y, a[1].z, a[2].x, a[2].y, a[2].z, t.x, t.y, t.z);
+                       shapes.index_of(organ), pigment, a[0].x, a[0].y, a[0].z, a[1].x, a[1].y, a[1].z, a[2].x, a[2].y,
+                       a[2].z, t.x, t.y, t.z);
         ++count;
       }
       return count;
@@ -407,7 +427,8 @@ void write_organs(Out out, const Plant& plant, const MesherOptions& mesher) {
   };
   organs({OrganKind::Leaf}, "leaves", "GB_Leaf");
   organs({OrganKind::YoungLeaf}, "young leaves", "GB_YoungLeaf");
-  organs({OrganKind::Flower, OrganKind::Bud}, "flowers and buds", "GB_Flower");
+  organs({OrganKind::Flower}, "flowers", "GB_Flower");
+  organs({OrganKind::Bud}, "buds", "GB_Bud");
 }
 
 // L-system polygons: one mesh2 of fans.

@@ -30,6 +30,7 @@
 #include "core/data_path.hpp"
 #include "core/errors.hpp"
 #include "core/file_hash.hpp"
+#include "harness/organs/placement.hpp"
 #include "harness/record/files.hpp"
 #include "harness/record/record.hpp"
 #include "harness/run/alloc_counter.hpp"
@@ -277,6 +278,7 @@ TrialSpecRecord to_record(const TrialSpec& s) {
   r.frame_every = s.frame_every;
   r.fault = s.fault;
   if (!s.mesher.leaf_obj.empty()) r.leaf_obj = s.mesher.leaf_obj;
+  if (!s.organs.empty()) r.organs = s.organs;
   return r;
 }
 
@@ -295,6 +297,7 @@ TrialSpec trial_spec_of(const TrialSpecRecord& r) {
   s.voxel_size = static_cast<float>(r.voxel_size);
   s.mesher.sides = r.sides;
   s.mesher.leaf_obj = r.leaf_obj.value_or("");
+  s.organs = r.organs.value_or(std::vector<std::string>{});
   s.budget_nodes = r.budget_nodes;
   s.budget_length_m = r.budget_length_m;
   s.metrics = r.metrics;
@@ -336,6 +339,7 @@ struct TrialState {
   Scene scene;
   std::unique_ptr<SceneQuery> query;
   std::unique_ptr<GrowthAlgorithm> algo;
+  std::optional<Plant> styled;  // the plant after the organ pass, when it ran
   OutputMesh mesh;
 };
 
@@ -468,7 +472,7 @@ void grow(const TrialSpec& spec, const Params& params, TrialState& st, PhaseTime
 // The meshing, export and metrics phases, then what the plant and its mesh hold.
 void mesh_export_measure(const TrialSpec& spec, const MesherOptions& mesher, TrialState& st, PhaseTimer& timer,
                          TrialRecord& rec) {
-  const Plant& plant = st.algo->plant();
+  const Plant& plant = st.styled ? *st.styled : st.algo->plant();
   // The plant itself, for rendering later (`growbench render`); not an output format, not timed. Written
   // before the exports: after them, tens of MB of dirty pages can make the kernel throttle this write.
   if (!spec.out_dir.empty()) {
@@ -489,7 +493,7 @@ void mesh_export_measure(const TrialSpec& spec, const MesherOptions& mesher, Tri
   });
   if (spec.metrics) {
     MetricOptions metric_options;
-    metric_options.organ_shape = organ_shape(mesher);
+    metric_options.custom_leaf = mesher.leaf;
     rec.metrics =
         timer.run("metrics", rec.phases.metrics, [&] { return compute_metrics(plant, *st.query, metric_options); });
   }
@@ -504,6 +508,23 @@ void mesh_export_measure(const TrialSpec& spec, const MesherOptions& mesher, Tri
   for (const auto& [k, v] : st.algo->stats()) rec.algorithm_stats[k] = v;
 }
 
+// The organ pass (variation, then placement) on a copy of the grown plant, when an option asks for it.
+void organ_pass(const TrialSpec& spec, const OrganOptions& options, const Params& given, const MesherOptions& mesher,
+                TrialState& st, PhaseTimer& timer, TrialRecord& rec) {
+  if (spec.organs.empty()) return;
+  OrganPassRecord out;
+  out.options = given.to_json();
+  timer.run("organs", rec.phases.organs, [&] {
+    st.styled = st.algo->plant();
+    vary_organs(*st.styled, options, spec.seed);
+    const PlacementCounts c = place_organs(*st.styled, options, mesher.leaf.get());
+    out.placed = c.placed;
+    out.fallen_back = c.fallen_back;
+    out.dropped = c.dropped;
+  });
+  rec.organs = std::move(out);
+}
+
 }  // namespace
 
 TrialRecord run_trial_record(const TrialSpec& spec, const std::function<void(const Progress&)>& progress,
@@ -513,6 +534,8 @@ TrialRecord run_trial_record(const TrialSpec& spec, const std::function<void(con
   const Params params = checked_params(spec, entry);
   // A custom leaf is read first: a bad file is invalid input before anything is grown.
   const MesherOptions mesher = with_leaf_mesh(spec.mesher);
+  Params organ_params;
+  const OrganOptions organ_options = read_organ_options(spec.organs, &organ_params);
   std::unique_ptr<tbb::global_control> threads;
   if (spec.threads > 0)
     threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
@@ -534,7 +557,8 @@ TrialRecord run_trial_record(const TrialSpec& spec, const std::function<void(con
   const Plant& plant = st.algo->plant();
   if (const std::string bad = plant.validate(); !bad.empty())
     throw std::logic_error(fmt::format("algorithm '{}' produced an invalid plant: {}", spec.algorithm, bad));
-  if (plant_out) *plant_out = plant;
+  organ_pass(spec, organ_options, organ_params, mesher, st, timer, rec);
+  if (plant_out) *plant_out = st.styled ? *st.styled : plant;
   mesh_export_measure(spec, mesher, st, timer, rec);
 
   rusage ru{};

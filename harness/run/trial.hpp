@@ -10,6 +10,7 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include "harness/organs/options.hpp"
 #include "harness/output/mesher.hpp"
 #include "harness/record/record.hpp"
 
@@ -28,6 +29,8 @@ struct TrialSpec {
   float voxel_size = 0.0f;         // 0: automatic (see SceneQueryOptions)
   std::string out_dir;             // empty: measure but write no files
   MesherOptions mesher;
+  // The organ pass after growth (harness/organs/options.hpp), as key=value; empty: the plant as grown.
+  std::vector<std::string> organs;
   // Comparable budgets across algorithms: stop once the plant has this many nodes / this much branch
   // length (0: no budget). Checked after every step.
   std::size_t budget_nodes = 0;

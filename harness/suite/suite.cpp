@@ -104,6 +104,7 @@ class SuiteReader : public JsonPathReader {
   };
   struct AlgoEntry {
     std::string label, name, fault, leaf_obj;
+    std::vector<std::string> organs;  // the organ pass's key=value
     std::vector<std::string> params;
     std::vector<std::pair<std::string, std::vector<json>>> sweep;
     std::vector<json> points;  // explicit sweep points (instead of a product)
@@ -206,7 +207,7 @@ class SuiteReader : public JsonPathReader {
     if (e.is_string()) {
       a.name = e.get<std::string>();
     } else {
-      only_keys(e, path, {"name", "label", "params", "sweep", "fault", "leaf_obj"});
+      only_keys(e, path, {"name", "label", "params", "sweep", "fault", "leaf_obj", "organs"});
       if (!e.contains("name") || !e["name"].is_string()) fail(path + "/name", "expected the algorithm's name");
       a.name = e["name"].get<std::string>();
       a.label = e.value("label", "");
@@ -215,11 +216,12 @@ class SuiteReader : public JsonPathReader {
         if (!e["leaf_obj"].is_string()) fail(path + "/leaf_obj", "expected the path of an OBJ file");
         a.leaf_obj = relative_to_suite(e["leaf_obj"].get<std::string>());
         try {
-          (void)load_leaf_mesh(a.leaf_obj);
+          (void)load_organ_obj(a.leaf_obj);
         } catch (const InputError& err) {
           fail(path + "/leaf_obj", err.what());
         }
       }
+      if (e.contains("organs")) read_organs(e["organs"], path + "/organs", a);
     }
     const AlgorithmEntry* entry = nullptr;
     try {
@@ -244,6 +246,25 @@ class SuiteReader : public JsonPathReader {
     }
     if (e.is_object() && e.contains("sweep")) read_sweep(e["sweep"], path, p, a);
     return a;
+  }
+
+  // The organ options, checked now as every other input is.
+  void read_organs(const json& o, const std::string& path, AlgoEntry& a) const {
+    if (!o.is_object()) fail(path, "expected an object of organ options (see `growbench list`)");
+    Params p("organ options", organ_param_specs());
+    for (const auto& [k, v] : o.items()) {
+      try {
+        p.set_json(k, v);
+      } catch (const InputError& err) {
+        fail(path + "/" + k, err.what());
+      }
+      a.organs.push_back(k + "=" + value_text(v));
+    }
+    try {
+      (void)read_organ_options(a.organs);
+    } catch (const InputError& err) {
+      fail(path, err.what());
+    }
   }
 
   // Every swept value is checked against the entry's parameters `p`.
@@ -305,6 +326,7 @@ class SuiteReader : public JsonPathReader {
             c.spec.budget_length_m = common.budget_length;
             c.spec.fault = a.fault;
             c.spec.mesher.leaf_obj = a.leaf_obj;
+            c.spec.organs = a.organs;
             std::size_t rest = point;
             std::vector<std::string> parts;
             auto assign = [&](const std::string& k, const json& val) {
@@ -349,7 +371,8 @@ std::string csv_row(const std::vector<std::string>& cells) {
 }
 
 // The CSV's phase columns, in the order trials run them.
-const std::vector<std::string> kPhases = {"scene_load", "query_build", "growth", "meshing", "export", "metrics"};
+const std::vector<std::string> kPhases = {"scene_load", "query_build", "growth", "organs",
+                                          "meshing",    "export",      "metrics"};
 
 // A number as the JSON has it ("" when absent), so the CSV and results.json agree digit for digit.
 template <class T>

@@ -55,7 +55,7 @@ TEST(Mesher, CustomLeafFromObj) {
   const std::string leaf = test::write_text(dir / "leaf.obj",
                                             "v 0 0 0.5\nv 0.2 0 1.5\nv 0 0 2.5\nv -0.2 0 1.5\nv 0 0.1 1.5\n"
                                             "f 1 2 3\nf 1 3 4\nf 1 5 3\n");
-  const TriangleMesh m = load_leaf_mesh(leaf);
+  const TriangleMesh m = load_organ_obj(leaf).mesh;
   ASSERT_EQ(m.triangles.size(), 3u);
   EXPECT_FLOAT_EQ(m.vertices[0].z, 0.0f);
   EXPECT_FLOAT_EQ(m.vertices[2].z, 1.0f);
@@ -66,7 +66,7 @@ TEST(Mesher, CustomLeafFromObj) {
   const OutputMesh mesh = mesh_plant(y_plant(), with_leaf_mesh(o));
   ASSERT_EQ(mesh.groups.size(), 2u);
   EXPECT_EQ(mesh.groups[1].triangle_count, 6u);
-  EXPECT_EQ(organ_shape(with_leaf_mesh(o)).triangles.size(), 3u);
+  EXPECT_EQ(with_leaf_mesh(o).leaf->mesh.triangles.size(), 3u);
   // A leaf of size 0.1 at (0, 2, 0) with the identity frame spans z 0..0.1 there.
   float zmax = -1.0f;
   for (std::uint32_t t = mesh.groups[1].first_triangle; t < mesh.groups[1].first_triangle + 3; ++t)
@@ -75,7 +75,7 @@ TEST(Mesher, CustomLeafFromObj) {
   // Bad leaves are errors that name the file and what was expected.
   auto message = [](const std::string& path) {
     try {
-      (void)load_leaf_mesh(path);
+      (void)load_organ_obj(path);
     } catch (const std::exception& e) {
       return std::string(e.what());
     }

@@ -211,7 +211,8 @@ struct Reference {
   const MetricOptions o;
   MetricDetails d;
   nlohmann::json m;
-  const TriangleMesh shape = organ_shape();  // the leaf's blade, placed by hand here, not through the mesher
+  const TriangleMesh shape =
+      builtin_organ_shape("leaf").mesh;  // the leaf's blade, placed by hand here, not through the mesher
   std::size_t borderline = 0, checked = 0;
 
   Reference(const Scene& scene, const SceneQuery& q, const Plant& plant)

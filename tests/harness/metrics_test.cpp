@@ -151,7 +151,7 @@ TEST(Metrics, SelfIntersectionAndLeafOverlapMatchAllPairs) {
       }
     }
   // Every pair of leaves, every pair of their blades' triangles.
-  const TriangleMesh shape = organ_shape();
+  const TriangleMesh shape = builtin_organ_shape("leaf").mesh;
   std::size_t overlapping = 0;
   for (std::size_t i = 0; i < p.organs.size(); ++i) {
     bool meets = false;

@@ -248,10 +248,14 @@ TEST(PovWriter, WritesEveryPartInPovRayHandedness) {
   EXPECT_EQ(bytes, pov.size());
   EXPECT_NE(pov.find("#version 3.7;"), std::string::npos);
   EXPECT_NE(pov.find("assumed_gamma 1.0"), std::string::npos);
-  EXPECT_EQ(count_of(pov, "\n  cone {"), p.nodes.size() - 1);     // one per segment
-  EXPECT_EQ(count_of(pov, "\n  sphere {"), p.nodes.size());       // every joint and tip, and the root (it has children)
-  EXPECT_EQ(count_of(pov, "#declare GB_OrganShape"), 1u);         // one declared leaf mesh ...
-  EXPECT_EQ(count_of(pov, "object { GB_OrganShape matrix"), 5u);  // ... instanced per organ
+  EXPECT_EQ(count_of(pov, "\n  cone {"), p.nodes.size() - 1);  // one per segment
+  EXPECT_EQ(count_of(pov, "\n  sphere {"), p.nodes.size());    // every joint and tip, and the root (it has children)
+  EXPECT_EQ(count_of(pov, " =  // "), 2u);  // one declared mesh per shape, the leaf's and the blossom's ...
+  EXPECT_EQ(count_of(pov, "#declare GB_Organ0 =  // leaf"), 1u);
+  EXPECT_EQ(count_of(pov, "#declare GB_Organ1 =  // blossom"), 1u);
+  EXPECT_EQ(count_of(pov, "object { GB_Organ0 matrix"), 4u);  // ... instanced per organ: the leaves plain,
+  // the blossom in its own petal colour (linear: the sRGB 0.97, 0.78, 0.84 of organ_shapes.cpp).
+  EXPECT_EQ(count_of(pov, "object { GB_Organ1 texture { pigment { rgb <0.9331,0.5705,0.6739> }"), 1u);
   EXPECT_NE(pov.find("texture { GB_Flower }"), std::string::npos);
   // Right-handed to left-handed: z negated. The root at (0, 0.1, 0.2) and the camera at z = 4.
   EXPECT_NE(pov.find("sphere { <0,0.1,-0.2>,0.04 }"), std::string::npos);

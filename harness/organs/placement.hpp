@@ -1,0 +1,40 @@
+// The organ pass after growth (options.hpp): variation, then placement. Shared by every algorithm.
+#pragma once
+
+#include <cstdint>
+
+#include "algorithms/plant.hpp"
+#include "harness/organs/options.hpp"
+#include "algorithms/organ_shapes.hpp"
+
+namespace growbench {
+
+struct PlacementCounts {
+  std::uint64_t placed = 0;       // as grown (after variation)
+  std::uint64_t fallen_back = 0;  // placed as their fallback
+  std::uint64_t dropped = 0;      // neither fitted
+};
+
+// Scales, turns and tints each organ by counter-based draws from `seed` and its index (the same plant
+// for any thread count), and alternates blooms when asked. Adds to plant.organ_shapes what it uses.
+void vary_organs(Plant& plant, const OrganOptions& options, std::uint64_t seed);
+
+// With placement=avoid: visits the organs in the plant's order and keeps each whose oriented box meets
+// neither the box of an organ kept before it nor a branch segment's capsule other than its own stem
+// (the segments ending or starting at its node); otherwise its fallback under the same test; otherwise
+// it is dropped. The boxes hold the shapes' triangles, so kept leaves never overlap by the
+// leaf_overlap metric's test. The candidate pairs are found in parallel with a k-d tree, then one
+// sequential sweep decides: O(n log n) and deterministic. With placement=free, only counts.
+PlacementCounts place_organs(Plant& plant, const OrganOptions& options, const OrganShape* custom_leaf = nullptr);
+
+// An organ's oriented box: the shape's bounds in the organ's frame, scaled by its size and padded by
+// `pad` in every direction.
+struct OrientedBox {
+  glm::dvec3 centre{0.0}, axis[3]{}, half{0.0};
+};
+OrientedBox organ_box(const Organ& organ, const OrganShape& shape, double pad);
+bool boxes_overlap(const OrientedBox& a, const OrientedBox& b);
+// Whether the capsule from p to q with radius r meets the box.
+bool capsule_meets_box(const glm::dvec3& p, const glm::dvec3& q, double r, const OrientedBox& box);
+
+}  // namespace growbench

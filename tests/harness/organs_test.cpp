@@ -1,0 +1,295 @@
+// Organ shapes, the organ pass (variation, avoid placement) and what the mesher makes of them.
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include <glm/gtc/quaternion.hpp>
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include "algorithms/organ_shapes.hpp"
+#include "core/random.hpp"
+#include "harness/organs/placement.hpp"
+#include "harness/output/exporters.hpp"
+#include "harness/output/mesher.hpp"
+#include "scenes/geometry.hpp"
+#include "test_util.hpp"
+
+namespace growbench {
+namespace {
+
+float max_radial(const OrganShape& s) {
+  float r = 0.0f;
+  for (const auto& v : s.mesh.vertices) r = std::max(r, std::hypot(v.x, v.y));
+  return r;
+}
+
+TEST(OrganShapes, BuiltinsHaveTheirSizeAndSettings) {
+  const OrganShape leaf = builtin_organ_shape("leaf");
+  EXPECT_EQ(leaf.mesh.triangles.size(), 2u);
+  EXPECT_EQ(leaf.box_min, glm::vec3(-0.25f, 0.0f, 0.0f));
+  EXPECT_EQ(leaf.box_max, glm::vec3(0.25f, 0.0f, 1.0f));
+  for (const auto& n : leaf.normals) EXPECT_EQ(n, glm::vec3(0, 1, 0));  // the upper side, +Y
+  // A blossom is 1 across at most, its petals tilted forward by `cup`; five petals of ten triangles.
+  const OrganShape open = builtin_organ_shape("blossom");
+  EXPECT_EQ(open.mesh.triangles.size(), 50u);
+  EXPECT_LE(max_radial(open), 0.5f);
+  EXPECT_GE(max_radial(open), 0.48f);
+  const OrganShape half = builtin_organ_shape("half_bloom");
+  EXPECT_LT(max_radial(half), 0.5f * max_radial(open) * 1.5f);
+  EXPECT_GT(half.box_max.z, open.box_max.z);  // cupped forward
+  EXPECT_EQ(builtin_organ_shape("blossom:petals=7,cup=0").mesh.triangles.size(), 70u);
+  EXPECT_NEAR(builtin_organ_shape("blossom:cup=0").box_max.z, 0.04f, 1e-6f);  // flat: the petals' plane
+  const OrganShape bud = builtin_organ_shape("bud");
+  EXPECT_FLOAT_EQ(bud.box_min.z, 0.0f);
+  EXPECT_FLOAT_EQ(bud.box_max.z, 1.0f);
+  EXPECT_TRUE(bud.mesh.is_closed());
+  EXPECT_TRUE(open.has_color && bud.has_color && !leaf.has_color);
+  // Bad names and settings name what was asked and what is allowed.
+  EXPECT_NE(test::error_of([] {
+              builtin_organ_shape("rose", "organ_k");
+            }).find("organ_k: unknown organ shape 'rose'; expected one of leaf, blossom, half_bloom, bud"),
+            std::string::npos);
+  EXPECT_NE(test::error_of([] {
+              builtin_organ_shape("blossom:petals=40");
+            }).find("'blossom:petals=40': petals must be in [3, 12], got 40"),
+            std::string::npos);
+  EXPECT_NE(test::error_of([] { builtin_organ_shape("bud:petals=5"); }).find("unknown setting 'petals'"),
+            std::string::npos);
+  EXPECT_NE(test::error_of([] { builtin_organ_shape("leaf:width"); }).find("expected settings as key=number"),
+            std::string::npos);
+}
+
+Organ organ_at(glm::vec3 p, float size, OrganKind kind = OrganKind::Leaf, glm::quat q = glm::quat(1, 0, 0, 0)) {
+  Organ o;
+  o.position = p;
+  o.size = size;
+  o.kind = kind;
+  o.orientation = q;
+  return o;
+}
+
+OrganOptions options(std::vector<std::string> set) {
+  return read_organ_options(set);
+}
+
+// Whether two kept organs' triangles meet, by the leaf_overlap metric's own test. Organs of size s lie
+// within s of their position, so farther pairs are skipped.
+bool meet(const OrganShapes& shapes, const Organ& a, const Organ& b) {
+  if (glm::length(a.position - b.position) > a.size + b.size) return false;
+  for (const auto& t : shapes.of(a).mesh.triangles)
+    for (const auto& u : shapes.of(b).mesh.triangles) {
+      const glm::vec3 ta[3] = {organ_point(a, shapes.of(a).mesh.vertices[t.x]),
+                               organ_point(a, shapes.of(a).mesh.vertices[t.y]),
+                               organ_point(a, shapes.of(a).mesh.vertices[t.z])};
+      const glm::vec3 tb[3] = {organ_point(b, shapes.of(b).mesh.vertices[u.x]),
+                               organ_point(b, shapes.of(b).mesh.vertices[u.y]),
+                               organ_point(b, shapes.of(b).mesh.vertices[u.z])};
+      if (geom::triangles_overlap(ta, tb)) return true;
+    }
+  return false;
+}
+
+TEST(OrganPlacement, ALeafThatDoesNotFitFallsBackOrIsDropped) {
+  Plant p;
+  p.organs.push_back(organ_at({0, 0, 0}, 1.0f));
+  // Pointing back at the first from z = 1.3, in its plane: it reaches z = 0.3, into the first blade; at a
+  // quarter of its size it reaches only z = 1.05, past the first's tip.
+  const glm::quat back = glm::angleAxis(glm::radians(180.0f), glm::vec3(0, 1, 0));
+  p.organs.push_back(organ_at({0, 0, 1.3f}, 1.0f, OrganKind::Leaf, back));
+  p.organs.push_back(organ_at({0, 0, 0}, 1.0f));  // the first again: no size of it fits
+  Plant free = p;
+  EXPECT_EQ(place_organs(free, options({})).placed, 3u);
+  const PlacementCounts c = place_organs(p, options({"placement=avoid", "fallback_leaf=0.25"}));
+  EXPECT_EQ(c.placed, 1u);
+  EXPECT_EQ(c.fallen_back, 1u);
+  EXPECT_EQ(c.dropped, 1u);
+  ASSERT_EQ(p.organs.size(), 2u);
+  EXPECT_FLOAT_EQ(p.organs[1].size, 0.25f);
+  // Without a fallback the second is dropped as well.
+  Plant q = free;
+  EXPECT_EQ(place_organs(q, options({"placement=avoid", "fallback_leaf=0"})).dropped, 2u);
+}
+
+TEST(OrganPlacement, LeavesOfOneTuftMayShareTheirBase) {
+  // Three leaves from one point, 120 degrees apart: they touch at the stem and nowhere else.
+  Plant p;
+  for (int k = 0; k < 3; ++k)
+    p.organs.push_back(
+        organ_at({0, 0, 0}, 1.0f, OrganKind::Leaf, glm::angleAxis(glm::radians(120.0f * k), glm::vec3(0, 1, 0))));
+  EXPECT_EQ(place_organs(p, options({"placement=avoid"})).placed, 3u);
+}
+
+TEST(OrganPlacement, AFlowerThroughABranchFallsBackToABud) {
+  // A branch passes through the blossom's petals 0.35 from its axis, outside the bud's body.
+  Plant p;
+  p.nodes.push_back({glm::vec3(0.35f, 0.0f, -0.5f), 0.01f, kNoParent, 0, 0, 0});
+  p.nodes.push_back({glm::vec3(0.35f, 0.0f, 1.0f), 0.01f, 0, 0, 0, 0});
+  p.organs.push_back(organ_at({0, 0, 0}, 1.0f, OrganKind::Flower));
+  const PlacementCounts c = place_organs(p, options({"placement=avoid"}));
+  EXPECT_EQ(c.fallen_back, 1u);
+  ASSERT_EQ(p.organs.size(), 1u);
+  EXPECT_EQ(p.organs[0].kind, OrganKind::Bud);
+  EXPECT_EQ(p.organ_shapes.at(p.organs[0].shape), "bud");
+  // Its own stem does not count: the same branch ending at the flower's node leaves it as it is.
+  Plant own;
+  own.nodes = p.nodes;
+  own.organs.push_back(organ_at({0, 0, 0}, 1.0f, OrganKind::Flower));
+  own.organs[0].node = 1;
+  EXPECT_EQ(place_organs(own, options({"placement=avoid"})).placed, 1u);
+  // fallback_flower=none drops it.
+  Plant none;
+  none.nodes = p.nodes;
+  none.organs.push_back(organ_at({0, 0, 0}, 1.0f, OrganKind::Flower));
+  EXPECT_EQ(place_organs(none, options({"placement=avoid", "fallback_flower=none"})).dropped, 1u);
+}
+
+// A crowd of leaves and flowers at random, dense enough that most meet another.
+Plant crowd(std::size_t n, float box) {
+  Plant p;
+  Rng rng(7, 1);
+  for (std::size_t i = 0; i < n; ++i) {
+    const glm::vec3 at(rng.uniform(0, box), rng.uniform(0, box), rng.uniform(0, box));
+    const glm::quat q =
+        glm::normalize(glm::quat(static_cast<float>(rng.uniform(-1, 1)), static_cast<float>(rng.uniform(-1, 1)),
+                                 static_cast<float>(rng.uniform(-1, 1)), static_cast<float>(rng.uniform(-1, 1))));
+    p.organs.push_back(organ_at(at, 0.1f, i % 4 == 3 ? OrganKind::Flower : OrganKind::Leaf, q));
+  }
+  return p;
+}
+
+TEST(OrganPlacement, KeptOrgansNeverMeetAndTheResultIsTheSameForAnyThreadCount) {
+  const Plant grown = crowd(1500, 0.6f);
+  Plant one = grown, two = grown;
+  PlacementCounts c1, c2;
+  {
+    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, 1);
+    c1 = place_organs(one, options({"placement=avoid"}));
+  }
+  {
+    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, 2);
+    c2 = place_organs(two, options({"placement=avoid"}));
+  }
+  EXPECT_EQ(one.geometry_hash(), two.geometry_hash());
+  EXPECT_EQ(c1.placed, c2.placed);
+  EXPECT_EQ(c1.placed + c1.fallen_back + c1.dropped, grown.organs.size());
+  EXPECT_GT(c1.fallen_back, 0u);
+  EXPECT_GT(c1.dropped, 0u);
+  // Every pair of kept organs, by brute force with the metric's triangle test.
+  const OrganShapes shapes(one);
+  std::size_t meeting = 0;
+  for (std::size_t i = 0; i < one.organs.size(); ++i)
+    for (std::size_t j = i + 1; j < one.organs.size(); ++j) meeting += meet(shapes, one.organs[i], one.organs[j]);
+  EXPECT_EQ(meeting, 0u);
+  // As grown, many do.
+  const OrganShapes all(grown);
+  std::size_t before = 0;
+  for (std::size_t i = 0; i < 300; ++i)
+    for (std::size_t j = i + 1; j < grown.organs.size(); ++j) before += meet(all, grown.organs[i], grown.organs[j]);
+  EXPECT_GT(before, 50u);
+}
+
+TEST(OrganVariation, DrawsStayInTheirRangesAndRepeat) {
+  Plant p = crowd(400, 1.0f);
+  const auto opt = options({"scale_min=0.5", "scale_max=1.5", "roll_deg=30", "tilt_deg=10", "color_jitter=0.2"});
+  Plant a = p, b = p;
+  vary_organs(a, opt, 3);
+  {
+    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, 1);
+    vary_organs(b, opt, 3);
+  }
+  EXPECT_EQ(a.geometry_hash(), b.geometry_hash());
+  Plant c = p;
+  vary_organs(c, opt, 4);
+  EXPECT_NE(a.geometry_hash(), c.geometry_hash());
+  float lo = 2.0f, hi = 0.0f;
+  for (std::size_t i = 0; i < a.organs.size(); ++i) {
+    const float s = a.organs[i].size / p.organs[i].size;
+    lo = std::min(lo, s);
+    hi = std::max(hi, s);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_GE(a.organs[i].tint[k], 0.8f - 1e-6f);
+      EXPECT_LE(a.organs[i].tint[k], 1.2f + 1e-6f);
+    }
+    // The roll turns about the stem: the blade's direction moves by at most the tilt.
+    const glm::vec3 h0 = p.organs[i].orientation * glm::vec3(0, 0, 1),
+                    h1 = a.organs[i].orientation * glm::vec3(0, 0, 1);
+    EXPECT_LE(std::acos(std::clamp(glm::dot(h0, h1), -1.0f, 1.0f)), glm::radians(10.0f) + 1e-3f);
+  }
+  EXPECT_LT(lo, 0.6f);
+  EXPECT_GT(hi, 1.4f);
+  EXPECT_TRUE(a.validate().empty()) << a.validate();
+}
+
+TEST(OrganVariation, AlternateBloomTurnsEverySecondBlossom) {
+  Plant p;
+  for (int i = 0; i < 5; ++i) p.organs.push_back(organ_at({float(i), 0, 0}, 0.1f, OrganKind::Flower));
+  p.organs.insert(p.organs.begin() + 1, organ_at({9, 0, 0}, 0.1f, OrganKind::Leaf));
+  vary_organs(p, options({"alternate_bloom=true"}), 1);
+  const OrganShapes shapes(p);
+  std::vector<std::string> names;
+  for (const auto& o : p.organs) names.push_back(shapes.of(o).name);
+  EXPECT_EQ(names, (std::vector<std::string>{"blossom", "leaf", "half_bloom", "blossom", "half_bloom", "blossom"}));
+}
+
+TEST(OrganOptions, BadValuesNameTheKey) {
+  EXPECT_NE(test::error_of([] { options({"placement=tidy"}); }).find("placement"), std::string::npos);
+  EXPECT_NE(test::error_of([] {
+              options({"scale_min=2", "scale_max=1"});
+            }).find("scale_min 2 is above scale_max 1"),
+            std::string::npos);
+  EXPECT_NE(test::error_of([] {
+              options({"fallback_flower=tulip"});
+            }).find("organ option fallback_flower: unknown organ shape 'tulip'"),
+            std::string::npos);
+  EXPECT_FALSE(options({}).active());
+  EXPECT_TRUE(options({"placement=avoid"}).active());
+}
+
+TEST(OrganMesher, ColouredOrgansGiveEveryVertexAColour) {
+  Plant plain;
+  plain.organs.push_back(organ_at({0, 0, 0}, 1.0f));
+  EXPECT_TRUE(mesh_plant(plain).colors.empty());  // plain leaves: no colours written
+  Plant p;
+  p.nodes.push_back({glm::vec3(0.0f), 0.01f, kNoParent, 0, 0, 0});
+  p.nodes.push_back({glm::vec3(0, 1, 0), 0.01f, 0, 0, 0, 0});
+  p.organs.push_back(organ_at({0, 1, 0}, 0.2f, OrganKind::Flower));
+  p.organs.push_back(organ_at({0, 1, 0}, 0.2f));
+  p.organs[1].tint = glm::vec3(0.5f, 1.0f, 1.0f);
+  const OutputMesh m = mesh_plant(p);
+  ASSERT_EQ(m.colors.size(), m.positions.size());
+  const glm::vec3 bark = srgb_to_linear(material_srgb("bark"));
+  const glm::vec3 leaf = srgb_to_linear(organ_kind_srgb(OrganKind::Leaf)) * glm::vec3(0.5f, 1.0f, 1.0f);
+  const glm::vec3 petal = srgb_to_linear(builtin_organ_shape("blossom").srgb);
+  const auto& g = m.groups;
+  ASSERT_EQ(g.size(), 3u);
+  EXPECT_EQ(m.colors[m.triangles[g[0].first_triangle].x], bark);
+  EXPECT_EQ(m.colors[m.triangles[g[1].first_triangle].x], leaf);
+  EXPECT_EQ(m.colors[m.triangles[g[2].first_triangle].x], petal);
+  EXPECT_EQ(g[2].triangle_count, 50u);
+}
+
+TEST(OrganSnapshot, ShapesAndTintsSurviveTheRoundTrip) {
+  const auto dir = test::temp_dir("organ_snapshot");
+  Plant p;
+  p.organs.push_back(organ_at({0, 0, 0}, 0.3f, OrganKind::Flower));
+  p.organs.push_back(organ_at({1, 0, 0}, 0.2f, OrganKind::Bud));
+  p.organ_shapes = {"half_bloom", "bud:width=0.2"};
+  p.organs[0].shape = 0;
+  p.organs[0].tint = glm::vec3(1.1f, 0.9f, 1.0f);
+  const std::string path = (dir / "p.gbplant").string();
+  write_plant_snapshot(path, p);
+  const Plant q = read_plant_snapshot(path);
+  EXPECT_EQ(q.organ_shapes, p.organ_shapes);
+  EXPECT_EQ(q.organs[0].shape, 0u);
+  EXPECT_EQ(q.organs[1].shape, kKindShape);
+  EXPECT_EQ(q.organs[0].tint, p.organs[0].tint);
+  EXPECT_EQ(q.geometry_hash(), p.geometry_hash());
+  // A shape index past the names is the plant's own check, through the reader.
+  Plant bad = p;
+  bad.organs[1].shape = 7;
+  EXPECT_NE(bad.validate().find("organ 1 has shape 7 of 2"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace growbench
