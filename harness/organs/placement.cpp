@@ -96,18 +96,43 @@ struct Candidate {
 
 // Whether two candidates' shapes intersect, triangle by triangle, as the leaf_overlap metric tests
 // them (geom::triangles_overlap on the triangles organ_point places): organs that only touch, such as
-// leaves of one tuft sharing their base, do not.
+// leaves of one tuft sharing their base, do not. Only triangles whose bounds meet the other organ's are
+// paired: disjoint bounds cannot hold a shared point, so this changes no verdict.
 bool shapes_meet(const Candidate& a, const Candidate& b) {
-  thread_local std::vector<glm::vec3> va, vb;
-  va.clear();
-  vb.clear();
-  for (const auto& v : a.shape->mesh.vertices) va.push_back(organ_point(a.as, v));
-  for (const auto& v : b.shape->mesh.vertices) vb.push_back(organ_point(b.as, v));
-  for (const auto& t : a.shape->mesh.triangles) {
-    const glm::vec3 ta[3] = {va[t.x], va[t.y], va[t.z]};
-    for (const auto& u : b.shape->mesh.triangles) {
-      const glm::vec3 tb[3] = {vb[u.x], vb[u.y], vb[u.z]};
-      if (geom::triangles_overlap(ta, tb)) return true;
+  struct Placed {
+    std::vector<glm::vec3> v;
+    std::vector<Aabb> box;  // per triangle
+    Aabb all;
+  };
+  thread_local Placed pa, pb;
+  auto place = [](const Candidate& c, Placed& p) {
+    p.v.clear();
+    p.box.clear();
+    p.all = Aabb{};
+    for (const auto& v : c.shape->mesh.vertices) p.v.push_back(organ_point(c.as, v));
+    for (const auto& t : c.shape->mesh.triangles) {
+      Aabb b;
+      for (int k = 0; k < 3; ++k) b.extend(p.v[t[k]]);
+      p.box.push_back(b);
+      p.all.extend(b.min);
+      p.all.extend(b.max);
+    }
+  };
+  auto disjoint = [](const Aabb& x, const Aabb& y) {
+    return glm::any(glm::lessThan(x.max, y.min)) || glm::any(glm::lessThan(y.max, x.min));
+  };
+  place(a, pa);
+  place(b, pb);
+  if (disjoint(pa.all, pb.all)) return false;
+  const auto& ta = a.shape->mesh.triangles;
+  const auto& tb = b.shape->mesh.triangles;
+  for (std::size_t i = 0; i < ta.size(); ++i) {
+    if (disjoint(pa.box[i], pb.all)) continue;
+    const glm::vec3 x[3] = {pa.v[ta[i].x], pa.v[ta[i].y], pa.v[ta[i].z]};
+    for (std::size_t j = 0; j < tb.size(); ++j) {
+      if (disjoint(pa.box[i], pb.box[j])) continue;
+      const glm::vec3 y[3] = {pb.v[tb[j].x], pb.v[tb[j].y], pb.v[tb[j].z]};
+      if (geom::triangles_overlap(x, y)) return true;
     }
   }
   return false;
@@ -273,31 +298,44 @@ struct Placement {
 
   // For each candidate, the candidates of earlier organs whose boxes it meets (CSR by candidate).
   void conflicts(std::vector<std::uint32_t>& offset, std::vector<std::uint32_t>& other) const {
-    std::vector<glm::vec3> centres(cand.size());
-    double rmax = 0.0;
-    for (std::size_t k = 0; k < cand.size(); ++k) {
-      centres[k] = glm::vec3(cand[k].box.centre);
-      rmax = std::max(rmax, cand[k].reach);
+    // A tree of the organs (their own boxes' centres); each organ's `spread` reaches the farthest point
+    // of any of its candidates' boxes, so two organs whose candidates can meet are within the sum.
+    const std::size_t organs = first.size() - 1;
+    std::vector<glm::vec3> centres(organs);
+    std::vector<double> spread(organs, 0.0);
+    double smax = 0.0;
+    for (std::size_t i = 0; i < organs; ++i) {
+      const std::uint32_t k0 = first[i];
+      centres[i] = glm::vec3(cand[k0].box.centre);
+      for (std::uint32_t k = k0; k < first[i + 1]; ++k)
+        spread[i] = std::max(spread[i], glm::length(cand[k].box.centre - cand[k0].box.centre) + cand[k].reach);
+      smax = std::max(smax, spread[i]);
     }
     Vec3Cloud cloud{&centres};
-    Vec3Tree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-    // Fixed chunks, joined in order: the lists do not depend on the thread count.
-    constexpr std::size_t kChunk = 2048;
-    const std::size_t chunks = (cand.size() + kChunk - 1) / kChunk;
+    Vec3Tree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(8));
+    // Fixed chunks of organs, joined in order: the lists do not depend on the thread count.
+    constexpr std::size_t kChunk = 1024;
+    const std::size_t chunks = (organs + kChunk - 1) / kChunk;
     std::vector<std::vector<std::uint32_t>> counts(chunks), lists(chunks);
     tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t ch) {
-      for (std::size_t k = ch * kChunk; k < std::min(cand.size(), (ch + 1) * kChunk); ++k) {
-        const Candidate& c = cand[k];
-        std::uint32_t count = 0;
-        kd_visit_within(
-            tree, centres[k], static_cast<float>((c.reach + rmax) * (1.0 + 1e-6)), [&](std::uint32_t j, float) {
-              if (cand[j].organ >= c.organ || !boxes_overlap(c.box, cand[j].box) || !shapes_meet(c, cand[j]))
-                return true;
-              lists[ch].push_back(j);
-              ++count;
-              return true;
-            });
-        counts[ch].push_back(count);
+      std::vector<std::uint32_t> found[2];
+      for (std::size_t i = ch * kChunk; i < std::min(organs, (ch + 1) * kChunk); ++i) {
+        const std::uint32_t k0 = first[i], k1 = first[i + 1];
+        found[0].clear();
+        found[1].clear();
+        kd_visit_within(tree, centres[i], static_cast<float>((spread[i] + smax) * (1.0 + 1e-6)),
+                        [&](std::uint32_t o, float d2) {
+                          if (o >= i || std::sqrt(d2) > (spread[i] + spread[o]) * (1.0 + 1e-6)) return true;
+                          for (std::uint32_t j = first[o]; j < first[o + 1]; ++j)
+                            for (std::uint32_t k = k0; k < k1; ++k)
+                              if (boxes_overlap(cand[k].box, cand[j].box) && shapes_meet(cand[k], cand[j]))
+                                found[k - k0].push_back(j);
+                          return true;
+                        });
+        for (std::uint32_t k = k0; k < k1; ++k) {
+          counts[ch].push_back(static_cast<std::uint32_t>(found[k - k0].size()));
+          lists[ch].insert(lists[ch].end(), found[k - k0].begin(), found[k - k0].end());
+        }
       }
     });
     offset.assign(1, 0);
