@@ -643,6 +643,7 @@ void put_fields(json& j, const CellResults& v) {
   put(j, "scene_hash", v.scene_hash);
   put(j, "alloc", v.alloc);
   put(j, "instructions", v.instructions);
+  put(j, "organs", v.organs);
 }
 void read_fields(Fields& f, CellResults& v) {
   f.field("geometry_hash", v.geometry_hash);
@@ -659,6 +660,7 @@ void read_fields(Fields& f, CellResults& v) {
   f.field("scene_hash", v.scene_hash);
   f.field("alloc", v.alloc);
   f.field("instructions", v.instructions);
+  f.field("organs", v.organs);
 }
 
 }  // namespace

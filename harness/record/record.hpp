@@ -242,6 +242,7 @@ struct CellResults {
   std::optional<std::string> scene_hash;
   std::optional<AllocByPhase> alloc;
   std::optional<InstructionCounts> instructions;
+  std::optional<OrganPassRecord> organs;  // the organ pass's counts, when it ran
 };
 
 // A median and its distribution-free 95% interval (median_interval in harness/stats/stats.hpp).

@@ -486,6 +486,7 @@ CellResults cell_results_of(const TrialRecord& rec, bool first, const std::optio
   });
   c.alloc = alloc;
   c.instructions = instructions;
+  c.organs = rec.organs;
   return c;
 }
 
