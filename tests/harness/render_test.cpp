@@ -803,9 +803,11 @@ TEST(RenderCli, DecalImagesAreReadBesideTheirSnapshotsAndAreNotAnimationFrames) 
   ro.render.width = 64;
   ro.render.height = 48;
   ro.quiet = true;
+  ro.turntable = 2;  // its frames, in turntable/, read the run's decal image beside plant.gbplant
   const RenderSummary summary = render_directory_record(dir.string(), ro);
   EXPECT_EQ(summary.failed, 0u);
-  EXPECT_EQ(summary.ok, frames + 1);
+  EXPECT_EQ(summary.ok, frames + 1 + 2);
+  EXPECT_NE(read_file(dir / "turntable" / "frame_0001.pov").find("png \"vine.png\""), std::string::npos);
   EXPECT_EQ(summary.warnings, 0u);
   EXPECT_NE(read_file(dir / "frames" / "step_000010.pov").find("png \"step_000010.vine.png\""), std::string::npos);
   EXPECT_NE(read_file(dir / "render.pov").find("png \"vine.png\""), std::string::npos);
