@@ -52,6 +52,10 @@ double luminance_variance(const Image& im) {
   return s2 / static_cast<double>(n) - (s / static_cast<double>(n)) * (s / static_cast<double>(n));
 }
 
+std::filesystem::path fs_concat(std::filesystem::path p, const std::string& tail) {
+  return p.concat(tail);
+}
+
 std::string read_file(const std::filesystem::path& p) {
   std::ifstream in(p);
   std::stringstream ss;
@@ -774,6 +778,65 @@ TEST(RenderCli, RunRendersThePlantAndItsGrowthFrames) {
   const auto bad = test::run_growbench("render " + test::temp_dir("cli_render_empty").string());
   EXPECT_EQ(bad.status, 2);
   EXPECT_NE(bad.out.find("neither a suite results directory"), std::string::npos) << bad.out;
+}
+
+TEST(RenderCli, BadRenderOptionsAreRefusedBeforeTheTrialNamingTheOption) {
+  const auto dir = test::temp_dir("cli_render_bad");
+  const std::string run = "run -q -a spacecol -s wall --set point_count=300 --max-steps 20 -o " + dir.string();
+  for (const auto& [args, option] :
+       std::vector<std::pair<std::string, std::string>>{{" --render preview --camera fish", "--camera"},
+                                                        {" --render preview --backdrop moon", "--backdrop"},
+                                                        {" --render preview --turntable 0", "--turntable"},
+                                                        {" --render preview --turntable -2", "--turntable"},
+                                                        {" --render preview --dof", "--dof"},
+                                                        {" --turntable 3", "--render"}}) {
+    const auto r = test::run_growbench(run + args);
+    EXPECT_EQ(r.status, 2) << args << ": " << r.out;
+    EXPECT_NE(r.out.find(option), std::string::npos) << args << ": " << r.out;
+    EXPECT_FALSE(std::filesystem::exists(dir / "record.json")) << args << ": the plant grew first";
+  }
+  const auto grown = test::run_growbench(run);
+  ASSERT_EQ(grown.status, 0) << grown.out;
+  for (const auto& [args, option] : std::vector<std::pair<std::string, std::string>>{
+           {"--camera fish", "--camera"}, {"--turntable 0", "--turntable"}, {"--dof", "--dof"}}) {
+    const auto r = test::run_growbench("render -q " + args + " " + dir.string());
+    EXPECT_EQ(r.status, 2) << args << ": " << r.out;
+    EXPECT_NE(r.out.find(option), std::string::npos) << args << ": " << r.out;
+  }
+}
+
+TEST(RenderCli, TurntableRendersFramesAroundThePlantAndItsVideo) {
+  const auto dir = test::temp_dir("cli_turntable");
+  const auto run =
+      test::run_growbench("run -q -a spacecol -s wall --set point_count=300 --max-steps 20 -o " + dir.string());
+  ASSERT_EQ(run.status, 0) << run.out;
+  const auto r = test::run_growbench("render --width 64 --height 48 --turntable 4 --backdrop studio " + dir.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("turntable/frame_0003.png: ok"), std::string::npos) << r.out;  // a progress line per frame
+  std::set<std::string> cameras;
+  for (int k = 0; k < 4; ++k) {
+    const auto frame = dir / "turntable" / fmt::format("frame_{:04d}", k);
+    EXPECT_TRUE(std::filesystem::exists(fs_concat(frame, ".png"))) << frame;
+    const std::string pov = read_file(fs_concat(frame, ".pov"));
+    cameras.insert(pov.substr(pov.find("camera {"), pov.find('\n', pov.find("camera {")) - pov.find("camera {")));
+    EXPECT_NE(pov.find("GB_Studio"), std::string::npos);
+  }
+  EXPECT_EQ(cameras.size(), 4u);
+  std::ifstream in(dir / "record.json");
+  const auto rec = nlohmann::json::parse(in);
+  EXPECT_EQ(rec["turntable"]["frames"], 4);
+  EXPECT_EQ(rec["render"]["backdrop"], "studio");
+  EXPECT_TRUE(rec["render"]["camera"] == "fitted" || rec["render"]["camera"] == "scene") << rec["render"].dump();
+  if (std::system("command -v ffmpeg > /dev/null") == 0) {
+    EXPECT_EQ(rec["turntable"]["status"], "ok") << rec["turntable"].dump();
+    EXPECT_TRUE(std::filesystem::exists(dir / "turntable.mp4"));
+  }
+  // A shorter turntable leaves none of the longer one's frames behind.
+  const auto again = test::run_growbench("render -q --width 64 --height 48 --turntable 2 " + dir.string());
+  ASSERT_EQ(again.status, 0) << again.out;
+  EXPECT_TRUE(std::filesystem::exists(dir / "turntable" / "frame_0001.png"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "turntable" / "frame_0002.png"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "turntable" / "frame_0003.pov"));
 }
 
 TEST(RenderCli, DecalImagesAreReadBesideTheirSnapshotsAndAreNotAnimationFrames) {
