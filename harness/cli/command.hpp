@@ -10,7 +10,13 @@
 
 namespace CLI {
 class App;
-}
+class Option;
+}  // namespace CLI
+
+namespace growbench {
+struct RenderDirOptions;
+enum class RenderQuality;
+}  // namespace growbench
 
 namespace growbench::cli {
 
@@ -24,6 +30,20 @@ struct Command {
 // loads them (algorithms/plugins/loader.hpp's load_plugins, which adds GROWBENCH_PLUGIN_PATH's) first
 // thing when it runs.
 void add_plugin_option(CLI::App* cmd, std::vector<std::string>& paths);
+
+// The options of every command that renders (run --render, suite --render, render): --camera, --dof,
+// --backdrop and --turntable, bound to a RenderFlags. When `needs` is given (the command's --render),
+// each requires it. apply_render_flags checks them (InputError naming the option: an unknown camera or
+// backdrop, a turntable of no frames, depth of field in preview quality) and sets them in `o`; commands
+// call it before anything grows or renders.
+struct RenderFlags {
+  std::string camera = "auto", backdrop = "scene";
+  bool dof = false;
+  int turntable = 0;
+  CLI::Option* turntable_option = nullptr;
+};
+void add_render_flags(CLI::App* cmd, RenderFlags& flags, CLI::Option* needs = nullptr);
+void apply_render_flags(const RenderFlags& flags, RenderQuality quality, RenderDirOptions& o);
 
 Command add_list(CLI::App& app);
 Command add_scenes(CLI::App& app);

@@ -15,11 +15,12 @@ namespace {
 
 struct RenderArgs {
   std::string dir, quality = "preview";
+  RenderFlags flags;
   RenderDirOptions options;
 };
 
 int render_dir(RenderArgs& a) {
-  a.options.render.quality = parse_render_quality(a.quality);
+  apply_render_flags(a.flags, parse_render_quality(a.quality), a.options);
   const RenderSummary r = render_directory_record(a.dir, a.options);
   fmt::print("rendered {} images ({} failed, {} POV-Ray warnings) in {:.1f} s with {} POV-Ray processes at once\n",
              r.renders, r.failed, r.warnings, r.wall_s, r.jobs);
@@ -47,6 +48,7 @@ Command add_render(CLI::App& app) {
                   "(the mesher's tubes as mesh2)")
       ->default_val("cones")
       ->check(CLI::IsMember({"cones", "mesh"}));
+  add_render_flags(cmd, a->flags);
   cmd->add_flag("-q,--quiet", a->options.quiet, "no progress lines");
   return {cmd, [a] { return render_dir(*a); }};
 }

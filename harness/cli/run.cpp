@@ -29,6 +29,7 @@ struct RunArgs {
   std::string out_dir;
   bool quiet = false;
   std::string render;
+  RenderFlags render_flags;
 };
 
 glm::vec3 parse_point(const std::string& text) {
@@ -67,23 +68,29 @@ void print_record(const TrialRecord& rec, const TrialSpec& spec, const std::stri
                out_dir, ph.growth.value().frame_capture_wall_s.value());
 }
 
+// What the record says of the render's camera: "" for the scene's, else how the plant was framed.
+std::string camera_note(const RenderRecord& rr) {
+  if (rr.camera.value_or("scene") != "fitted") return "";
+  return fmt::format(", camera fitted: the plant spanned {:.2f} of the scene camera's frame",
+                     rr.scene_extent.value_or(0.0));
+}
+
 // Renders the run directory and reports what the record says of it: 1 when the render failed.
-int render_run(const std::string& out_dir, RenderQuality quality, bool quiet) {
-  RenderDirOptions ro;
-  ro.render.quality = quality;
-  ro.quiet = quiet;
+int render_run(const std::string& out_dir, const RenderDirOptions& ro) {
+  const RenderQuality quality = ro.render.quality;
   const RenderSummary r = render_directory_record(out_dir, ro);
   const std::string record_path = (std::filesystem::path(out_dir) / "record.json").string();
   const TrialRecord updated = read_trial_record(record_path);
   if (!updated.render)
     throw std::runtime_error(fmt::format("{}: at render: expected the render just made, found none", record_path));
   const RenderRecord& rr = *updated.render;
+  auto video = [](const std::optional<AnimationRecord>& a, const char* what) {
+    return a ? fmt::format(", {} {} frames: {}", a->frames, what, a->file.value_or(a->status)) : std::string();
+  };
   if (rr.status == "ok")
-    fmt::print("  rendered {}/render.png ({}x{}, {}) in {:.2f} s of POV-Ray{}\n", out_dir, rr.width, rr.height,
-               to_string(quality), rr.wall_s,
-               updated.animation ? fmt::format(", {} frames: {}", updated.animation->frames,
-                                               updated.animation->file.value_or(updated.animation->status))
-                                 : "");
+    fmt::print("  rendered {}/render.png ({}x{}, {}{}) in {:.2f} s of POV-Ray{}{}\n", out_dir, rr.width, rr.height,
+               to_string(quality), camera_note(rr), rr.wall_s, video(updated.animation, "growth"),
+               ro.turntable > 0 ? video(updated.turntable, "turntable") : "");
   else
     fmt::print(stderr, "growbench: render failed: {}\n", rr.message.value_or(rr.status));
   return r.failed > 0 ? 1 : 0;
@@ -94,8 +101,13 @@ int run_one(RunArgs& a) {
   for (const auto& s : a.seed_at) spec.seed_at.push_back(parse_point(s));
   if (a.out_dir.empty()) a.out_dir = default_out_dir(spec);
   spec.out_dir = a.out_dir;
-  std::optional<RenderQuality> quality;
-  if (!a.render.empty()) quality = parse_render_quality(a.render, "--render");
+  // The render's options are checked before the plant grows, so a bad one costs no growth.
+  std::optional<RenderDirOptions> render;
+  if (!a.render.empty()) {
+    render.emplace();
+    apply_render_flags(a.render_flags, parse_render_quality(a.render, "--render"), *render);
+    render->quiet = a.quiet;
+  }
   const bool tty = isatty(STDERR_FILENO) != 0;
   auto last = std::chrono::steady_clock::now();
   auto progress = [&](const Progress& p) {
@@ -109,7 +121,7 @@ int run_one(RunArgs& a) {
   const TrialRecord rec = run_trial_record(spec, progress);
   if (!a.quiet && isatty(STDERR_FILENO)) fmt::print(stderr, "\r{:60}\r", "");
   print_record(rec, spec, a.out_dir);
-  return quality ? render_run(a.out_dir, *quality, a.quiet) : 0;
+  return render ? render_run(a.out_dir, *render) : 0;
 }
 
 }  // namespace
@@ -147,7 +159,9 @@ Command add_run(CLI::App& app) {
                   "`growbench list organs` lists them");
   run->add_option("-o,--out", a->out_dir, "output directory (default: out/ALGORITHM-SCENE)");
   run->add_flag("-q,--quiet", a->quiet, "no progress line");
-  run->add_option("--render", a->render, "render the plant with POV-Ray afterwards: preview or paper (render.png)");
+  CLI::Option* render =
+      run->add_option("--render", a->render, "render the plant with POV-Ray afterwards: preview or paper (render.png)");
+  add_render_flags(run, a->render_flags, render);
   run->add_option("--frames", spec.frame_every,
                   "growth animation: keep the plant every K steps (frames/); with --render, render them and make "
                   "animation.mp4 with ffmpeg")

@@ -28,6 +28,7 @@ struct SuiteArgs {
   int repetitions = 0;
   bool instructions = false;
   std::string render, history;
+  RenderFlags render_flags;
   std::vector<std::string> plugins;
 };
 
@@ -46,10 +47,7 @@ void parse_shard(const std::string& shard, SuiteRunOptions& o) {
 }
 
 // Renders every trial of the results directory of `results_path`, then the grid.
-void render_suite(const std::string& results_path, RenderQuality quality, bool quiet) {
-  RenderDirOptions ro;
-  ro.render.quality = quality;
-  ro.quiet = quiet;
+void render_suite(const std::string& results_path, const RenderDirOptions& ro) {
   const RenderSummary r = render_directory_record(std::filesystem::path(results_path).parent_path().string(), ro);
   fmt::print("rendered {} trials ({} failed) in {:.0f} s; grid: {}\n", r.renders, r.failed, r.wall_s,
              (std::filesystem::path(results_path).parent_path() / r.grid.value_or("")).string());
@@ -75,13 +73,17 @@ int run_suite_file(const SuiteArgs& a) {
   else
     fmt::print("suite {}: {} cells x {} repetitions (+{} warm-up)\n", suite.name, suite.configs.size(),
                suite.repetitions, suite.warmup);
-  std::optional<RenderQuality> quality;
-  if (!a.render.empty()) quality = parse_render_quality(a.render, "--render");
+  std::optional<RenderDirOptions> render;  // checked before any trial runs
+  if (!a.render.empty()) {
+    render.emplace();
+    apply_render_flags(a.render_flags, parse_render_quality(a.render, "--render"), *render);
+    render->quiet = a.quiet;
+  }
   const std::string path = run_suite(suite, o);
   fmt::print("{}", summarize_results(read_results(path)));
   fmt::print("\nwrote {} and results.csv beside it\n", path);
   if (!a.history.empty()) fmt::print("history: appended to {}\n", history_add(path, a.history));
-  if (quality) render_suite(path, *quality, a.quiet);
+  if (render) render_suite(path, *render);
   return 0;
 }
 
@@ -104,8 +106,9 @@ Command add_suite(CLI::App& app) {
   cmd->add_flag("--instructions", a->instructions,
                 "run each trial once, single-threaded, under valgrind's callgrind, and record instructions per "
                 "phase (the deterministic regression gate: see `growbench compare`)");
-  cmd->add_option("--render", a->render,
-                  "render every trial with POV-Ray afterwards (preview or paper) and compose grid.png");
+  CLI::Option* render = cmd->add_option(
+      "--render", a->render, "render every trial with POV-Ray afterwards (preview or paper) and compose grid.png");
+  add_render_flags(cmd, a->render_flags, render);
   cmd->add_option("--history", a->history,
                   "append the run to this history directory (MACHINE/SUITE/COMMIT.json; see growbench history)");
   return {cmd, [a] { return run_suite_file(*a); }};

@@ -421,6 +421,10 @@ json to_json(const RenderRecord& v) {
             {"write_s", v.write_s},   {"wall_s", v.wall_s},     {"cpu_s", v.cpu_s},   {"quality", v.quality},
             {"branches", v.branches}, {"threads", v.threads}};
   put(j, "message", v.message);
+  put(j, "camera", v.camera);
+  put(j, "scene_extent", v.scene_extent);
+  put(j, "backdrop", v.backdrop);
+  put(j, "dof", v.dof);
   return j;
 }
 void read(const Node& n, RenderRecord& v) {
@@ -440,6 +444,10 @@ void read(const Node& n, RenderRecord& v) {
   f.field("quality", v.quality);
   f.field("branches", v.branches);
   f.field("threads", v.threads);
+  f.field("camera", v.camera);
+  f.field("scene_extent", v.scene_extent);
+  f.field("backdrop", v.backdrop);
+  f.field("dof", v.dof);
   f.done();
 }
 
@@ -489,6 +497,7 @@ json to_json(const TrialRecord& v) {
   put(j, "context", v.context);
   put(j, "render", v.render);
   put(j, "animation", v.animation);
+  put(j, "turntable", v.turntable);
   return j;
 }
 void read(const Node& n, TrialRecord& v) {
@@ -519,6 +528,7 @@ void read(const Node& n, TrialRecord& v) {
   f.field("context", v.context);
   f.field("render", v.render);
   f.field("animation", v.animation);
+  f.field("turntable", v.turntable);
   f.done();
 }
 
@@ -728,6 +738,7 @@ json to_json(const SuiteCell& v) {
   put(j, "summary", v.summary);
   put(j, "render", v.render);
   put(j, "animation", v.animation);
+  put(j, "turntable", v.turntable);
   return j;
 }
 void read(const Node& n, SuiteCell& v) {
@@ -748,6 +759,7 @@ void read(const Node& n, SuiteCell& v) {
   f.field("summary", v.summary);
   f.field("render", v.render);
   f.field("animation", v.animation);
+  f.field("turntable", v.turntable);
   f.done();
 }
 
@@ -801,6 +813,10 @@ json to_json(const RenderSummary& v) {
   put(j, "grid", v.grid);
   put(j, "grid_per_scene", v.grid_per_scene);
   put(j, "grid_error", v.grid_error);
+  put(j, "camera", v.camera);
+  put(j, "backdrop", v.backdrop);
+  put(j, "dof", v.dof);
+  put(j, "turntable", v.turntable);
   return j;
 }
 void read(const Node& n, RenderSummary& v) {
@@ -822,6 +838,10 @@ void read(const Node& n, RenderSummary& v) {
   f.field("grid", v.grid);
   f.field("grid_per_scene", v.grid_per_scene);
   f.field("grid_error", v.grid_error);
+  f.field("camera", v.camera);
+  f.field("backdrop", v.backdrop);
+  f.field("dof", v.dof);
+  f.field("turntable", v.turntable);
   f.done();
 }
 

@@ -130,9 +130,15 @@ struct RenderRecord {
   double write_s = 0.0, wall_s = 0.0, cpu_s = 0.0;
   std::string quality, branches;
   int threads = 0;
+  // The camera it used, "scene" or "fitted" (harness/render/camera.hpp), and the plant's projected extent
+  // with the scene's camera, the figure its auto rule judged; the backdrop (scene | studio) and whether it
+  // had depth of field.
+  std::optional<std::string> camera, backdrop;
+  std::optional<double> scene_extent;
+  std::optional<bool> dof;
 };
 
-// The growth animation made from a trial's frames.
+// The growth animation made from a trial's frames, or a turntable (the camera orbiting the plant).
 struct AnimationRecord {
   std::string status;  // ok | failed | no_ffmpeg
   std::uint64_t frames = 0;
@@ -174,6 +180,7 @@ struct TrialRecord {
   std::optional<RunContext> context;   // absent in a suite's trials (the suite records it once)
   std::optional<RenderRecord> render;  // added by growbench render
   std::optional<AnimationRecord> animation;
+  std::optional<AnimationRecord> turntable;  // growbench render --turntable N: turntable/frame_NNNN.png
 };
 
 // A trial as a suite hands it to its process and stores it in results (harness/run/trial.hpp's TrialSpec,
@@ -278,6 +285,7 @@ struct SuiteCell {
   std::optional<CellSummary> summary;
   std::optional<RenderRecord> render;
   std::optional<AnimationRecord> animation;
+  std::optional<AnimationRecord> turntable;  // growbench render --turntable N: turntable/frame_NNNN.png
 };
 
 struct SuiteInfo {
@@ -303,6 +311,9 @@ struct RenderSummary {
   double povray_s = 0.0, wall_s = 0.0;
   std::optional<std::string> grid, grid_error;
   std::optional<std::map<std::string, std::string>> grid_per_scene;  // scene -> image
+  std::optional<std::string> camera, backdrop;                       // as asked: auto | scene, scene | studio
+  std::optional<bool> dof;
+  std::optional<std::uint64_t> turntable;  // frames per trial
 };
 
 // Growth time over the seeds of one algorithm entry (and sweep point) on one scene: the rows of the

@@ -33,6 +33,25 @@ const char* to_string(RenderQuality q) {
   return q == RenderQuality::Paper ? "paper" : "preview";
 }
 
+Backdrop parse_backdrop(const std::string& text, const std::string& option) {
+  if (text == "scene") return Backdrop::Scene;
+  if (text == "studio") return Backdrop::Studio;
+  throw InputError(fmt::format("{} '{}': expected scene or studio", option, text));
+}
+
+const char* to_string(Backdrop b) {
+  return b == Backdrop::Studio ? "studio" : "scene";
+}
+
+void check_render_options(const RenderOptions& o) {
+  if (o.dof && o.quality != RenderQuality::Paper)
+    throw InputError(
+        "--dof: depth of field is a paper-quality option (a preview stays quick, and focal blur traces many rays a "
+        "pixel); render at paper quality (--render paper, or --quality paper) or leave --dof out");
+  if (o.turns < 0 || (o.turns > 0 && (o.turn < 0 || o.turn >= o.turns)))
+    throw InputError(fmt::format("turntable frame {} of {}: expected 0 <= frame < frames", o.turn, o.turns));
+}
+
 int render_width(const RenderOptions& o) {
   return o.width > 0 ? o.width : o.quality == RenderQuality::Paper ? 1600 : 480;
 }
@@ -197,29 +216,46 @@ void write_settings(Out out, const Scene& scene, const Plant& plant, const Rende
       "#declare GB_Ground = texture {{ pigment {{ checker srgb <0.56,0.55,0.52> srgb <0.62,0.61,0.58> scale {:.4g} }} "
       "}}\n",
       paper ? 0.0 : 0.12, std::max(0.25f, 0.05f * diag));
+  if (o.backdrop == Backdrop::Studio) {
+    // A neutral grey: the sweep, and the background behind it (which radiosity sees as the sky).
+    fmt::format_to(out,
+                   "#declare GB_Studio = texture {{ pigment {{ srgb <0.80,0.80,0.80> }} }}\n"
+                   "background {{ srgb <0.80,0.80,0.80> }}\n");
+    return;
+  }
   fmt::format_to(
       out,
       "sky_sphere {{ pigment {{ gradient y color_map {{ [0.0 srgb <0.93,0.94,0.95>] [0.5 srgb <0.93,0.94,0.95>]\n"
       "  [1.0 srgb <0.50,0.66,0.86>] }} scale 2 translate -1 }} }}\n");
 }
 
-// The scene's camera, with its vertical field of view kept at the image's aspect.
-void write_camera(Out out, const Camera& camera, float aspect) {
+// The render's camera, with its vertical field of view kept at the image's aspect; with depth of field,
+// focused on the subject's centre (camera.hpp's focal_blur). Focal blur samples each pixel at jittered
+// points, so it is anti-aliased without POV-Ray's anti-aliasing (povray_args leaves it off).
+void write_camera(Out out, const RenderView& view, float aspect, bool dof) {
+  const Camera& camera = view.camera;
   const float vfov = glm::radians(camera.fov_deg);
   const float hfov = 2.0f * std::atan(std::tan(0.5f * vfov) * aspect);
   fmt::format_to(out, "camera {{ perspective location ");
   vec(out, pov(camera.position));
   fmt::format_to(out, " look_at ");
   vec(out, pov(camera.look_at));
-  fmt::format_to(out, " right x*{:.6g} up y angle {:.6g} }}\n", aspect, glm::degrees(hfov));
+  fmt::format_to(out, " right x*{:.6g} up y angle {:.6g}", aspect, glm::degrees(hfov));
+  if (const FocalBlur fb = focal_blur(camera, view.subject); dof && fb.aperture > 0.0f) {
+    fmt::format_to(out, "\n  aperture {:.6g} blur_samples 16, 64 confidence 0.95 variance 1/256 focal_point ",
+                   fb.aperture);
+    vec(out, pov(fb.focal_point));
+  }
+  fmt::format_to(out, " }}\n");
 }
 
-// The scene light: the sun as a parallel light from far along its direction, or the point light; in the
-// preview also a dim shadowless light at the camera.
-void write_lights(Out out, const Scene& scene, const glm::vec3& centre, float diag, bool paper) {
-  const bool sun = scene.light.kind == Light::Kind::Sun;
-  const glm::vec3 towards = sun ? glm::normalize(scene.light.direction) : glm::normalize(scene.light.position - centre);
-  const glm::vec3 lpos = sun ? centre + towards * (20.0f * diag) : scene.light.position;
+// The light (the scene's, turned with a turntable's camera): the sun as a parallel light from far along
+// its direction, or the point light; in the preview also a dim shadowless light at the render's camera.
+void write_lights(Out out, const RenderView& view, const glm::vec3& centre, float diag, bool paper) {
+  const Light& light = view.light;
+  const bool sun = light.kind == Light::Kind::Sun;
+  const glm::vec3 towards = sun ? glm::normalize(light.direction) : glm::normalize(light.position - centre);
+  const glm::vec3 lpos = sun ? centre + towards * (20.0f * diag) : light.position;
   fmt::format_to(out, "light_source {{ ");
   vec(out, pov(lpos));
   fmt::format_to(out, " color srgb <1.0,0.98,0.94>");
@@ -240,7 +276,7 @@ void write_lights(Out out, const Scene& scene, const glm::vec3& centre, float di
   fmt::format_to(out, " }}\n");
   if (!paper) {
     fmt::format_to(out, "light_source {{ ");
-    vec(out, pov(scene.camera.position));
+    vec(out, pov(view.camera.position));
     fmt::format_to(out, " color srgb 0.35 shadowless }}\n");
   }
 }
@@ -284,12 +320,20 @@ void write_planar_decal_layer(Out out, const SurfaceDecal& d) {
       d.image, kDecalFinish, u.x, u.y, u.z, v.x, v.y, v.z, n.x, n.y, n.z, o.x, o.y, o.z);
 }
 
+// Whether the studio backdrop keeps scene mesh i: the plant climbs it, or a decal follows it.
+bool kept_in_studio(const Scene& scene, std::size_t i, const std::vector<SurfaceDecal>& decals) {
+  return scene.meshes[i].climbable || std::any_of(decals.begin(), decals.end(), [&](const SurfaceDecal& d) {
+           return d.mesh >= 0 && static_cast<std::size_t>(d.mesh) == i;
+         });
+}
+
 // The scene's meshes, each with its texture and, on top, the decals laid over it: those that follow its
-// texture coordinates and, on a climbable mesh, the planar ones. write_pov has checked the decals.
-void write_scene_meshes(Out out, const Scene& scene, const std::vector<SurfaceDecal>& decals) {
+// texture coordinates and, on a climbable mesh, the planar ones. write_pov has checked the decals. The
+// studio backdrop keeps only the meshes kept_in_studio.
+void write_scene_meshes(Out out, const Scene& scene, const std::vector<SurfaceDecal>& decals, bool studio) {
   for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
     const TriangleMesh& m = scene.meshes[i];
-    if (m.triangles.empty()) continue;
+    if (m.triangles.empty() || (studio && !kept_in_studio(scene, i, decals))) continue;
     std::vector<const SurfaceDecal*> uv_decals, planar;
     for (const auto& d : decals) {
       if (d.mesh == kPlanarDecal && m.climbable) planar.push_back(&d);
@@ -327,6 +371,51 @@ void write_free_decals(Out out, const Scene& scene, const std::vector<SurfaceDec
     write_uv_decal_layer(out, d);
     fmt::format_to(out, "}}\n");
   }
+}
+
+// The studio backdrop: a grey sweep, a floor under `content` that curves up into a wall behind it as the
+// camera sees it, as one smooth mesh2 (a profile swept sideways), so no edge or horizon shows. The bend
+// starts behind the content's farthest point, and the sweep reaches past the frame's edges and top.
+void write_studio(Out out, const Camera& camera, float aspect, const Aabb& content) {
+  const CameraFrame c = camera_frame(camera);
+  glm::vec3 h(c.forward.x, 0.0f, c.forward.z);  // the sweep faces the camera's horizontal view
+  h = glm::length(h) > 1e-6f ? glm::normalize(h) : glm::vec3(0.0f, 0.0f, -1.0f);
+  const glm::vec3 up(0.0f, 1.0f, 0.0f), side = glm::normalize(glm::cross(h, up));
+  const float radius = std::max(0.5f * glm::length(content.size()), 0.05f);
+  const float floor_y = content.min.y, bend = 0.5f * radius;
+  float back = 0.0f;  // the content's farthest corner, along h from the camera
+  for (const glm::vec3& p : corners(content)) back = std::max(back, glm::dot(p - camera.position, h));
+  back += bend;
+  // The wall rises past the frame's top edge (its steepest ray, the top middle), up to about 83 degrees.
+  const float tv = std::tan(0.5f * glm::radians(camera.fov_deg));
+  const float top_elevation = std::asin(std::clamp(c.forward.y, -1.0f, 1.0f)) + std::atan(tv) + 0.1f;
+  const float top = std::max({camera.position.y + back * std::tan(std::min(top_elevation, 1.45f)),
+                              floor_y + 2.0f * bend, content.max.y + radius});
+  const float front = -std::max(back, 2.0f * std::abs(camera.position.y - floor_y));
+  const float half_w = 2.0f * glm::length(glm::vec2(back, top - camera.position.y)) * tv * aspect + radius;
+  // The profile, (along h from the camera, height) with its normal: the floor, a quarter circle, the wall.
+  std::vector<glm::vec2> at = {{front, floor_y}}, normal = {{0.0f, 1.0f}};
+  constexpr int kArc = 12;
+  for (int k = 0; k <= kArc; ++k) {
+    const float a = 0.5f * std::numbers::pi_v<float> * static_cast<float>(k) / kArc;
+    at.emplace_back(back - bend + bend * std::sin(a), floor_y + bend - bend * std::cos(a));
+    normal.emplace_back(-std::sin(a), std::cos(a));
+  }
+  at.emplace_back(back, top);
+  normal.emplace_back(-1.0f, 0.0f);
+  const glm::vec3 base(camera.position.x, 0.0f, camera.position.z);
+  std::vector<glm::vec3> vertices, normals;
+  std::vector<glm::uvec3> triangles;
+  for (std::size_t i = 0; i < at.size(); ++i)
+    for (const float w : {-half_w, half_w}) {
+      vertices.push_back(base + at[i].x * h + at[i].y * up + w * side);
+      normals.push_back(normal[i].x * h + normal[i].y * up);
+    }
+  for (std::uint32_t i = 0; i + 1 < at.size(); ++i)
+    triangles.insert(triangles.end(), {{2 * i, 2 * i + 1, 2 * i + 3}, {2 * i, 2 * i + 3, 2 * i + 2}});
+  fmt::format_to(out, "// studio backdrop: a sweep from the floor up behind the plant, facing the camera\n");
+  write_mesh2(out, vertices, normals, triangles, 0, static_cast<std::uint32_t>(triangles.size()));
+  fmt::format_to(out, "  texture {{ GB_Studio }}\n}}\n");
 }
 
 // Branches as cones between each node and its parent, with a sphere at each joint and tip.
@@ -472,28 +561,54 @@ std::string decal_problem(const Scene& scene, const Plant& plant) {
   return "";
 }
 
-std::uint64_t write_pov(const std::string& path, const Scene& scene, const Plant& plant, const RenderOptions& o) {
+namespace {
+
+float aspect_of(const RenderOptions& o) {
+  return static_cast<float>(render_width(o)) / static_cast<float>(render_height(o));
+}
+
+// How far the organ shape reaches from its stem at unit size (plant_bounds' organ_reach).
+float organ_reach(const MesherOptions& mesher) {
+  float reach = 0.0f;
+  for (const glm::vec3& v : organ_shape(mesher).vertices) reach = std::max(reach, glm::length(v));
+  return reach > 0.0f ? reach : 1.0f;
+}
+
+// What the studio backdrop stands behind: the subject and the scene meshes it keeps.
+Aabb studio_content(const Scene& scene, const Plant& plant, const RenderView& view, bool decals) {
+  Aabb content = view.subject;
+  for (std::size_t i = 0; i < scene.meshes.size(); ++i)
+    if (kept_in_studio(scene, i, decals ? plant.decals : std::vector<SurfaceDecal>{}))
+      content.extend(scene.meshes[i].bounds());
+  if (content.empty()) content.extend(glm::vec3(0.0f));
+  return content;
+}
+
+std::uint64_t write_pov_view(const std::string& path, const Scene& scene, const Plant& plant, const RenderOptions& o,
+                             const RenderView& view) {
+  check_render_options(o);
   fmt::memory_buffer b;
   auto out = std::back_inserter(b);
-  const int w = render_width(o), h = render_height(o);
-  const float aspect = static_cast<float>(w) / static_cast<float>(h);
-
   Aabb bounds = scene.bounds();
   for (const auto& n : plant.nodes) bounds.extend(n.position);
   if (bounds.empty()) bounds.extend(glm::vec3(0.0f));
   const float diag = std::max(glm::length(bounds.size()), 1.0f);
+  const bool studio = o.backdrop == Backdrop::Studio;
 
   write_settings(out, scene, plant, o, diag);
-  write_camera(out, scene.camera, aspect);
-  write_lights(out, scene, bounds.center(), diag, o.quality == RenderQuality::Paper);
-  // Ground: a plane under everything (the scene's own ground mesh, when it has one, sits on it).
-  fmt::format_to(out, "plane {{ y, {:.6g} texture {{ GB_Ground }} }}\n", bounds.min.y - 1e-3f);
+  fmt::format_to(out, "// camera: {}\n", view.describe());
+  write_camera(out, view, aspect_of(o), o.dof);
+  write_lights(out, view, bounds.center(), diag, o.quality == RenderQuality::Paper);
   const bool decals = o.draw_plant && !plant.decals.empty();
   if (decals)
     if (const std::string bad = decal_problem(scene, plant); !bad.empty())
       throw InputError(fmt::format("{}: cannot draw the plant's decals: {}", path, bad));
+  if (studio)
+    write_studio(out, view.camera, aspect_of(o), studio_content(scene, plant, view, decals));
+  else  // Ground: a plane under everything (the scene's own ground mesh, when it has one, sits on it).
+    fmt::format_to(out, "plane {{ y, {:.6g} texture {{ GB_Ground }} }}\n", bounds.min.y - 1e-3f);
   const std::vector<SurfaceDecal> no_decals;
-  write_scene_meshes(out, scene, decals ? plant.decals : no_decals);
+  write_scene_meshes(out, scene, decals ? plant.decals : no_decals, studio);
   write_free_decals(out, scene, decals ? plant.decals : no_decals);
   // A plant with decals is drawn by them (CONTRIBUTING.md, Rendering): its branches, organs and polygons
   // are not drawn again on top.
@@ -506,11 +621,50 @@ std::uint64_t write_pov(const std::string& path, const Scene& scene, const Plant
   return write_file_atomic(path, b.data(), b.size());
 }
 
+}  // namespace
+
+std::string RenderView::describe() const {
+  if (subject.empty()) return "the scene's (the plant is empty)";
+  return fmt::format("{}: the plant's box spans {:.3f} of the frame with the scene camera, {:.3f} with this one",
+                     fitted ? "fitted to the plant" : "the scene's", scene_extent, extent);
+}
+
+RenderView render_view(const Scene& scene, const Plant& plant, const RenderOptions& o) {
+  const float aspect = aspect_of(o);
+  RenderView v;
+  v.light = scene.light;
+  v.subject = o.subject.empty() ? plant_bounds(scene, plant, organ_reach(o.mesher)) : o.subject;
+  if (o.turns > 0) {
+    const Orbit orbit = turntable_camera(scene.camera, aspect, v.subject, o.turn, o.turns);
+    v.camera = orbit.camera;
+    v.fitted = !v.subject.empty();
+    // The light turns with the camera, as if the plant turned on a turntable under fixed lights: every
+    // frame is lit as the first.
+    v.light.direction = turn_about_vertical(scene.light.direction, glm::vec3(0.0f), orbit.angle);
+    v.light.position = turn_about_vertical(scene.light.position, orbit.axis_point, orbit.angle);
+  } else {
+    const RenderCamera rc = choose_camera(scene.camera, aspect, v.subject, o.camera);
+    v.camera = rc.camera;
+    v.fitted = rc.fitted;
+  }
+  v.scene_extent = projected_extent(scene.camera, aspect, v.subject);
+  v.extent = projected_extent(v.camera, aspect, v.subject);
+  return v;
+}
+
+std::uint64_t write_pov(const std::string& path, const Scene& scene, const Plant& plant, const RenderOptions& o) {
+  return write_pov_view(path, scene, plant, o, render_view(scene, plant, o));
+}
+
 nlohmann::json RenderResult::to_json() const {
   nlohmann::json j = {
       {"status", status},       {"png", png},         {"pov", pov},       {"width", width}, {"height", height},
       {"pov_bytes", pov_bytes}, {"write_s", write_s}, {"wall_s", wall_s}, {"cpu_s", cpu_s}, {"warnings", warnings}};
   if (!message.empty()) j["message"] = message;
+  if (!camera.empty()) {
+    j["camera"] = camera;
+    j["scene_extent"] = scene_extent;
+  }
   return j;
 }
 
@@ -537,11 +691,10 @@ namespace {
 
 // POV-Ray's command line, the file names relative to the directory it runs in.
 std::vector<std::string> povray_args(const std::string& bin, const fs::path& pov_abs, const fs::path& png_abs,
-                                     const RenderResult& r, const RenderOptions& o) {
-  const fs::path dir = png_abs.parent_path();
+                                     const fs::path& dir, const RenderResult& r, const RenderOptions& o) {
   std::vector<std::string> args = {bin,
                                    "+I" + pov_abs.lexically_relative(dir).string(),
-                                   "+O" + png_abs.filename().string(),
+                                   "+O" + png_abs.lexically_relative(dir).string(),
                                    fmt::format("+W{}", r.width),
                                    fmt::format("+H{}", r.height),
                                    "+FN",
@@ -549,7 +702,7 @@ std::vector<std::string> povray_args(const std::string& bin, const fs::path& pov
                                    "-V",
                                    "-P",
                                    fmt::format("+WT{}", std::max(1, o.threads))};
-  if (o.quality == RenderQuality::Paper) {
+  if (o.quality == RenderQuality::Paper && !o.dof) {  // focal blur anti-aliases itself (write_camera)
     args.insert(args.end(), {"+A0.1", "+AM2", "+R3"});
   } else {
     args.push_back("-A");
@@ -572,7 +725,8 @@ std::vector<std::string> scan_log(const std::string& log, std::vector<std::strin
 
 }  // namespace
 
-RenderResult run_povray(const std::string& pov_path, const std::string& png_path, const RenderOptions& o) {
+RenderResult run_povray(const std::string& pov_path, const std::string& png_path, const RenderOptions& o,
+                        const std::string& work_dir) {
   RenderResult r;
   r.pov = pov_path;
   r.png = png_path;
@@ -588,14 +742,15 @@ RenderResult run_povray(const std::string& pov_path, const std::string& png_path
   // POV-Ray runs in the output directory with relative file names: Debian's povray.conf restricts
   // reading and writing to the working directory and below.
   const fs::path png_abs = fs::absolute(png_path), pov_abs = fs::absolute(pov_path);
+  const fs::path dir = work_dir.empty() ? png_abs.parent_path() : fs::absolute(work_dir);
   std::error_code ec;
   fs::remove(png_abs, ec);
   fs::remove(r.log, ec);
-  const std::vector<std::string> args = povray_args(bin, pov_abs, png_abs, r, o);
+  const std::vector<std::string> args = povray_args(bin, pov_abs, png_abs, dir, r, o);
   const auto t0 = std::chrono::steady_clock::now();
   ChildResult cr;
   try {
-    cr = run_program(args, png_abs.parent_path().string(), {o.timeout_s, 0}, fs::absolute(r.log).string());
+    cr = run_program(args, dir.string(), {o.timeout_s, 0}, fs::absolute(r.log).string());
   } catch (const std::exception& e) {
     r.status = "failed";
     r.message = e.what();
@@ -622,13 +777,11 @@ RenderResult run_povray(const std::string& pov_path, const std::string& png_path
 
 namespace {
 
-// Why the plant's decals cannot be rendered into png_path ("" when they can): a decal the scene cannot
-// hold, or an image missing from the render's directory, where POV-Ray runs and reads them.
-std::string decal_render_problem(const Scene& scene, const Plant& plant, const std::string& png_path,
-                                 const RenderOptions& o) {
+// Why the plant's decals cannot be rendered ("" when they can): a decal the scene cannot hold, or an
+// image missing from `dir`, where POV-Ray runs and reads them.
+std::string decal_render_problem(const Scene& scene, const Plant& plant, const fs::path& dir, const RenderOptions& o) {
   if (!o.draw_plant || plant.decals.empty()) return "";
   if (std::string bad = decal_problem(scene, plant); !bad.empty()) return bad;
-  const fs::path dir = fs::absolute(png_path).parent_path();
   for (std::size_t i = 0; i < plant.decals.size(); ++i)
     if (!fs::is_regular_file(dir / plant.decals[i].image))
       return fmt::format("decal {}: its image {} is missing (a render reads decal images from its own directory)", i,
@@ -639,10 +792,11 @@ std::string decal_render_problem(const Scene& scene, const Plant& plant, const s
 }  // namespace
 
 RenderResult render_plant(const Scene& scene, const Plant& plant, const std::string& pov_path,
-                          const std::string& png_path, const RenderOptions& o) {
+                          const std::string& png_path, const RenderOptions& o, const std::string& work_dir) {
   // A decal that cannot be drawn fails the render rather than leaving the plant out of it: a render
   // without the plant would pass for one of a plant that grew nothing.
-  if (const std::string bad = decal_render_problem(scene, plant, png_path, o); !bad.empty()) {
+  const fs::path dir = work_dir.empty() ? fs::absolute(png_path).parent_path() : fs::absolute(work_dir);
+  if (const std::string bad = decal_render_problem(scene, plant, dir, o); !bad.empty()) {
     std::error_code ec;
     fs::remove(png_path, ec);  // an earlier render's image would pass for this one's
     RenderResult r;
@@ -656,8 +810,9 @@ RenderResult render_plant(const Scene& scene, const Plant& plant, const std::str
   }
   const auto t0 = std::chrono::steady_clock::now();
   std::uint64_t bytes = 0;
+  const RenderView view = render_view(scene, plant, o);
   try {
-    bytes = write_pov(pov_path, scene, plant, o);
+    bytes = write_pov_view(pov_path, scene, plant, o, view);
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {
@@ -669,9 +824,11 @@ RenderResult render_plant(const Scene& scene, const Plant& plant, const std::str
     return r;
   }
   const double write_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  RenderResult r = run_povray(pov_path, png_path, o);
+  RenderResult r = run_povray(pov_path, png_path, o, work_dir);
   r.pov_bytes = bytes;
   r.write_s = write_s;
+  r.camera = view.fitted ? "fitted" : "scene";
+  r.scene_extent = view.scene_extent;
   return r;
 }
 

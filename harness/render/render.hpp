@@ -4,7 +4,8 @@
 //
 // Coordinates: growbench is right-handed with Y up; POV-Ray is left-handed with Y up. The writer
 // negates Z everywhere (points, normals, instance matrices, camera and light), which mirrors nothing
-// in the image. The scene camera's fov_deg is the vertical field of view.
+// in the image. The scene camera's fov_deg is the vertical field of view. The camera a render uses is the
+// scene's or one framing the plant (camera.hpp).
 #pragma once
 
 #include <cstdint>
@@ -15,6 +16,7 @@
 
 #include "algorithms/plant.hpp"
 #include "harness/output/mesher.hpp"
+#include "harness/render/camera.hpp"
 #include "scenes/scene.hpp"
 
 namespace growbench {
@@ -23,6 +25,14 @@ enum class RenderQuality { Preview, Paper };
 // "preview" or "paper"; anything else is an InputError naming the option.
 RenderQuality parse_render_quality(const std::string& text, const std::string& option = "--quality");
 const char* to_string(RenderQuality q);
+
+// What stands behind the plant: the scene's sky and ground plane, or a studio sweep (a seamless grey
+// floor curving up into a wall behind the plant, turned to face the camera) in their place, with only the
+// scene meshes a plant climbs on (and those its decals lie on) kept.
+enum class Backdrop { Scene, Studio };
+// "scene" or "studio"; anything else is an InputError naming the option.
+Backdrop parse_backdrop(const std::string& text, const std::string& option = "--backdrop");
+const char* to_string(Backdrop b);
 
 struct RenderOptions {
   // preview: 480x360, no anti-aliasing, one sun with hard shadows and a weak fill light (CI, quick looks).
@@ -36,15 +46,43 @@ struct RenderOptions {
   std::string branches = "cones";
   bool draw_plant = true;  // false: the scene alone (the tests compare renders with and without the plant)
   double timeout_s = 900.0;
-  MesherOptions mesher;  // tube sides (branches=mesh) and the leaf shape
+  MesherOptions mesher;                  // tube sides (branches=mesh) and the leaf shape
+  CameraMode camera = CameraMode::Auto;  // camera.hpp's choose_camera
+  // Depth of field (paper quality only: check_render_options): in focus at the plant's centre, the
+  // aperture from camera.hpp's focal_blur.
+  bool dof = false;
+  Backdrop backdrop = Backdrop::Scene;
+  // A turntable frame (turns > 0): frame `turn` of `turns`, camera.hpp's turntable_camera; the light
+  // turns with the camera. The camera option does not apply: every frame is framed.
+  int turn = 0, turns = 0;
+  // The box the camera frames and focuses on, when not empty; else the plant's own (plant_bounds). A
+  // growth frame takes the grown plant's, so the animation's camera stands still.
+  Aabb subject;
 };
+
+// InputError naming the option for options that cannot render: depth of field in preview quality (a
+// preview stays quick: focal blur traces many rays a pixel).
+void check_render_options(const RenderOptions& o);
 
 [[nodiscard]] int render_width(const RenderOptions& o);
 [[nodiscard]] int render_height(const RenderOptions& o);
 
+// The camera and light a render uses: the scene's camera or one framing the plant (options.camera), or a
+// turntable frame's orbit, and the scene's light (turned with a turntable's camera).
+struct RenderView {
+  Camera camera;
+  Light light;
+  Aabb subject;            // what is framed and focused on: the plant's bounds (options.subject if set)
+  bool fitted = false;     // the camera was moved to frame the subject
+  float scene_extent = 0;  // the subject's projected extent with the scene camera (camera.hpp)
+  float extent = 0;        // ... and with this camera
+  [[nodiscard]] std::string describe() const;  // a line for the .pov file's header
+};
+RenderView render_view(const Scene& scene, const Plant& plant, const RenderOptions& options);
+
 // Writes a POV-Ray 3.7 scene file (`#version 3.7`, `assumed_gamma 1.0`): the scene's meshes as mesh2,
-// the plant's branches, its leaves and flowers instanced from one declared mesh each, the scene camera
-// and light, a sky and a ground plane. Returns the bytes written.
+// the plant's branches, its leaves and flowers instanced from one declared mesh each, render_view's
+// camera and light, a sky and a ground plane (or the studio backdrop). Returns the bytes written.
 // A plant with decals is drawn by them instead: each image is a texture layer on top of the meshes it
 // lies on (through a mesh's texture coordinates, or projected onto every climbable mesh), its alpha
 // showing the surface below. Their names are written as they are, so POV-Ray reads them from its working
@@ -60,6 +98,8 @@ struct RenderResult {
   std::vector<std::string> warnings;  // POV-Ray's warning lines (a clean scene has none)
   std::string pov, png, log;          // the files (paths as given)
   int width = 0, height = 0;
+  std::string camera;      // "scene" or "fitted" (RenderView::fitted); "" when nothing was written
+  float scene_extent = 0;  // RenderView's
   std::uint64_t pov_bytes = 0;
   double write_s = 0.0;              // writing the .pov file
   double wall_s = 0.0, cpu_s = 0.0;  // the POV-Ray process (parse + render), apart from the trial's time
@@ -74,13 +114,16 @@ std::string povray_version();
 
 // Runs POV-Ray on POV_PATH writing PNG_PATH (its log beside the PNG, .log). Never throws for a POV-Ray
 // failure: the result's status and message say what happened. Safe to call from several threads.
-RenderResult run_povray(const std::string& pov_path, const std::string& png_path, const RenderOptions& options);
+// POV-Ray runs in WORK_DIR (PNG_PATH's directory when empty), where it reads decal images; the .pov file
+// and the image must be in it or below it (Debian's povray.conf allows no other).
+RenderResult run_povray(const std::string& pov_path, const std::string& png_path, const RenderOptions& options,
+                        const std::string& work_dir = "");
 
 // write_pov, then run_povray. The .pov file is kept beside the image for inspection. The images of the
-// plant's decals must be in PNG_PATH's directory: when one is missing or cannot be drawn, the result is
-// "failed" with a message saying which, and POV-Ray is not run.
+// plant's decals must be in WORK_DIR (PNG_PATH's directory when empty): when one is missing or cannot be
+// drawn, the result is "failed" with a message saying which, and POV-Ray is not run.
 RenderResult render_plant(const Scene& scene, const Plant& plant, const std::string& pov_path,
-                          const std::string& png_path, const RenderOptions& options);
+                          const std::string& png_path, const RenderOptions& options, const std::string& work_dir = "");
 
 // One labelled image: `cells` is rows x cols PNG paths (an empty path or a missing file draws a grey
 // box with `notes[r][c]`, if given). Throws std::runtime_error naming the file it cannot write.

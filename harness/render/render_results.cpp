@@ -33,7 +33,9 @@ struct Job {
   std::string scene_spec;
   std::vector<std::string> scene_params;
   std::string leaf_obj;  // the trial's custom leaf ("" : the default shape)
-  bool frame = false;
+  bool frame = false;    // a growth frame
+  int turn = -1;         // a turntable frame: its number
+  fs::path trial_dir;    // where the trial's plant.gbplant is, and its decal images
   RenderResult result;
 };
 
@@ -54,12 +56,25 @@ std::vector<fs::path> frame_snapshots(const fs::path& trial_dir) {
 // sit beside it as step_NNNNNN.IMAGE (step_000010.texture.png), which this must not match.
 constexpr const char* kFrameGlob = "frames/step_[0-9][0-9][0-9][0-9][0-9][0-9].png";
 
-// ffmpeg: the rendered frames (kFrameGlob) to animation.mp4 (H.264, even dimensions). Returns a record of
-// the attempt.
-AnimationRecord make_animation(const fs::path& trial_dir, std::size_t frames) {
+// A video made from numbered frames: the frames' glob (relative to the trial directory), the file it
+// writes there, ffmpeg's log beside it, and its frame rate.
+struct Video {
+  const char* glob;
+  const char* file;
+  const char* log;
+  const char* fps;
+};
+// The growth animation; the turntable, whose frames are turntable/frame_NNNN.png (four digits, so names
+// sort in turn order).
+constexpr Video kGrowthVideo{kFrameGlob, "animation.mp4", "animation.log", "12"};
+constexpr Video kTurntableVideo{"turntable/frame_[0-9][0-9][0-9][0-9].png", "turntable.mp4", "turntable.log", "24"};
+
+// ffmpeg: the rendered frames (video.glob) to video.file (H.264, even dimensions). Returns a record of the
+// attempt.
+AnimationRecord make_video(const fs::path& trial_dir, std::size_t frames, const Video& video) {
   AnimationRecord a;
   a.frames = frames;
-  a.frame_pattern = kFrameGlob;
+  a.frame_pattern = video.glob;
   const std::string ffmpeg = find_program("ffmpeg");
   if (ffmpeg.empty()) {
     a.status = "no_ffmpeg";
@@ -67,41 +82,54 @@ AnimationRecord make_animation(const fs::path& trial_dir, std::size_t frames) {
     return a;
   }
   // `-f image2`: ffmpeg picks its image reader from the name only when the name holds *, ? or {, and
-  // kFrameGlob has none of them.
+  // the globs have none of them.
   std::vector<std::string> args = {ffmpeg,
                                    "-y",
                                    "-loglevel",
                                    "error",
                                    "-framerate",
-                                   "12",
+                                   video.fps,
                                    "-f",
                                    "image2",
                                    "-pattern_type",
                                    "glob",
                                    "-i",
-                                   kFrameGlob,
+                                   video.glob,
                                    "-vf",
                                    "pad=ceil(iw/2)*2:ceil(ih/2)*2",
                                    "-pix_fmt",
                                    "yuv420p",
-                                   "animation.mp4"};
-  const ChildResult cr = run_program(args, trial_dir.string(), {600.0, 0}, (trial_dir / "animation.log").string());
-  if (cr.exit_code == 0 && fs::exists(trial_dir / "animation.mp4")) {
+                                   video.file};
+  const ChildResult cr = run_program(args, trial_dir.string(), {600.0, 0}, (trial_dir / video.log).string());
+  if (cr.exit_code == 0 && fs::exists(trial_dir / video.file)) {
     a.status = "ok";
-    a.file = "animation.mp4";
-    a.bytes = fs::file_size(trial_dir / "animation.mp4");
+    a.file = video.file;
+    a.bytes = fs::file_size(trial_dir / video.file);
   } else {
     a.status = "failed";
-    a.message = fmt::format("ffmpeg failed (exit {}); see {}", cr.exit_code, (trial_dir / "animation.log").string());
+    a.message = fmt::format("ffmpeg failed (exit {}); see {}", cr.exit_code, (trial_dir / video.log).string());
   }
   return a;
+}
+
+// Removes an earlier turntable's frames (their images, scene files and logs) from trial_dir/turntable, so
+// a shorter turntable does not pick up its tail.
+void clear_turntable(const fs::path& trial_dir) {
+  const fs::path d = trial_dir / "turntable";
+  if (!fs::is_directory(d)) return;
+  std::vector<fs::path> old;
+  for (const auto& e : fs::directory_iterator(d))
+    if (e.path().filename().string().rfind("frame_", 0) == 0) old.push_back(e.path());
+  for (const auto& p : old) fs::remove(p);
 }
 
 // A trial's render and its frames' (when it kept a plant snapshot); false when it has none. Each render
 // sits beside its snapshot, so the decal images the snapshot names (relative to its directory) are in
 // the directory POV-Ray runs in and reads them from.
+// A turntable of `turntable` frames (turntable/frame_NNNN.png, rendered with POV-Ray in the trial's
+// directory, where the plant's decal images are) follows, when asked.
 bool add_trial(std::vector<Job>& jobs, const std::string& key, const fs::path& tdir, const std::string& scene_spec,
-               const std::vector<std::string>& scene_params, const std::string& leaf_obj) {
+               const std::vector<std::string>& scene_params, const std::string& leaf_obj, int turntable) {
   if (!fs::exists(tdir / "plant.gbplant")) return false;
   jobs.push_back({key,
                   tdir / "plant.gbplant",
@@ -111,13 +139,30 @@ bool add_trial(std::vector<Job>& jobs, const std::string& key, const fs::path& t
                   scene_params,
                   leaf_obj,
                   false,
+                  -1,
+                  tdir,
                   {}});
   for (const auto& f : frame_snapshots(tdir)) {
     fs::path png = f;
     png.replace_extension(".png");
     fs::path pov = f;
     pov.replace_extension(".pov");
-    jobs.push_back({key, f, pov, png, scene_spec, scene_params, leaf_obj, true, {}});
+    jobs.push_back({key, f, pov, png, scene_spec, scene_params, leaf_obj, true, -1, tdir, {}});
+  }
+  if (turntable > 0) clear_turntable(tdir);
+  for (int k = 0; k < turntable; ++k) {
+    const fs::path base = tdir / "turntable" / fmt::format("frame_{:04d}", k);
+    jobs.push_back({key,
+                    tdir / "plant.gbplant",
+                    fs::path(base).concat(".pov"),
+                    fs::path(base).concat(".png"),
+                    scene_spec,
+                    scene_params,
+                    leaf_obj,
+                    false,
+                    k,
+                    tdir,
+                    {}});
   }
   return true;
 }
@@ -145,6 +190,27 @@ void render_jobs(std::vector<Job>& jobs, int workers, const RenderOptions& ro, c
     jro.mesher = with_leaf_mesh(jro.mesher);
     return leaf_options.emplace(j.leaf_obj, jro).first->second;
   };
+  // A growth frame is framed as the grown plant is, so the animation's camera stands still.
+  std::map<fs::path, Aabb> grown;
+  auto job_options = [&](const Job& j, const Scene& scene) {
+    RenderOptions jo = options_for(j);
+    if (j.turn >= 0) {
+      jo.turn = j.turn;
+      jo.turns = o.turntable;
+    }
+    if (!j.frame) return jo;
+    {
+      std::lock_guard lock(scene_mutex);
+      if (const auto it = grown.find(j.trial_dir); it != grown.end()) {
+        jo.subject = it->second;
+        return jo;
+      }
+    }
+    jo.subject = render_view(scene, read_plant_snapshot((j.trial_dir / "plant.gbplant").string()), jo).subject;
+    std::lock_guard lock(scene_mutex);
+    grown.emplace(j.trial_dir, jo.subject);
+    return jo;
+  };
   std::atomic<std::size_t> next{0}, done{0};
   const bool tty = isatty(STDERR_FILENO) != 0 && !o.quiet;
   const auto t0 = std::chrono::steady_clock::now();
@@ -154,7 +220,9 @@ void render_jobs(std::vector<Job>& jobs, int workers, const RenderOptions& ro, c
       try {
         const auto scene = scene_for(j);
         const Plant plant = read_plant_snapshot(j.snapshot.string());
-        j.result = render_plant(*scene, plant, j.pov.string(), j.png.string(), options_for(j));
+        // A turntable frame runs POV-Ray in the trial's directory, where the decal images are.
+        j.result = render_plant(*scene, plant, j.pov.string(), j.png.string(), job_options(j, *scene),
+                                j.turn >= 0 ? j.trial_dir.string() : std::string());
       } catch (const std::exception& e) {
         j.result.status = "failed";
         j.result.message = e.what();
@@ -163,8 +231,8 @@ void render_jobs(std::vector<Job>& jobs, int workers, const RenderOptions& ro, c
       if (!o.quiet) {
         std::lock_guard lock(print_mutex);
         const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        const std::string what =
-            j.key.empty() ? j.png.filename().string() : j.key + (j.frame ? "/" + j.png.filename().string() : "");
+        const std::string rel = j.png.lexically_relative(j.trial_dir).string();
+        const std::string what = j.key.empty() ? rel : j.frame || j.turn >= 0 ? j.key + "/" + rel : j.key;
         const std::string line =
             fmt::format("render [{}/{}] {}: {} ({:.1f} s), ETA {:.0f} s", n, jobs.size(), what, j.result.status,
                         j.result.wall_s, el / static_cast<double>(n) * static_cast<double>(jobs.size() - n));
@@ -207,6 +275,12 @@ RenderRecord render_record(const Job& j, const RenderOptions& ro, const fs::path
   rr.quality = to_string(ro.quality);
   rr.branches = ro.branches;
   rr.threads = ro.threads;
+  if (!r.camera.empty()) {
+    rr.camera = r.camera;
+    rr.scene_extent = r.scene_extent;
+  }
+  rr.backdrop = to_string(ro.backdrop);
+  rr.dof = ro.dof;
   return rr;
 }
 
@@ -227,40 +301,66 @@ struct RenderTargets {
     else
       record->animation = std::move(a);
   }
+  void set_turntable(const std::string& key, AnimationRecord a) {
+    if (results)
+      results->trials[trial_index.at(key)].turntable = std::move(a);
+    else
+      record->turntable = std::move(a);
+  }
 };
 
-// Records every render, makes each trial's animation from its frames; the tally into `summary`.
+// The frames of one kind (growth or turntable) per trial, and the first failure among them.
+struct FrameTally {
+  std::map<std::string, std::size_t> count;
+  std::map<std::string, std::string> failure;
+  void add(const Job& j) {
+    ++count[j.key];
+    if (!j.result.ok() && !failure.count(j.key)) failure[j.key] = j.result.message;
+  }
+};
+
+// Each trial's video from its frames (none when one of them failed), recorded by `set`.
+template <class Set>
+void make_videos(const FrameTally& tally, const Video& video, const char* what, const fs::path& dir, bool suite,
+                 bool quiet, Set&& set) {
+  for (const auto& [key, n] : tally.count) {
+    const fs::path tdir = suite ? dir / "trials" / key : dir;
+    AnimationRecord a;
+    if (const auto failed = tally.failure.find(key); failed != tally.failure.end()) {
+      a.status = "failed";
+      a.frames = n;
+      a.message = failed->second;
+    } else {
+      a = make_video(tdir, n, video);
+    }
+    if (suite && a.file) a.file = (tdir / *a.file).lexically_relative(dir).string();
+    if (!quiet) fmt::print(stderr, "{} {}: {} frames, {}\n", what, key.empty() ? dir.string() : key, n, a.status);
+    set(key, std::move(a));
+  }
+}
+
+// Records every render, makes each trial's animation from its frames and its turntable video; the tally
+// into `summary`.
 void record_renders(const std::vector<Job>& jobs, const RenderOptions& ro, const fs::path& dir,
                     const RenderDirOptions& o, RenderTargets& targets, RenderSummary& summary) {
   const bool suite = targets.results != nullptr;
-  std::map<std::string, std::size_t> frames_of;
-  std::map<std::string, std::vector<std::string>> frame_failures;
+  FrameTally growth, turntable;
   for (const auto& j : jobs) {
     j.result.ok() ? ++summary.ok : ++summary.failed;
     summary.warnings += j.result.warnings.size();
     summary.povray_s += j.result.wall_s;
-    if (j.frame) {
-      ++frames_of[j.key];
-      if (!j.result.ok()) frame_failures[j.key].push_back(j.result.message);
-      continue;
-    }
-    targets.set(j.key, render_record(j, ro, dir));
+    if (j.frame)
+      growth.add(j);
+    else if (j.turn >= 0)
+      turntable.add(j);
+    else
+      targets.set(j.key, render_record(j, ro, dir));
   }
   summary.renders = summary.ok + summary.failed;
-  for (const auto& [key, n] : frames_of) {
-    const fs::path tdir = suite ? dir / "trials" / key : dir;
-    AnimationRecord a;
-    if (frame_failures.count(key)) {
-      a.status = "failed";
-      a.frames = n;
-      a.message = frame_failures[key].front();
-    } else {
-      a = make_animation(tdir, n);
-    }
-    if (suite && a.file) a.file = (tdir / *a.file).lexically_relative(dir).string();
-    if (!o.quiet) fmt::print(stderr, "animation {}: {} frames, {}\n", key.empty() ? dir.string() : key, n, a.status);
-    targets.set(key, std::move(a));
-  }
+  make_videos(growth, kGrowthVideo, "animation", dir, suite, o.quiet,
+              [&](const std::string& key, AnimationRecord a) { targets.set(key, std::move(a)); });
+  make_videos(turntable, kTurntableVideo, "turntable", dir, suite, o.quiet,
+              [&](const std::string& key, AnimationRecord a) { targets.set_turntable(key, std::move(a)); });
 }
 
 // grid.png: one row per algorithm entry (and sweep value), one column per scene, the lowest seed's plant;
@@ -331,6 +431,8 @@ void write_grids(const ResultsFile& doc, const fs::path& dir, const RenderOption
 
 RenderSummary render_directory_record(const std::string& dir_arg, const RenderDirOptions& o) {
   const fs::path dir(dir_arg);
+  check_render_options(o.render);
+  if (o.turntable < 0) throw InputError(fmt::format("--turntable {}: expected a number of frames >= 1", o.turntable));
   const bool suite = fs::exists(dir / "results.json");
   if (!suite && !fs::exists(dir / "record.json"))
     throw InputError(
@@ -347,13 +449,13 @@ RenderSummary render_directory_record(const std::string& dir_arg, const RenderDi
       const SuiteCell& t = results.trials[i];
       targets.trial_index[t.id] = i;
       if (!add_trial(jobs, t.id, dir / "trials" / t.id, t.spec.scene.empty() ? t.scene_spec : t.spec.scene,
-                     t.spec.scene_params, t.spec.leaf_obj.value_or("")))
+                     t.spec.scene_params, t.spec.leaf_obj.value_or(""), o.turntable))
         ++skipped;
     }
   } else {
     record = read_trial_record((dir / "record.json").string());
     targets.record = &record;
-    if (!add_trial(jobs, "", dir, record.scene.spec, record.scene.params, record.leaf_obj.value_or("")))
+    if (!add_trial(jobs, "", dir, record.scene.spec, record.scene.params, record.leaf_obj.value_or(""), o.turntable))
       throw InputError(
           fmt::format("{}: no plant.gbplant to render (written by growbench run and suite trials)", dir_arg));
   }
@@ -378,6 +480,10 @@ RenderSummary render_directory_record(const std::string& dir_arg, const RenderDi
   summary.threads_per_render = ro.threads;
   summary.skipped_without_snapshot = skipped;
   summary.wall_s = total_s;
+  summary.camera = to_string(ro.camera);
+  summary.backdrop = to_string(ro.backdrop);
+  summary.dof = ro.dof;
+  if (o.turntable > 0) summary.turntable = static_cast<std::uint64_t>(o.turntable);
   record_renders(jobs, ro, dir, o, targets, summary);
   if (suite) {
     write_grids(results, dir, ro, summary);

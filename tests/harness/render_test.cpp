@@ -3,10 +3,13 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <regex>
+#include <set>
 #include <sstream>
 
 #include <cairo.h>
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <stb_image.h>
@@ -47,6 +50,10 @@ double luminance_variance(const Image& im) {
     s2 += y * y;
   }
   return s2 / static_cast<double>(n) - (s / static_cast<double>(n)) * (s / static_cast<double>(n));
+}
+
+std::filesystem::path fs_concat(std::filesystem::path p, const std::string& tail) {
+  return p.concat(tail);
 }
 
 std::string read_file(const std::filesystem::path& p) {
@@ -202,6 +209,266 @@ SurfaceDecal uv_decal(const std::string& image, std::int32_t mesh) {
   d.image = image;
   d.mesh = mesh;
   return d;
+}
+
+// A large ground (not climbable) with a small climbable post behind the plant, and a camera 12 m away
+// that shows tiny_plant small: its box spans about a fifth of the frame.
+Scene far_scene() {
+  TriangleMesh ground = geom::make_box("ground", {-10.0f, -0.1f, -10.0f}, {10.0f, 0.0f, 10.0f});
+  ground.climbable = false;
+  Scene s = test::scene_with(ground);
+  s.meshes.push_back(geom::make_box("post", {-0.1f, 0.0f, -0.6f}, {0.1f, 1.0f, -0.4f}));
+  s.name = "far";
+  s.camera = {{0.0f, 4.0f, 12.0f}, {0.0f, 1.0f, 0.0f}, 45.0f};
+  return s;
+}
+
+// The projected box of `points` in `camera`'s frame: (min x, min y) and (max x, max y), in [-1, 1] across.
+std::pair<glm::vec2, glm::vec2> projected_box(const Camera& camera, float aspect,
+                                              const std::vector<glm::vec3>& points) {
+  glm::vec2 lo(1e9f), hi(-1e9f);
+  for (const glm::vec3& p : points) {
+    const glm::vec3 q = project(camera, aspect, p);
+    EXPECT_GT(q.z, 0.0f) << "a point behind the camera";
+    lo = glm::min(lo, glm::vec2(q));
+    hi = glm::max(hi, glm::vec2(q));
+  }
+  return {lo, hi};
+}
+
+// Every point inside the frame less kFrameMargin on each side, and the points' extent reaching that margin
+// on one axis at least (to within `slack`).
+void expect_framed(const Camera& camera, float aspect, const std::vector<glm::vec3>& points, float slack = 2e-3f) {
+  const auto [lo, hi] = projected_box(camera, aspect, points);
+  const float edge = 1.0f - 2.0f * kFrameMargin;  // the margin is a fraction of the frame, which is 2 across
+  EXPECT_GE(lo.x, -edge - slack);
+  EXPECT_GE(lo.y, -edge - slack);
+  EXPECT_LE(hi.x, edge + slack);
+  EXPECT_LE(hi.y, edge + slack);
+  EXPECT_GE(std::max(hi.x - lo.x, hi.y - lo.y), 2.0f * edge - slack) << "the plant does not fill the frame";
+}
+
+TEST(RenderCamera, AutoFramesASmallPlantWithTheMarginKeepingTheViewDirection) {
+  const Scene scene = far_scene();
+  const Plant plant = tiny_plant();
+  const float aspect = 4.0f / 3.0f;
+  const Aabb box = plant_bounds(scene, plant);
+  // The organs reach their size around them (a leaf on the top node), the nodes their radius.
+  EXPECT_NEAR(box.max.y, 1.7f + 0.25f, 1e-5f);
+  EXPECT_NEAR(box.min.x, -0.6f - 0.01f, 1e-5f);  // a side branch tip, without organs
+  const float before = projected_extent(scene.camera, aspect, box);
+  EXPECT_LT(before, kSmallPlantExtent);
+  const RenderCamera rc = choose_camera(scene.camera, aspect, box, CameraMode::Auto);
+  ASSERT_TRUE(rc.fitted);
+  EXPECT_FLOAT_EQ(rc.scene_extent, before);
+  EXPECT_FLOAT_EQ(rc.camera.fov_deg, scene.camera.fov_deg);
+  EXPECT_GT(glm::dot(camera_frame(rc.camera).forward, camera_frame(scene.camera).forward), 1.0f - 1e-6f);
+  expect_framed(rc.camera, aspect, corners(box));
+  EXPECT_GT(projected_extent(rc.camera, aspect, box), 0.79f);
+  // Off to one side and at another aspect, it is framed and centred all the same.
+  Aabb side = box;
+  side.min += glm::vec3(3.0f, 0.0f, -2.0f);
+  side.max += glm::vec3(3.0f, 0.0f, -2.0f);
+  const Camera wide = choose_camera(scene.camera, 2.0f, side, CameraMode::Auto).camera;
+  expect_framed(wide, 2.0f, corners(side));
+  const auto [lo, hi] = projected_box(wide, 2.0f, corners(side));
+  EXPECT_NEAR(lo.x + hi.x, 0.0f, 1e-3f);
+  EXPECT_NEAR(lo.y + hi.y, 0.0f, 1e-3f);
+  // camera=scene keeps the scene's camera however small the plant.
+  const RenderCamera kept = choose_camera(scene.camera, aspect, box, CameraMode::Scene);
+  EXPECT_FALSE(kept.fitted);
+  EXPECT_EQ(kept.camera.position, scene.camera.position);
+}
+
+TEST(RenderCamera, SceneCameraIsKeptWhenThePlantFillsItsFrameOrIsEmpty) {
+  Scene scene = tiny_scene();
+  scene.camera.position = {0.0f, 1.0f, 2.5f};
+  const Aabb box = plant_bounds(scene, tiny_plant());
+  EXPECT_GT(projected_extent(scene.camera, 4.0f / 3.0f, box), kSmallPlantExtent);
+  const RenderCamera rc = choose_camera(scene.camera, 4.0f / 3.0f, box, CameraMode::Auto);
+  EXPECT_FALSE(rc.fitted);
+  EXPECT_EQ(rc.camera.position, scene.camera.position);
+  EXPECT_EQ(rc.camera.look_at, scene.camera.look_at);
+  const auto dir = test::temp_dir("camera_kept");
+  write_pov((dir / "a.pov").string(), scene, tiny_plant(), RenderOptions{});
+  EXPECT_NE(read_file(dir / "a.pov").find("location <0,1,-2.5> look_at"), std::string::npos);
+  // An empty plant has nothing to frame.
+  const Scene far = far_scene();
+  EXPECT_TRUE(plant_bounds(far, Plant{}).empty());
+  const RenderCamera empty = choose_camera(far.camera, 4.0f / 3.0f, plant_bounds(far, Plant{}), CameraMode::Auto);
+  EXPECT_FALSE(empty.fitted);
+  EXPECT_EQ(empty.camera.position, far.camera.position);
+  write_pov((dir / "e.pov").string(), far, Plant{}, RenderOptions{});
+  EXPECT_NE(read_file(dir / "e.pov").find("location <0,4,-12>"), std::string::npos);
+}
+
+TEST(RenderCamera, APlantWithDecalsIsFramedByThem) {
+  // The decals stand for the plant: its nodes (far off here) do not count, the decal's rectangle and the
+  // mesh a decal follows do.
+  Scene scene = uv_quad_scene();
+  Plant p;
+  PlantNode far_node;
+  far_node.position = {50.0f, 0.0f, 0.0f};
+  p.nodes.push_back(far_node);
+  p.decals = {tilted_planar_decal("a.png")};
+  Aabb box = plant_bounds(scene, p);
+  EXPECT_EQ(box.min, glm::vec3(-1.0f, 0.0f, 0.0f));
+  EXPECT_EQ(box.max, glm::vec3(1.0f, 2.0f, 1.0f));
+  p.decals = {uv_decal("a.png", 0)};
+  box = plant_bounds(scene, p);
+  EXPECT_EQ(box.min, glm::vec3(-1.0f, 0.0f, 0.0f));
+  EXPECT_EQ(box.max, glm::vec3(1.0f, 2.0f, 0.0f));
+}
+
+TEST(RenderCamera, TurntableFramesOrbitTheAxisAtOneDistanceWithThePlantInFrame) {
+  const Scene scene = far_scene();
+  Plant plant = tiny_plant();
+  plant.nodes[10].position.x += 1.0f;  // lopsided, so a fit to each angle's view would vary
+  const Aabb box = plant_bounds(scene, plant);
+  const float aspect = 4.0f / 3.0f;
+  const int n = 7;
+  std::vector<glm::vec3> positions;
+  for (int k = 0; k < n; ++k) {
+    const Orbit o = turntable_camera(scene.camera, aspect, box, k, n);
+    EXPECT_NEAR(o.angle, 2.0f * std::numbers::pi_v<float> * static_cast<float>(k) / n, 1e-5f);
+    EXPECT_EQ(o.axis_point, box.center());
+    positions.push_back(o.camera.position);
+    // In frame, with the margin, at every angle (a prism around the swept cylinder is fitted, so the
+    // plant's own box lies inside it).
+    const auto [lo, hi] = projected_box(o.camera, aspect, corners(box));
+    for (const float v : {lo.x, lo.y, hi.x, hi.y}) EXPECT_LE(std::abs(v), 0.8f + 2e-3f) << "frame " << k;
+    EXPECT_GT(projected_extent(o.camera, aspect, box), 0.5f) << "frame " << k;
+    EXPECT_FLOAT_EQ(o.camera.fov_deg, scene.camera.fov_deg);
+  }
+  // Frame 0 looks the scene camera's way; all are at one distance from the axis and one height, and
+  // distinct.
+  const Orbit first = turntable_camera(scene.camera, aspect, box, 0, n);
+  EXPECT_GT(glm::dot(camera_frame(first.camera).forward, camera_frame(scene.camera).forward), 1.0f - 1e-6f);
+  const glm::vec2 axis(box.center().x, box.center().z);
+  const float r0 = glm::length(glm::vec2(positions[0].x, positions[0].z) - axis);
+  EXPECT_GT(r0, 1.0f);
+  for (int k = 0; k < n; ++k) {
+    EXPECT_NEAR(glm::length(glm::vec2(positions[k].x, positions[k].z) - axis), r0, 1e-4f * r0) << "frame " << k;
+    EXPECT_NEAR(positions[k].y, positions[0].y, 1e-4f * r0);
+    for (int m = 0; m < k; ++m) EXPECT_GT(glm::length(positions[k] - positions[m]), 0.5f * r0) << k << " and " << m;
+  }
+  // The .pov files follow: each frame its own camera, and the light turned with it.
+  const auto dir = test::temp_dir("turntable_pov");
+  RenderOptions o;
+  o.turns = n;
+  std::set<std::string> cameras, lights;
+  for (int k = 0; k < n; ++k) {
+    o.turn = k;
+    write_pov((dir / "t.pov").string(), scene, plant, o);
+    const std::string pov = read_file(dir / "t.pov");
+    cameras.insert(pov.substr(pov.find("camera {"), pov.find('\n', pov.find("camera {")) - pov.find("camera {")));
+    lights.insert(pov.substr(pov.find("light_source {"), 60));
+  }
+  EXPECT_EQ(cameras.size(), static_cast<std::size_t>(n));
+  EXPECT_EQ(lights.size(), static_cast<std::size_t>(n));
+  o.turn = n;
+  EXPECT_NE(test::error_of([&] { write_pov((dir / "t.pov").string(), scene, plant, o); }).find("turntable frame"),
+            std::string::npos);
+}
+
+TEST(PovWriter, DepthOfFieldFocusesOnThePlantAndKeepsItSharp) {
+  const auto dir = test::temp_dir("pov_dof");
+  const Scene scene = far_scene();
+  const Plant plant = tiny_plant();
+  RenderOptions o;
+  o.quality = RenderQuality::Paper;
+  write_pov((dir / "sharp.pov").string(), scene, plant, o);
+  EXPECT_EQ(read_file(dir / "sharp.pov").find("aperture"), std::string::npos);
+  o.dof = true;
+  write_pov((dir / "dof.pov").string(), scene, plant, o);
+  const std::string pov = read_file(dir / "dof.pov");
+  const RenderView view = render_view(scene, plant, o);
+  const glm::vec3 c = view.subject.center();
+  EXPECT_NE(pov.find(fmt::format("focal_point <{:.6g},{:.6g},{:.6g}>", c.x, c.y, -c.z)), std::string::npos) << pov;
+  EXPECT_NE(pov.find("blur_samples"), std::string::npos);
+  // The aperture keeps the box's corners within kSharpBlur of the frame's height (POV-Ray's lens is half
+  // the aperture across), and one of them, or the far background, at the limit.
+  const FocalBlur fb = focal_blur(view.camera, view.subject);
+  EXPECT_NE(pov.find(fmt::format("aperture {:.6g} ", fb.aperture)), std::string::npos);
+  ASSERT_GT(fb.aperture, 0.0f);
+  const CameraFrame f = camera_frame(view.camera);
+  const float focus = glm::dot(c - view.camera.position, f.forward);
+  const float frame_h = 2.0f * focus * std::tan(0.5f * glm::radians(view.camera.fov_deg));
+  float worst = 0.0f;
+  for (const glm::vec3& p : corners(view.subject)) {
+    const float d = glm::dot(p - view.camera.position, f.forward);
+    worst = std::max(worst, 0.5f * fb.aperture * std::abs(d - focus) / d / frame_h);
+  }
+  EXPECT_LE(worst, kSharpBlur * 1.001f);
+  EXPECT_TRUE(worst > kSharpBlur * 0.999f || 0.5f * fb.aperture / frame_h > kMaxBlur * 0.999f);
+  // The preview refuses it, naming the option.
+  o.quality = RenderQuality::Preview;
+  EXPECT_NE(test::error_of([&] { write_pov((dir / "p.pov").string(), scene, plant, o); }).find("--dof"),
+            std::string::npos);
+}
+
+TEST(PovWriter, StudioBackdropReplacesSkyAndGroundAndKeepsWhatThePlantClimbs) {
+  const auto dir = test::temp_dir("pov_studio");
+  const Scene scene = far_scene();
+  RenderOptions o;
+  write_pov((dir / "scene.pov").string(), scene, tiny_plant(), o);
+  const std::string with_scene = read_file(dir / "scene.pov");
+  EXPECT_NE(with_scene.find("sky_sphere"), std::string::npos);
+  EXPECT_NE(with_scene.find("plane {"), std::string::npos);
+  EXPECT_NE(with_scene.find("scene mesh 'ground'"), std::string::npos);
+  o.backdrop = Backdrop::Studio;
+  write_pov((dir / "studio.pov").string(), scene, tiny_plant(), o);
+  const std::string studio = read_file(dir / "studio.pov");
+  EXPECT_EQ(studio.find("sky_sphere"), std::string::npos);
+  EXPECT_EQ(studio.find("plane {"), std::string::npos);
+  EXPECT_EQ(studio.find("scene mesh 'ground'"), std::string::npos);  // not climbable
+  EXPECT_NE(studio.find("scene mesh 'post'"), std::string::npos);
+  EXPECT_NE(studio.find("texture { GB_Studio }"), std::string::npos);
+  EXPECT_NE(studio.find("background {"), std::string::npos);
+  EXPECT_EQ(count_of(studio, "\n  cone {"), tiny_plant().nodes.size() - 1);  // the plant is all there
+}
+
+TEST(PovRender, AutoCameraFillsTheFrameWithASmallPlant) {
+  ASSERT_FALSE(find_povray().empty()) << "povray is not installed (scripts/install-deps installs it)";
+  const auto dir = test::temp_dir("render_auto");
+  const Scene scene = far_scene();
+  RenderOptions o;
+  o.width = 160;
+  o.height = 120;
+  // The plant's pixels: where the render differs from the one without it (same camera: it frames the
+  // plant whether or not it is drawn). Returns the fraction of the frame's width and height they span.
+  auto plant_span = [&](CameraMode mode, const std::string& name) {
+    o.camera = mode;
+    o.draw_plant = true;
+    const RenderResult with =
+        render_plant(scene, tiny_plant(), (dir / (name + ".pov")).string(), (dir / (name + ".png")).string(), o);
+    EXPECT_TRUE(with.ok()) << with.message;
+    EXPECT_TRUE(with.warnings.empty()) << with.warnings.front();
+    o.draw_plant = false;
+    const RenderResult bare = render_plant(scene, tiny_plant(), (dir / (name + "_bare.pov")).string(),
+                                           (dir / (name + "_bare.png")).string(), o);
+    EXPECT_TRUE(bare.ok()) << bare.message;
+    const Image a = load_png(with.png), b = load_png(bare.png);
+    glm::ivec2 lo(a.w, a.h), hi(-1);
+    for (int y = 0; y < a.h; ++y)
+      for (int x = 0; x < a.w; ++x) {
+        const std::size_t i = 3 * (static_cast<std::size_t>(y) * a.w + x);
+        int d = 0;
+        for (int c = 0; c < 3; ++c) d += std::abs(a.rgb[i + c] - b.rgb[i + c]);
+        if (d > 30) {
+          lo = glm::min(lo, glm::ivec2(x, y));
+          hi = glm::max(hi, glm::ivec2(x, y));
+        }
+      }
+    return std::make_pair(with.camera, glm::vec2(hi - lo + 1) / glm::vec2(a.w, a.h));
+  };
+  const auto [fitted, big] = plant_span(CameraMode::Auto, "auto");
+  const auto [kept, small] = plant_span(CameraMode::Scene, "scene");
+  EXPECT_EQ(fitted, "fitted");
+  EXPECT_EQ(kept, "scene");
+  EXPECT_LT(std::max(small.x, small.y), 0.3f) << small.x << " x " << small.y;
+  // The plant (its shadow too) spans most of the frame on one axis, inside the margin's 80% or about.
+  EXPECT_GT(std::max(big.x, big.y), 0.6f) << big.x << " x " << big.y;
 }
 
 TEST(PlantSnapshot, RoundTripsBitForBit) {
@@ -517,6 +784,65 @@ TEST(RenderCli, RunRendersThePlantAndItsGrowthFrames) {
   EXPECT_NE(bad.out.find("neither a suite results directory"), std::string::npos) << bad.out;
 }
 
+TEST(RenderCli, BadRenderOptionsAreRefusedBeforeTheTrialNamingTheOption) {
+  const auto dir = test::temp_dir("cli_render_bad");
+  const std::string run = "run -q -a spacecol -s wall --set point_count=300 --max-steps 20 -o " + dir.string();
+  for (const auto& [args, option] :
+       std::vector<std::pair<std::string, std::string>>{{" --render preview --camera fish", "--camera"},
+                                                        {" --render preview --backdrop moon", "--backdrop"},
+                                                        {" --render preview --turntable 0", "--turntable"},
+                                                        {" --render preview --turntable -2", "--turntable"},
+                                                        {" --render preview --dof", "--dof"},
+                                                        {" --turntable 3", "--render"}}) {
+    const auto r = test::run_growbench(run + args);
+    EXPECT_EQ(r.status, 2) << args << ": " << r.out;
+    EXPECT_NE(r.out.find(option), std::string::npos) << args << ": " << r.out;
+    EXPECT_FALSE(std::filesystem::exists(dir / "record.json")) << args << ": the plant grew first";
+  }
+  const auto grown = test::run_growbench(run);
+  ASSERT_EQ(grown.status, 0) << grown.out;
+  for (const auto& [args, option] : std::vector<std::pair<std::string, std::string>>{
+           {"--camera fish", "--camera"}, {"--turntable 0", "--turntable"}, {"--dof", "--dof"}}) {
+    const auto r = test::run_growbench("render -q " + args + " " + dir.string());
+    EXPECT_EQ(r.status, 2) << args << ": " << r.out;
+    EXPECT_NE(r.out.find(option), std::string::npos) << args << ": " << r.out;
+  }
+}
+
+TEST(RenderCli, TurntableRendersFramesAroundThePlantAndItsVideo) {
+  const auto dir = test::temp_dir("cli_turntable");
+  const auto run =
+      test::run_growbench("run -q -a spacecol -s wall --set point_count=300 --max-steps 20 -o " + dir.string());
+  ASSERT_EQ(run.status, 0) << run.out;
+  const auto r = test::run_growbench("render --width 64 --height 48 --turntable 4 --backdrop studio " + dir.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("turntable/frame_0003.png: ok"), std::string::npos) << r.out;  // a progress line per frame
+  std::set<std::string> cameras;
+  for (int k = 0; k < 4; ++k) {
+    const auto frame = dir / "turntable" / fmt::format("frame_{:04d}", k);
+    EXPECT_TRUE(std::filesystem::exists(fs_concat(frame, ".png"))) << frame;
+    const std::string pov = read_file(fs_concat(frame, ".pov"));
+    cameras.insert(pov.substr(pov.find("camera {"), pov.find('\n', pov.find("camera {")) - pov.find("camera {")));
+    EXPECT_NE(pov.find("GB_Studio"), std::string::npos);
+  }
+  EXPECT_EQ(cameras.size(), 4u);
+  std::ifstream in(dir / "record.json");
+  const auto rec = nlohmann::json::parse(in);
+  EXPECT_EQ(rec["turntable"]["frames"], 4);
+  EXPECT_EQ(rec["render"]["backdrop"], "studio");
+  EXPECT_TRUE(rec["render"]["camera"] == "fitted" || rec["render"]["camera"] == "scene") << rec["render"].dump();
+  if (std::system("command -v ffmpeg > /dev/null") == 0) {
+    EXPECT_EQ(rec["turntable"]["status"], "ok") << rec["turntable"].dump();
+    EXPECT_TRUE(std::filesystem::exists(dir / "turntable.mp4"));
+  }
+  // A shorter turntable leaves none of the longer one's frames behind.
+  const auto again = test::run_growbench("render -q --width 64 --height 48 --turntable 2 " + dir.string());
+  ASSERT_EQ(again.status, 0) << again.out;
+  EXPECT_TRUE(std::filesystem::exists(dir / "turntable" / "frame_0001.png"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "turntable" / "frame_0002.png"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "turntable" / "frame_0003.pov"));
+}
+
 TEST(RenderCli, DecalImagesAreReadBesideTheirSnapshotsAndAreNotAnimationFrames) {
   const auto dir = test::temp_dir("cli_render_decals");
   const auto run = test::run_growbench(
@@ -544,9 +870,11 @@ TEST(RenderCli, DecalImagesAreReadBesideTheirSnapshotsAndAreNotAnimationFrames) 
   ro.render.width = 64;
   ro.render.height = 48;
   ro.quiet = true;
+  ro.turntable = 2;  // its frames, in turntable/, read the run's decal image beside plant.gbplant
   const RenderSummary summary = render_directory_record(dir.string(), ro);
   EXPECT_EQ(summary.failed, 0u);
-  EXPECT_EQ(summary.ok, frames + 1);
+  EXPECT_EQ(summary.ok, frames + 1 + 2);
+  EXPECT_NE(read_file(dir / "turntable" / "frame_0001.pov").find("png \"vine.png\""), std::string::npos);
   EXPECT_EQ(summary.warnings, 0u);
   EXPECT_NE(read_file(dir / "frames" / "step_000010.pov").find("png \"step_000010.vine.png\""), std::string::npos);
   EXPECT_NE(read_file(dir / "render.pov").find("png \"vine.png\""), std::string::npos);

@@ -1,0 +1,104 @@
+// The render's camera: the scene's, or one that frames the plant; the turntable's orbit; the depth of
+// field that keeps the plant sharp. All in growbench's coordinates (right-handed, Y up); the POV-Ray
+// writer converts them. A camera's fov_deg is vertical, and POV-Ray's camera is set up as camera_frame
+// says (look_at, sky +Y, square pixels), so project() is where a point lands in the image.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "algorithms/plant.hpp"
+#include "scenes/scene.hpp"
+
+namespace growbench {
+
+enum class CameraMode { Auto, Scene };
+// "auto" or "scene"; anything else is an InputError naming the option.
+CameraMode parse_camera_mode(const std::string& text, const std::string& option = "--camera");
+const char* to_string(CameraMode m);
+
+// The margin a fitted camera leaves between the plant's projected box and each edge of the frame, as a
+// fraction of the frame's width (left and right) and height (top and bottom).
+constexpr float kFrameMargin = 0.1f;
+
+// What of the plant a render draws, as a box: each node a sphere of its radius, each organ a sphere of its
+// size times `organ_reach` (the organ shape's farthest point from its stem at unit size), the polygons'
+// vertices. A plant with decals is drawn by them alone, so it is their bounds instead: the scene mesh a
+// decal's image follows, and a planar decal's rectangle. Empty for an empty plant.
+Aabb plant_bounds(const Scene& scene, const Plant& plant, float organ_reach = 1.0f);
+
+// A camera's axes as POV-Ray sets them up from location, look_at and the default sky +Y: unit right, up
+// and forward.
+struct CameraFrame {
+  glm::vec3 right, up, forward;
+};
+CameraFrame camera_frame(const Camera& camera);
+
+// Where p lands in the image of `camera` at `aspect` (width / height): x from -1 (left edge) to 1 (right),
+// y from -1 (bottom) to 1 (top), z its depth along the view direction (not positive: behind the camera).
+glm::vec3 project(const Camera& camera, float aspect, const glm::vec3& p);
+
+// The box's 8 corners (none for an empty box).
+std::vector<glm::vec3> corners(const Aabb& box);
+
+// How much of the frame `box` covers: its projected corners' extent, clipped to the frame, as a fraction
+// of the frame's width or of its height, whichever is larger. 0 for an empty box or one with a corner
+// behind the camera.
+float projected_extent(const Camera& camera, float aspect, const Aabb& box);
+
+// The camera with `camera`'s view direction and vertical field of view, moved along and across that
+// direction, that frames `points`: each lies at least `margin` of the frame's width and height inside the
+// frame's edges, and on the tighter axis their projection spans the rest of the frame, centred. An exact
+// fit of the perspective projection, not of a bounding sphere. `camera` itself when there are no points.
+Camera fit_camera(const Camera& camera, float aspect, const std::vector<glm::vec3>& points,
+                  float margin = kFrameMargin);
+
+// The camera a render uses, and why.
+struct RenderCamera {
+  Camera camera;
+  bool fitted = false;       // moved to frame the plant
+  float scene_extent = 0.f;  // the plant's projected_extent with the scene camera
+};
+
+// The `auto` rule, in one place: the scene camera unless the plant is small in its frame, then a camera
+// fitted to the plant (fit_camera with kFrameMargin). Small: the plant's box spans less than
+// kSmallPlantExtent of the frame's width and of its height (or some of it lies behind the camera).
+// Why keep the scene camera otherwise: it frames its scene as the scene's author meant, with room around
+// it (a standard wall spans about half the frame), so a plant that covers its support spans a good part of
+// the frame and is best seen that way; grids stay comparable across algorithms, and renders that already
+// show the plant do not change. Below about a third of the frame, the plant is a twig in a large scene.
+// `scene` always keeps it; an empty `plant` box keeps it too.
+constexpr float kSmallPlantExtent = 0.35f;
+RenderCamera choose_camera(const Camera& scene_camera, float aspect, const Aabb& plant, CameraMode mode);
+
+// Turntable frame `frame` of `frames`: the scene camera turned by 2 pi frame / frames about the vertical
+// axis through the plant box's centre (so frame 0 looks as the scene camera does), at the distance from
+// that axis at which the plant stays in frame at every angle: fitted to a prism around the cylinder the
+// plant's box sweeps, turned with the view, so every frame has the same fit. An empty `plant` box orbits the
+// scene camera about the vertical through its look_at, unfitted. `angle` is the turn, in radians about +Y
+// (the light turns with the camera: the plant turns as on a turntable under fixed lights).
+struct Orbit {
+  Camera camera;
+  glm::vec3 axis_point{0.0f};  // a point of the vertical axis
+  float angle = 0.0f;
+};
+Orbit turntable_camera(const Camera& scene_camera, float aspect, const Aabb& plant, int frame, int frames);
+
+// A point rotated by `angle` radians about the vertical axis through `axis_point`.
+glm::vec3 turn_about_vertical(const glm::vec3& p, const glm::vec3& axis_point, float angle);
+
+// Depth of field for `subject` (the plant's box) seen by `camera`: in focus at the box's centre, with the
+// widest aperture (world units, POV-Ray's `aperture`) that keeps the box's nearest and farthest corners
+// within kSharpBlur of the frame's height of blur, and no wider than blurs the far background (at
+// infinity) by kMaxBlur of it. A deep plant stays sharp with a little background blur; a flat one (on a
+// wall) lets the background soften more.
+constexpr float kSharpBlur = 0.0025f, kMaxBlur = 0.03f;
+struct FocalBlur {
+  glm::vec3 focal_point{0.0f};
+  float aperture = 0.0f;
+};
+FocalBlur focal_blur(const Camera& camera, const Aabb& subject);
+
+}  // namespace growbench
