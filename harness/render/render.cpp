@@ -567,10 +567,12 @@ float aspect_of(const RenderOptions& o) {
   return static_cast<float>(render_width(o)) / static_cast<float>(render_height(o));
 }
 
-// How far the organ shape reaches from its stem at unit size (plant_bounds' organ_reach).
-float organ_reach(const MesherOptions& mesher) {
+// How far the plant's organ shapes reach from their stems at unit size (plant_bounds' organ_reach).
+float organ_reach(const Plant& plant, const MesherOptions& mesher) {
   float reach = 0.0f;
-  for (const glm::vec3& v : organ_shape(mesher).vertices) reach = std::max(reach, glm::length(v));
+  const OrganShapes shapes = organ_shapes(plant, mesher);
+  for (const OrganShape& s : shapes.all())
+    for (const glm::vec3& v : s.mesh.vertices) reach = std::max(reach, glm::length(v));
   return reach > 0.0f ? reach : 1.0f;
 }
 
@@ -633,7 +635,7 @@ RenderView render_view(const Scene& scene, const Plant& plant, const RenderOptio
   const float aspect = aspect_of(o);
   RenderView v;
   v.light = scene.light;
-  v.subject = o.subject.empty() ? plant_bounds(scene, plant, organ_reach(o.mesher)) : o.subject;
+  v.subject = o.subject.empty() ? plant_bounds(scene, plant, organ_reach(plant, o.mesher)) : o.subject;
   if (o.turns > 0) {
     const Orbit orbit = turntable_camera(scene.camera, aspect, v.subject, o.turn, o.turns);
     v.camera = orbit.camera;
