@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <numbers>
 
 #include <fmt/format.h>
@@ -250,29 +252,39 @@ glm::vec3 srgb_to_linear(const glm::vec3& c) {
   return {f(c.x), f(c.y), f(c.z)};
 }
 
+namespace {
+
+// Built-ins by their text, made once per process: a plant's meshing, metrics and render each ask for
+// the same few, and a leafy plant should not pay for a blossom it does not have.
+std::shared_ptr<const OrganShape> shared_builtin(const std::string& text) {
+  static std::mutex mutex;
+  static std::map<std::string, std::shared_ptr<const OrganShape>> made;
+  const std::lock_guard<std::mutex> lock(mutex);
+  auto& s = made[text];
+  if (!s) s = std::make_shared<const OrganShape>(builtin_organ_shape(text));
+  return s;
+}
+
+}  // namespace
+
 OrganShapes::OrganShapes(const Plant& plant, const OrganShape* custom_leaf) {
   static const char* const kDefault[4] = {"leaf", "leaf", "blossom", "bud"};
+  std::array<bool, 4> present{};
+  for (const auto& o : plant.organs)
+    if (o.shape == kKindShape) present[static_cast<std::size_t>(o.kind)] = true;
+  if (custom_leaf) shapes_.push_back(std::make_shared<const OrganShape>(*custom_leaf));
   for (std::size_t k = 0; k < 4; ++k) {
-    if (custom_leaf && k > 0) {
-      kind_[k] = 0;
-      continue;
-    }
-    kind_[k] = shapes_.size();
-    if (custom_leaf)
-      shapes_.push_back(*custom_leaf);
-    else if (k == 1)
-      kind_[k] = kind_[0];
-    else
-      shapes_.push_back(builtin_organ_shape(kDefault[k]));
+    if (custom_leaf || !present[k]) continue;  // kind_[k] stays 0: never asked for
+    const auto it = std::find_if(shapes_.begin(), shapes_.end(), [&](const auto& s) { return s->name == kDefault[k]; });
+    kind_[k] = static_cast<std::size_t>(it - shapes_.begin());
+    if (it == shapes_.end()) shapes_.push_back(shared_builtin(kDefault[k]));
   }
   for (const auto& name : plant.organ_shapes) {
-    const auto it = std::find_if(shapes_.begin(), shapes_.end(), [&](const OrganShape& s) { return s.name == name; });
-    if (it != shapes_.end()) {
-      named_.push_back(static_cast<std::size_t>(it - shapes_.begin()));
-    } else {
-      named_.push_back(shapes_.size());
-      shapes_.push_back(organ_shape_named(name));
-    }
+    const auto it = std::find_if(shapes_.begin(), shapes_.end(), [&](const auto& s) { return s->name == name; });
+    named_.push_back(static_cast<std::size_t>(it - shapes_.begin()));
+    if (it != shapes_.end()) continue;
+    const bool file = name.find('/') != std::string::npos || name.ends_with(".obj") || name.ends_with(".OBJ");
+    shapes_.push_back(file ? std::make_shared<const OrganShape>(load_organ_obj(name)) : shared_builtin(name));
   }
 }
 
@@ -281,7 +293,7 @@ std::size_t OrganShapes::index_of(const Organ& o) const {
 }
 
 const OrganShape& OrganShapes::of(const Organ& o) const {
-  return shapes_[index_of(o)];
+  return *shapes_[index_of(o)];
 }
 
 glm::vec3 OrganShapes::linear_color(const Organ& o) const {

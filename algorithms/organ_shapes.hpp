@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -57,7 +58,8 @@ class OrganShapes {
   OrganShapes(const Plant& plant, const OrganShape* custom_leaf = nullptr);
   [[nodiscard]] const OrganShape& of(const Organ& organ) const;
   // Every distinct shape, and the index of an organ's shape among them.
-  [[nodiscard]] const std::vector<OrganShape>& all() const { return shapes_; }
+  [[nodiscard]] std::size_t size() const { return shapes_.size(); }
+  [[nodiscard]] const OrganShape& at(std::size_t i) const { return *shapes_[i]; }
   [[nodiscard]] std::size_t index_of(const Organ& organ) const;
   // The linear colour an organ is drawn in: its shape's or its kind's, times its tint.
   [[nodiscard]] glm::vec3 linear_color(const Organ& organ) const;
@@ -65,9 +67,9 @@ class OrganShapes {
   [[nodiscard]] bool any_color(const Plant& plant) const;
 
  private:
-  std::vector<OrganShape> shapes_;
-  std::vector<std::size_t> named_;     // Plant::organ_shapes[i] -> shapes_
-  std::array<std::size_t, 4> kind_{};  // OrganKind -> shapes_
+  std::vector<std::shared_ptr<const OrganShape>> shapes_;  // built-ins shared by every OrganShapes
+  std::vector<std::size_t> named_;                         // Plant::organ_shapes[i] -> shapes_
+  std::array<std::size_t, 4> kind_{};                      // OrganKind -> shapes_ (only the kinds the plant has)
 };
 
 }  // namespace growbench

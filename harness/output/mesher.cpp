@@ -118,7 +118,8 @@ void add_organ(OutputMesh& m, const Organ& organ, const OrganShape& shape, const
   const auto base = static_cast<std::uint32_t>(m.positions.size());
   const glm::mat3 r = glm::mat3_cast(organ.orientation);
   for (std::size_t k = 0; k < shape.mesh.vertices.size(); ++k) {
-    m.positions.push_back(organ_point(organ, shape.mesh.vertices[k]));
+    // organ_point's arithmetic in its order (the same floats), with the rotation made once per organ.
+    m.positions.push_back(organ.position + r * (shape.mesh.vertices[k] * organ.size));
     m.normals.push_back(r * shape.normals[k]);
   }
   if (color) m.colors.resize(m.positions.size(), *color);
@@ -149,8 +150,9 @@ OutputMesh mesh_plant(const Plant& plant, const MesherOptions& o) {
   // or its group's material colour.
   const bool colored = shapes.any_color(plant);
   auto organ_mesh = [&](const Organ& organ) {
+    if (!colored) return add_organ(m, organ, shapes.of(organ), nullptr);
     const glm::vec3 c = shapes.linear_color(organ);
-    add_organ(m, organ, shapes.of(organ), colored ? &c : nullptr);
+    add_organ(m, organ, shapes.of(organ), &c);
   };
   auto group = [&](const char* name, const char* material, auto&& body) {
     const auto first = static_cast<std::uint32_t>(m.triangles.size());

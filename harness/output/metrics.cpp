@@ -308,6 +308,9 @@ class MetricsPass {
                             std::max(nodes[static_cast<std::size_t>(nodes[s].parent)].radius, 1e-4f),
                             std::max(nodes[s].radius, 1e-4f)});
       std::vector<Occluder::Triangle> tris;
+      std::size_t organ_triangles = 0;
+      for (const auto& org : plant.organs) organ_triangles += shapes.of(org).mesh.triangles.size();
+      tris.reserve(organ_triangles);
       for (std::uint32_t i = 0; i < plant.organs.size(); ++i)
         for (const auto& t : shapes.of(plant.organs[i]).mesh.triangles) {
           Occluder::Triangle ot;

@@ -479,14 +479,13 @@ void write_branches(Out out, const Plant& plant, const RenderOptions& o) {
 void write_organs(Out out, const Plant& plant, const MesherOptions& mesher) {
   if (plant.organs.empty()) return;
   const OrganShapes shapes = organ_shapes(plant, mesher);
-  std::vector<std::uint8_t> used(shapes.all().size(), 0);
+  std::vector<std::uint8_t> used(shapes.size(), 0);
   for (const auto& organ : plant.organs) used[shapes.index_of(organ)] = 1;
   for (std::size_t k = 0; k < used.size(); ++k) {
     if (!used[k]) continue;
-    const TriangleMesh& m = shapes.all()[k].mesh;
-    fmt::format_to(out, "#declare GB_Organ{} =  // {}\n", k, shapes.all()[k].name);
-    write_mesh2(out, m.vertices, shapes.all()[k].normals, m.triangles, 0,
-                static_cast<std::uint32_t>(m.triangles.size()));
+    const TriangleMesh& m = shapes.at(k).mesh;
+    fmt::format_to(out, "#declare GB_Organ{} =  // {}\n", k, shapes.at(k).name);
+    write_mesh2(out, m.vertices, shapes.at(k).normals, m.triangles, 0, static_cast<std::uint32_t>(m.triangles.size()));
     fmt::format_to(out, "}}\n");
   }
   const glm::mat3 flip(glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, 0, -1));
@@ -571,8 +570,8 @@ float aspect_of(const RenderOptions& o) {
 float organ_reach(const Plant& plant, const MesherOptions& mesher) {
   float reach = 0.0f;
   const OrganShapes shapes = organ_shapes(plant, mesher);
-  for (const OrganShape& s : shapes.all())
-    for (const glm::vec3& v : s.mesh.vertices) reach = std::max(reach, glm::length(v));
+  for (std::size_t k = 0; k < shapes.size(); ++k)
+    for (const glm::vec3& v : shapes.at(k).mesh.vertices) reach = std::max(reach, glm::length(v));
   return reach > 0.0f ? reach : 1.0f;
 }
 
