@@ -222,11 +222,17 @@ OrganShape load_organ_obj(const std::string& path) {
   return s;
 }
 
+namespace {
+
+// A shape's name that means a file: a path, or anything ending in .obj.
+bool names_a_file(const std::string& name) {
+  return name.find('/') != std::string::npos || name.ends_with(".obj") || name.ends_with(".OBJ");
+}
+
+}  // namespace
+
 OrganShape organ_shape_named(const std::string& name, std::string_view source) {
-  const bool file = name.find('/') != std::string::npos ||
-                    (name.size() > 4 && name.compare(name.size() - 4, 4, ".obj") == 0) ||
-                    (name.size() > 4 && name.compare(name.size() - 4, 4, ".OBJ") == 0);
-  return file ? load_organ_obj(name) : builtin_organ_shape(name, source);
+  return names_a_file(name) ? load_organ_obj(name) : builtin_organ_shape(name, source);
 }
 
 glm::vec3 organ_point(const Organ& organ, const glm::vec3& local) {
@@ -283,8 +289,8 @@ OrganShapes::OrganShapes(const Plant& plant, const OrganShape* custom_leaf) {
     const auto it = std::find_if(shapes_.begin(), shapes_.end(), [&](const auto& s) { return s->name == name; });
     named_.push_back(static_cast<std::size_t>(it - shapes_.begin()));
     if (it != shapes_.end()) continue;
-    const bool file = name.find('/') != std::string::npos || name.ends_with(".obj") || name.ends_with(".OBJ");
-    shapes_.push_back(file ? std::make_shared<const OrganShape>(load_organ_obj(name)) : shared_builtin(name));
+    shapes_.push_back(names_a_file(name) ? std::make_shared<const OrganShape>(load_organ_obj(name))
+                                         : shared_builtin(name));
   }
 }
 
