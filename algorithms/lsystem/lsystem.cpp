@@ -74,8 +74,8 @@ const AlgorithmInfo kInfo = {
             param::text("context_ignore")
                 .doc("symbols skipped when matching contexts, e.g. '+-F'; with '[' or ']' brackets become transparent"),
             param::boolean("context_siblings", false)
-                .doc(
-                    "contexts read across branch brackets (pre-Houdini 10 behaviour) instead of skipping sub-branches"),
+                .doc("Context Includes Siblings (pre-Houdini 10): a right context that reaches the end of its "
+                     "branch goes on in the next sibling branch"),
             param::choice("probability", "sequential", {"sequential", "normalized"})
                 .doc("sequential: each applicable rule fires with its own chance, in order (Houdini); normalized: one "
                      "of "
@@ -268,7 +268,8 @@ Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* quer
       .stream = 0,  // set for each plant before it is rewritten
       .probability =
           p.text("probability") == "normalized" ? lsys::ProbabilityMode::Normalized : lsys::ProbabilityMode::Sequential,
-      .brackets_transparent = p.boolean("context_siblings") || s.grammar.ignore.test('[') || s.grammar.ignore.test(']'),
+      .brackets_transparent = s.grammar.ignore.test('[') || s.grammar.ignore.test(']'),
+      .siblings = p.boolean("context_siblings"),
       .max_symbols = max_symbols,
       .max_params = max_symbols * 2,
       .env = {},
