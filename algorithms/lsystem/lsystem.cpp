@@ -12,6 +12,7 @@
 #include "algorithms/lsystem/lsystem.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -98,6 +99,11 @@ const AlgorithmInfo kInfo = {
                 .doc("what in(x,y,z) tests: the scene envelope, the scene's solids, or auto (envelope if any, else "
                      "solids)"),
             param::text("pic_image").doc("image read by pic(u, v, plane) (PNG, JPEG, ...)"),
+            param::choice("geometry", "tube", {"tube", "skeleton"})
+                .doc("tube: tubes around the branches (F(l,w,s,d): s cross sections, d divisions); skeleton: "
+                     "the branches' polylines alone (Houdini's Geometry Type)"),
+            param::text("group_prefix", "lsys")
+                .doc("names of g groups: the prefix and the group number (letters, digits and _)"),
             param::integer("max_symbols", 50'000'000)
                 .range(1, 2e9)
                 .doc("a generation that would exceed this many symbols stops the run with an error"),
@@ -290,6 +296,12 @@ Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* quer
   for (std::size_t k = 0; k < user_values.size(); ++k) env[lsys::kUserVar0 + k] = user_values[k];
 
   if (p.text("surface") == "wrap" && !query) throw InputError("surface=wrap needs a scene with surfaces");
+  for (const char c : p.text("group_prefix"))
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_'))
+      throw InputError(
+          fmt::format("group_prefix '{}': expected letters, digits and '_' only (it names OBJ groups "
+                      "and glTF nodes)",
+                      p.text("group_prefix")));
   s.turtle = {
       .step = p.real("step_size"),
       .step_scale = p.real("step_scale"),
@@ -411,6 +423,9 @@ class LSystem final : public GrowthAlgorithm {
   void redraw() {
     const auto t0 = std::chrono::steady_clock::now();
     plant_.clear();
+    plant_.group_prefix = setup_.params.text("group_prefix");
+    plant_.branch_geometry =
+        setup_.params.text("geometry") == "skeleton" ? BranchGeometry::Skeleton : BranchGeometry::Tube;
     for (auto& pl : plants_) {
       if (!pl.started) continue;
       lsys::TurtleSettings ts = setup_.turtle;
