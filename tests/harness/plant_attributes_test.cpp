@@ -19,6 +19,7 @@
 #include "core/errors.hpp"
 #include "harness/output/exporters.hpp"
 #include "harness/output/mesher.hpp"
+#include "harness/render/render.hpp"
 #include "scenes/scene_library.hpp"
 #include "test_util.hpp"
 
@@ -341,6 +342,21 @@ TEST_F(PlantAttributes, OtherAttributesBecomePlyPropertiesAndGltfUnderscoreAttri
   ASSERT_EQ(wet_values.size(), m.positions.size());
   EXPECT_EQ(wet_values, m.attributes[0].values);
   EXPECT_EQ(std::count(wet_values.begin(), wet_values.end(), 0.75f), 14);  // the branch's rings and caps
+}
+
+TEST_F(PlantAttributes, RendersColourConesByCdAndLeaveOthersAsTheyWere) {
+  const Plant p = grow("a(\"Cd\",1,0,0)F[a(\"Cd\",0,0,1)F]");
+  const auto dir = test::temp_dir("attr_render");
+  RenderOptions o;
+  write_pov((dir / "c.pov").string(), *scene_, p, o);
+  const std::string pov = text_of(dir / "c.pov");
+  EXPECT_NE(pov.find("coloured by Cd"), std::string::npos);
+  EXPECT_NE(pov.find(" texture { GB_Bark pigment { rgb <0,0,1> } } }"), std::string::npos) << pov;
+  EXPECT_NE(pov.find(" texture { GB_Bark pigment { rgb <1,0,0> } } }"), std::string::npos);
+  Plant plain = p;
+  plain.node_attributes.clear();
+  write_pov((dir / "plain.pov").string(), *scene_, plain, o);
+  EXPECT_EQ(text_of(dir / "plain.pov").find("pigment { rgb"), std::string::npos);
 }
 
 // ---------- F(l, w, s, d) and the geometry type ----------
