@@ -94,21 +94,39 @@ std::int32_t group_of(const TubeExtras& x, std::int32_t node) {
   return g < 0 ? -1 : g;
 }
 
-// One ring of `sides` vertices around pts[j], its frame carried along from `normal` (parallel transport
-// in projection form: the previous normal made perpendicular to the tangent).
-void add_ring(OutputMesh& m, const std::vector<glm::vec3>& pts, float radius, std::size_t j, int sides,
-              glm::vec3& normal) {
-  const glm::vec3 a = pts[j == 0 ? 0 : j - 1], b = pts[j + 1 < pts.size() ? j + 1 : j];
-  const glm::vec3 t = glm::normalize(b - a);
-  glm::vec3 nrm = j == 0 ? any_perpendicular(t) : normal - glm::dot(normal, t) * t;
-  if (glm::length(nrm) < 1e-6f) nrm = any_perpendicular(t);
-  normal = glm::normalize(nrm);
-  const glm::vec3 binormal = glm::cross(t, normal);
-  for (int s = 0; s < sides; ++s) {
-    const float ang = 2.0f * std::numbers::pi_v<float> * static_cast<float>(s) / static_cast<float>(sides);
-    const glm::vec3 d = std::cos(ang) * normal + std::sin(ang) * binormal;
-    m.positions.push_back(pts[j] + radius * d);
-    m.normals.push_back(d);
+// Rings start..end of a tube with `sides` vertices each, the frame carried along from `normal`
+// (parallel transport in projection form: the previous normal made perpendicular to the tangent), then
+// the quads between them. One loop with its values in locals, as this is most of a big plant's meshing.
+void add_strip(OutputMesh& m, const std::vector<glm::vec3>& pts, const std::vector<float>& rad, std::size_t start,
+               std::size_t end, int sides, glm::vec3& normal) {
+  const auto base = static_cast<std::uint32_t>(m.positions.size());
+  const std::size_t n = pts.size();
+  const float fsides = static_cast<float>(sides);
+  glm::vec3 carried = normal;
+  for (std::size_t j = start; j <= end; ++j) {
+    const glm::vec3 a = pts[j == 0 ? 0 : j - 1], b = pts[j + 1 < n ? j + 1 : j];
+    const glm::vec3 t = glm::normalize(b - a);
+    glm::vec3 nrm = j == 0 ? any_perpendicular(t) : carried - glm::dot(carried, t) * t;
+    if (glm::length(nrm) < 1e-6f) nrm = any_perpendicular(t);
+    carried = glm::normalize(nrm);
+    const glm::vec3 binormal = glm::cross(t, carried);
+    for (int s = 0; s < sides; ++s) {
+      const float ang = 2.0f * std::numbers::pi_v<float> * static_cast<float>(s) / fsides;
+      const glm::vec3 d = std::cos(ang) * carried + std::sin(ang) * binormal;
+      m.positions.push_back(pts[j] + rad[j] * d);
+      m.normals.push_back(d);
+    }
+  }
+  normal = carried;
+  const auto S = static_cast<std::uint32_t>(sides);
+  const auto segments = static_cast<std::uint32_t>(end - start);
+  for (std::uint32_t j = 0; j < segments; ++j) {
+    for (std::uint32_t s = 0; s < S; ++s) {
+      const std::uint32_t a = base + j * S + s, b = base + j * S + (s + 1) % S;
+      const std::uint32_t c = a + S, d = b + S;
+      m.triangles.emplace_back(a, b, d);
+      m.triangles.emplace_back(a, d, c);
+    }
   }
 }
 
@@ -126,6 +144,25 @@ struct TubePath {
 // at its parent's node with its own radius.
 void tube_path(TubePath& t, const Plant& plant, const std::vector<std::int32_t>& chain, const MesherOptions& o,
                const TubeExtras& x, int sides) {
+  if (!x.tubes && !t.sources) {  // most plants: points and radii alone, in vectors that do not escape
+    std::vector<glm::vec3> pts;
+    std::vector<float> rad;
+    for (std::size_t j = 0; j < chain.size(); ++j) {
+      const auto& node = plant.nodes[static_cast<std::size_t>(chain[j])];
+      const glm::vec3 p = node.position;
+      if (!pts.empty() && glm::length(p - pts.back()) < 1e-7f) continue;  // drop zero-length segments
+      float r = node.radius;
+      if (j == 0 && chain.size() > 1) {
+        const auto& next = plant.nodes[static_cast<std::size_t>(chain[1])];
+        if (next.shoot != node.shoot) r = std::min(r, next.radius);
+      }
+      pts.push_back(p);
+      rad.push_back(std::max(r, o.min_radius > 0.0f ? o.min_radius : 1e-4f));
+    }
+    t.pts = std::move(pts);
+    t.rad = std::move(rad);
+    return;
+  }
   for (std::size_t j = 0; j < chain.size(); ++j) {
     const auto id = chain[j];
     const auto& node = plant.nodes[static_cast<std::size_t>(id)];
@@ -172,8 +209,9 @@ void tube_path(TubePath& t, const Plant& plant, const std::vector<std::int32_t>&
 void add_tube(OutputMesh& m, const Plant& plant, const std::vector<std::int32_t>& chain, const MesherOptions& o,
               const TubeExtras& x, std::vector<std::int32_t>* triangle_groups) {
   const int sides = std::clamp(o.sides, 3, 64);
+  const bool vertex_data = x.vertex_data();
   TubePath path;
-  path.sources = x.vertex_data() || triangle_groups != nullptr;
+  path.sources = vertex_data || triangle_groups != nullptr;
   tube_path(path, plant, chain, o, x, sides);
   const std::vector<glm::vec3>& pts = path.pts;
   const std::vector<float>& rad = path.rad;
@@ -187,23 +225,16 @@ void add_tube(OutputMesh& m, const Plant& plant, const std::vector<std::int32_t>
   int first_sides = sides, last_sides = sides;
   for (std::size_t start = 0; start + 1 < pts.size();) {
     const int d = segment_divisions(start);
-    std::size_t end = start + 1;
+    std::size_t end = divisions.empty() ? pts.size() - 1 : start + 1;
     while (end + 1 < pts.size() && segment_divisions(end) == d) ++end;
     const auto base = static_cast<std::uint32_t>(m.positions.size());
-    for (std::size_t j = start; j <= end; ++j) {
-      add_ring(m, pts, rad[j], j, d, normal);
-      if (x.vertex_data()) add_vertex_data(m, x, src[j], static_cast<std::size_t>(d));
-    }
+    add_strip(m, pts, rad, start, end, d, normal);
     const auto S = static_cast<std::uint32_t>(d);
-    for (std::uint32_t j = 0; j < end - start; ++j) {
-      for (std::uint32_t s = 0; s < S; ++s) {
-        const std::uint32_t a = base + j * S + s, b = base + j * S + (s + 1) % S;
-        const std::uint32_t c = a + S, e = b + S;
-        m.triangles.emplace_back(a, b, e);
-        m.triangles.emplace_back(a, e, c);
-      }
-      if (triangle_groups) triangle_groups->insert(triangle_groups->end(), 2 * S, group_of(x, src[start + j + 1].b));
-    }
+    if (vertex_data)
+      for (std::size_t j = start; j <= end; ++j) add_vertex_data(m, x, src[j], S);
+    if (triangle_groups)
+      for (std::size_t j = start; j < end; ++j)
+        triangle_groups->insert(triangle_groups->end(), 2 * S, group_of(x, src[j + 1].b));
     if (start == 0) {
       first_ring = base;
       first_sides = d;
@@ -219,7 +250,7 @@ void add_tube(OutputMesh& m, const Plant& plant, const std::vector<std::int32_t>
       const auto centre = static_cast<std::uint32_t>(m.positions.size());
       m.positions.push_back(pts[j]);
       m.normals.push_back(start ? -t : t);
-      if (x.vertex_data()) add_vertex_data(m, x, src[j], 1);
+      if (vertex_data) add_vertex_data(m, x, src[j], 1);
       const std::uint32_t ring = start ? first_ring : last_ring;
       const auto S = static_cast<std::uint32_t>(start ? first_sides : last_sides);
       for (std::uint32_t s = 0; s < S; ++s) {
