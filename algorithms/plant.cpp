@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <memory>
@@ -85,10 +86,7 @@ std::string Plant::geometry_hash() const {
     put(o.stamp);
   }
   // Shapes and tints enter only when some organ has them, so plants without stay as they hashed before.
-  const bool styled = !organ_shapes.empty() || std::any_of(organs.begin(), organs.end(), [](const Organ& o) {
-    return o.shape != kKindShape || o.tint != glm::vec3(1.0f);
-  });
-  if (styled) {
+  if (organs_styled()) {
     put(organ_shapes.size());
     for (const auto& name : organ_shapes) {
       put(name.size());
@@ -112,6 +110,23 @@ std::string Plant::geometry_hash() const {
     bytes(a.name.data(), a.name.size());
     put(a.components);
     bytes(a.values.data(), a.values.size() * sizeof(float));
+  }
+  // Added after the above existed: each enters only when present, so older plants keep their hashes.
+  if (!node_tubes.empty()) {
+    bytes("tubes", 5);
+    put(node_tubes.size());
+    for (const auto& t : node_tubes) {
+      put(t.sections);
+      put(t.divisions);
+    }
+  }
+  if (!node_groups.empty() && !group_prefix.empty()) {
+    bytes("prefix", 6);
+    bytes(group_prefix.data(), group_prefix.size());
+  }
+  if (branch_geometry != BranchGeometry::Tube) {
+    bytes("geometry", 8);
+    put(branch_geometry);
   }
   hasher->flush();
   return fmt::format("{:016x}", XXH3_64bits_digest(hasher->st));
@@ -156,7 +171,33 @@ std::string Plant::validate() const {
     if (a.components < 1 || a.values.size() != nodes.size() * static_cast<std::size_t>(a.components))
       return fmt::format("attribute '{}' has {} values for {} nodes of {} components", a.name, a.values.size(),
                          nodes.size(), a.components);
+  if (!node_tubes.empty() && node_tubes.size() != nodes.size())
+    return fmt::format("{} node tubes for {} nodes", node_tubes.size(), nodes.size());
+  for (std::size_t i = 0; i < node_tubes.size(); ++i) {
+    const TubeShape& t = node_tubes[i];
+    if (t.sections > kMaxTubeSections)
+      return fmt::format("node {} has {} tube sections (expected 0 to {})", i, t.sections, kMaxTubeSections);
+    if (t.divisions != 0 && (t.divisions < kMinTubeDivisions || t.divisions > kMaxTubeDivisions))
+      return fmt::format("node {} has {} tube divisions (expected 0, or {} to {})", i, t.divisions, kMinTubeDivisions,
+                         kMaxTubeDivisions);
+  }
+  // The prefix names OBJ groups and glTF nodes: a word, so no reader splits or mangles it.
+  for (const char c : group_prefix)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_'))
+      return fmt::format("group prefix '{}' has a character other than letters, digits and '_'", group_prefix);
+  if (branch_geometry != BranchGeometry::Tube && branch_geometry != BranchGeometry::Skeleton)
+    return fmt::format("branch geometry {} is unknown", static_cast<int>(branch_geometry));
   return {};
+}
+
+bool Plant::organs_styled() const {
+  return !organ_shapes.empty() || std::any_of(organs.begin(), organs.end(), [](const Organ& o) {
+    return o.shape != kKindShape || o.tint != glm::vec3(1.0f);
+  });
+}
+
+std::string Plant::group_name(std::int32_t g) const {
+  return fmt::format("{}{}", group_prefix.empty() ? "group" : group_prefix, g);
 }
 
 void assign_pipe_radii(Plant& plant, float tip_radius, float exponent) {

@@ -54,6 +54,18 @@ struct NodeAttribute {
   std::vector<float> values;
 };
 
+// The tube an L-system F(l, w, s, d) asks for on the segment that ends at a node: `sections` cross
+// sections along it and `divisions` around it; 0 leaves either to the mesher (one section, its sides).
+struct TubeShape {
+  std::uint16_t sections = 0;   // 0 or 1..kMaxTubeSections
+  std::uint16_t divisions = 0;  // 0 or kMinTubeDivisions..kMaxTubeDivisions
+};
+constexpr int kMaxTubeSections = 64, kMinTubeDivisions = 3, kMaxTubeDivisions = 64;
+
+// What the mesher makes of the branches: tubes around them, or their polylines alone (Houdini's
+// Geometry Type Skeleton).
+enum class BranchGeometry : std::uint8_t { Tube, Skeleton };
+
 // An image an algorithm paints over the scene's surfaces (the vines' texture). Renders lay it over the
 // surfaces' own material, and it stands for the plant there: a plant with decals is drawn by them.
 // The image's (u, v) cover [0, 1]^2 with v up: its top row is v = 1, as in OBJ texture coordinates.
@@ -78,6 +90,10 @@ struct Plant {
   // Optional per-node data, empty unless an algorithm fills it (one entry per node when present):
   std::vector<std::int32_t> node_groups;  // group number (-1: none); L-system g
   std::vector<NodeAttribute> node_attributes;
+  std::vector<TubeShape> node_tubes;  // L-system F(l, w, s, d)
+  // Group g of node_groups is named group_prefix + g (group_name); letters, digits and '_' only.
+  std::string group_prefix;
+  BranchGeometry branch_geometry = BranchGeometry::Tube;
 
   void clear() {
     nodes.clear();
@@ -87,12 +103,20 @@ struct Plant {
     organ_shapes.clear();
     node_groups.clear();
     node_attributes.clear();
+    node_tubes.clear();
+    group_prefix.clear();
+    branch_geometry = BranchGeometry::Tube;
   }
+  // The name of group g (>= 0): group_prefix + g, or "group" + g without a prefix.
+  [[nodiscard]] std::string group_name(std::int32_t g) const;
   [[nodiscard]] std::size_t leaf_count() const;
   [[nodiscard]] double total_length() const;  // sum of segment lengths (node to parent)
-  // A hash of the canonical content (positions, radii, topology, organs, polygons) as 16 hex digits.
-  // Equal hashes mean bit-identical plants.
+  // A hash of the canonical content (positions, radii, topology, organs, polygons, and the optional
+  // per-node data, group prefix and branch geometry when present) as 16 hex digits. Equal hashes mean
+  // bit-identical plants; a plant without the optional data hashes as it did before they existed.
   [[nodiscard]] std::string geometry_hash() const;
+  // Whether some organ has a shape or tint of its own (what hashes and snapshots then carry).
+  [[nodiscard]] bool organs_styled() const;
   // Checks the forest's invariants (parents precede children, finite values, non-negative radii);
   // returns an empty string when valid, otherwise the first violation.
   [[nodiscard]] std::string validate() const;

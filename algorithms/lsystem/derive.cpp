@@ -191,8 +191,23 @@ bool Deriver::bind(const Rule& r, const LString& in, std::size_t m, std::size_t 
             ++pos;
             continue;
           }
-          if (c == ']') return false;  // the branch ends before the context does
-          int depth = 1;               // skip a sub-branch
+          if (c == ']') {  // the branch ends before the context does
+            if (!s_.siblings) return false;
+            // Context Includes Siblings: the context goes on in the next sibling branch (the next '[' of
+            // the parent's string), skipping the parent's own symbols; none before the parent ends: no match.
+            ++pos;
+            while (true) {
+              if (pos >= n) return false;
+              const std::uint16_t w2 = sym[pos];
+              const char c2 = symbol_of(w2);
+              ++pos;
+              if (c2 == '[') break;
+              if (c2 == ']') return false;
+              off += count_of(w2);
+            }
+            continue;
+          }
+          int depth = 1;  // skip a sub-branch
           ++pos;
           while (depth > 0) {
             if (pos >= n) return false;

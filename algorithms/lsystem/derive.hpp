@@ -42,7 +42,8 @@ struct DeriveSettings {
   std::uint64_t seed;
   std::uint64_t stream;  // e.g. the plant (scene seed) index
   ProbabilityMode probability;
-  bool brackets_transparent;  // context includes siblings, or [ ] in the ignore list
+  bool brackets_transparent;  // [ or ] in the ignore list: contexts are matched on the flat string
+  bool siblings;              // Context Includes Siblings: a right context goes on in the next sibling branch
   std::size_t max_symbols;
   std::size_t max_params;
   std::array<double, kMaxSlots> env;  // a b c d T and user variables filled in, the rest 0

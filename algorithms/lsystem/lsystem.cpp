@@ -12,6 +12,7 @@
 #include "algorithms/lsystem/lsystem.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -75,8 +76,8 @@ const AlgorithmInfo kInfo = {
             param::text("context_ignore")
                 .doc("symbols skipped when matching contexts, e.g. '+-F'; with '[' or ']' brackets become transparent"),
             param::boolean("context_siblings", false)
-                .doc(
-                    "contexts read across branch brackets (pre-Houdini 10 behaviour) instead of skipping sub-branches"),
+                .doc("Context Includes Siblings (pre-Houdini 10): a right context that reaches the end of its "
+                     "branch goes on in the next sibling branch"),
             param::choice("probability", "sequential", {"sequential", "normalized"})
                 .doc("sequential: each applicable rule fires with its own chance, in order (Houdini); normalized: one "
                      "of "
@@ -107,6 +108,11 @@ const AlgorithmInfo kInfo = {
                 .doc("what J places, for the metrics, mesh groups and materials"),
             param::choice("kind_k", "flower", {"leaf", "young_leaf", "flower", "bud"}).doc("what K places"),
             param::choice("kind_m", "bud", {"leaf", "young_leaf", "flower", "bud"}).doc("what M places"),
+            param::choice("geometry", "tube", {"tube", "skeleton"})
+                .doc("tube: tubes around the branches (F(l,w,s,d): s cross sections, d divisions); skeleton: "
+                     "the branches' polylines alone (Houdini's Geometry Type)"),
+            param::text("group_prefix", "lsys")
+                .doc("names of g groups: the prefix and the group number (letters, digits and _)"),
             param::integer("max_symbols", 50'000'000)
                 .range(1, 2e9)
                 .doc("a generation that would exceed this many symbols stops the run with an error"),
@@ -307,7 +313,8 @@ Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* quer
       .stream = 0,  // set for each plant before it is rewritten
       .probability =
           p.text("probability") == "normalized" ? lsys::ProbabilityMode::Normalized : lsys::ProbabilityMode::Sequential,
-      .brackets_transparent = p.boolean("context_siblings") || s.grammar.ignore.test('[') || s.grammar.ignore.test(']'),
+      .brackets_transparent = s.grammar.ignore.test('[') || s.grammar.ignore.test(']'),
+      .siblings = p.boolean("context_siblings"),
       .max_symbols = max_symbols,
       .max_params = max_symbols * 2,
       .env = {},
@@ -328,6 +335,12 @@ Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* quer
   for (std::size_t k = 0; k < user_values.size(); ++k) env[lsys::kUserVar0 + k] = user_values[k];
 
   if (p.text("surface") == "wrap" && !query) throw InputError("surface=wrap needs a scene with surfaces");
+  for (const char c : p.text("group_prefix"))
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_'))
+      throw InputError(
+          fmt::format("group_prefix '{}': expected letters, digits and '_' only (it names OBJ groups "
+                      "and glTF nodes)",
+                      p.text("group_prefix")));
   s.turtle = {
       .step = p.real("step_size"),
       .step_scale = p.real("step_scale"),
@@ -453,6 +466,9 @@ class LSystem final : public GrowthAlgorithm {
     const auto t0 = std::chrono::steady_clock::now();
     plant_.clear();
     plant_.organ_shapes = setup_.organ_shapes;
+    plant_.group_prefix = setup_.params.text("group_prefix");
+    plant_.branch_geometry =
+        setup_.params.text("geometry") == "skeleton" ? BranchGeometry::Skeleton : BranchGeometry::Tube;
     for (auto& pl : plants_) {
       if (!pl.started) continue;
       lsys::TurtleSettings ts = setup_.turtle;

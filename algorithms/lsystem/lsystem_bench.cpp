@@ -30,6 +30,7 @@ DeriveSettings settings(const NoHost& host) {
           .stream = 0,
           .probability = ProbabilityMode::Sequential,
           .brackets_transparent = false,
+          .siblings = false,
           .max_symbols = 200'000'000,
           .max_params = 400'000'000,
           .env = {}};

@@ -99,6 +99,44 @@ TEST(LSystemDerivation, BranchAwareContext) {
   EXPECT_EQ(derive("B(2)A(3)C(4)", "B(x) < A(y) > C(z) : x + z > y = A(x*y*z)", 1), "B(2)A(24)C(4)");
 }
 
+// The reference's "Context Includes Siblings" paragraph, rule A>B=F, case by case: by default a right
+// context skips sub-branches ([Q]) and stops at its branch's end; [] in context_ignore matches on the
+// flat string; the siblings flag lets a context that reaches its branch's end go on in the next sibling
+// branch, skipping the parent's own symbols ([A]Q[B] resolves). With [] ignored there are no branches
+// left for the flag to act on.
+TEST(LSystemDerivation, ContextIncludesSiblings) {
+  const std::string rule = "A > B = F";
+  const std::vector<std::string> siblings = {"context_siblings=true"};
+  const std::vector<std::string> flat = {"context_ignore=[]"};
+  const std::vector<std::string> both = {"context_siblings=true", "context_ignore=[]"};
+  // A[B]: B is in a sub-branch
+  EXPECT_EQ(derive("A[B]", rule, 1), "A[B]");
+  EXPECT_EQ(derive("A[B]", rule, 1, flat), "F[B]");
+  EXPECT_EQ(derive("A[B]", rule, 1, siblings), "A[B]");
+  EXPECT_EQ(derive("A[B]", rule, 1, both), "F[B]");
+  // A[Q]B: the sub-branch [Q] is skipped
+  EXPECT_EQ(derive("A[Q]B", rule, 1), "F[Q]B");
+  EXPECT_EQ(derive("A[Q]B", rule, 1, flat), "A[Q]B");
+  EXPECT_EQ(derive("A[Q]B", rule, 1, siblings), "F[Q]B");
+  EXPECT_EQ(derive("A[Q]B", rule, 1, both), "A[Q]B");
+  // [A]Q[B]: B is in the sibling branch after A's
+  EXPECT_EQ(derive("[A]Q[B]", rule, 1), "[A]Q[B]");
+  EXPECT_EQ(derive("[A]Q[B]", rule, 1, flat), "[A]Q[B]");
+  EXPECT_EQ(derive("[A]Q[B]", rule, 1, siblings), "[F]Q[B]");
+  EXPECT_EQ(derive("[A]Q[B]", rule, 1, both), "[A]Q[B]");
+  // only the next sibling, from its start (its own sub-branches skipped), and only within the parent
+  EXPECT_EQ(derive("[A]Q[C][B]", rule, 1, siblings), "[A]Q[C][B]");
+  EXPECT_EQ(derive("[A]Q[[C]B]", rule, 1, siblings), "[F]Q[[C]B]");
+  EXPECT_EQ(derive("[[A]Q]R[B]", rule, 1, siblings), "[[A]Q]R[B]");
+  EXPECT_EQ(derive("[A]Q[B]", "A > BC = F", 1, siblings), "[A]Q[B]");
+  EXPECT_EQ(derive("[A]Q[BC]", "A > BC = F", 1, siblings), "[F]Q[BC]");
+  // parameters bind across the parent's symbols
+  EXPECT_EQ(derive("[A]Q(5)[B(2)]", "A > B(x) = F(x)", 1, siblings), "[F(2)]Q(5)[B(2)]");
+  // the left context is the same either way (ABOP's: into the parent, over sibling branches)
+  EXPECT_EQ(derive("B[C]A", "B < A = X", 1, siblings), "B[C]X");
+  EXPECT_EQ(derive("[A]Q[B]", "Q < B = X", 1, siblings), "[A]Q[X]");
+}
+
 TEST(LSystemDerivation, Parametric) {  // ABOP 1.10, fig. 1.31
   const std::string rules =
       "A(x,y): y <= 3 = A(x*2, x+y)\n"

@@ -57,6 +57,7 @@ class Interpreter {
     t.shoot = next_shoot();
     if (s_.wrap) snap_start(t);
     const std::size_t first_node = plant_.nodes.size();
+    first_node_ = first_node;
     const std::size_t first_organ = plant_.organs.size();
     const std::size_t first_poly = plant_.polygons.size();
     attr_snapshots_.assign(1, {});
@@ -99,13 +100,13 @@ class Interpreter {
           double width = k > 1 ? a[1] : t.width;
           if (fresh && s_.continuous_width) width *= s_.fraction;
           const bool draw = c == 'F' || c == 'H';
-          if (draw && t.node == kNoParent) t.node = add_node(t.pos, width, kNoParent, t);
+          if (draw && t.node == kNoParent) t.node = add_node(t.pos, width, kNoParent, t, {});
           const glm::dvec3 before = t.pos;
           t.pos += t.H * len;
           if (s_.wrap) snap(t);
           if (c == 'F' || c == 'H' || c == 'G') t.arc += glm::length(t.pos - before);
           if (draw)
-            t.node = add_node(t.pos, width, t.node, t);
+            t.node = add_node(t.pos, width, t.node, t, k > 2 ? tube_shape(a, k) : TubeShape{});
           else if (c == 'f' || c == 'h')
             t.node = kNoParent;
           break;
@@ -330,7 +331,19 @@ class Interpreter {
                      static_cast<float>(t.arc),   static_cast<float>(t.length), static_cast<float>(t.width),
                      static_cast<float>(t.u),     static_cast<float>(t.v)};
   }
-  std::int32_t add_node(const glm::dvec3& pos, double width, std::int32_t parent, const State& t) {
+  // F(l, w, s, d)'s s cross sections and d divisions, rounded and clamped to what Plant::validate accepts
+  // (a value below 1 leaves it to the mesher).
+  static TubeShape tube_shape(const float* a, int k) {
+    auto count = [](float v, int lo, int hi) -> std::uint16_t {
+      if (!(v >= 0.5f)) return 0;
+      return static_cast<std::uint16_t>(std::clamp(static_cast<int>(std::lround(std::min(v, 1e4f))), lo, hi));
+    };
+    TubeShape shape;
+    shape.sections = count(a[2], 1, kMaxTubeSections);
+    if (k > 3) shape.divisions = count(a[3], kMinTubeDivisions, kMaxTubeDivisions);
+    return shape;
+  }
+  std::int32_t add_node(const glm::dvec3& pos, double width, std::int32_t parent, const State& t, TubeShape tube) {
     PlantNode nd;
     nd.position = glm::vec3(pos);
     nd.radius = static_cast<float>(std::max(0.0, width * 0.5));
@@ -343,6 +356,11 @@ class Interpreter {
     // before that has no group and the empty snapshot)
     if (groups_used_) node_groups_.push_back(t.group);
     if (attrs_used_) node_attrs_.push_back(t.attrs);
+    if (tube.sections != 0 || tube.divisions != 0) {
+      if (!tubes_used_) node_tubes_.assign(plant_.nodes.size() - 1 - first_node_, TubeShape{});
+      tubes_used_ = true;
+    }
+    if (tubes_used_) node_tubes_.push_back(tube);
     return static_cast<std::int32_t>(plant_.nodes.size() - 1);
   }
   void snap_start(State& t) { snap(t); }
@@ -394,6 +412,13 @@ class Interpreter {
     if (groups_used_ || !plant_.node_groups.empty()) {
       plant_.node_groups.resize(first_node, -1);
       plant_.node_groups.insert(plant_.node_groups.end(), node_groups_.begin(), node_groups_.end());
+      plant_.node_groups.resize(plant_.nodes.size(), -1);  // a plant without g after one with it
+    }
+    if (tubes_used_) node_tubes_.resize(count);
+    if (tubes_used_ || !plant_.node_tubes.empty()) {
+      plant_.node_tubes.resize(first_node);
+      plant_.node_tubes.insert(plant_.node_tubes.end(), node_tubes_.begin(), node_tubes_.end());
+      plant_.node_tubes.resize(plant_.nodes.size());
     }
     for (std::size_t id = 0; id < attr_components_.size(); ++id) {
       const int comps = attr_components_[id];
@@ -428,8 +453,10 @@ class Interpreter {
   std::vector<std::uint32_t> node_attrs_;
   std::vector<std::vector<std::array<float, 4>>> attr_snapshots_;
   std::vector<int> attr_components_;
+  std::vector<TubeShape> node_tubes_;
   std::int32_t group_counter_ = 0;
-  bool groups_used_ = false, attrs_used_ = false;
+  bool groups_used_ = false, attrs_used_ = false, tubes_used_ = false;
+  std::size_t first_node_ = 0;  // this plant's first node in plant_
   std::uint32_t shoot_counter_ = 0;
   double cached_angle_ = std::numeric_limits<double>::quiet_NaN(), cached_cos_ = 1.0, cached_sin_ = 0.0;
   TurtleResult result_;

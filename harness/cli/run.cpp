@@ -61,8 +61,9 @@ void print_record(const TrialRecord& rec, const TrialSpec& spec, const std::stri
       ph.exporting.value().wall_s, static_cast<double>(rec.peak_rss_bytes) / (1024.0 * 1024.0));
   std::string own;  // the algorithm's own files (the vines' texture), as the record lists them
   for (const auto& [name, bytes] : rec.output_bytes.algorithm_files) own += ", " + name;
-  fmt::print("  wrote {}/plant.obj, plant.ply, plant.glb, skeleton.obj{}, record.json (geometry hash {})\n", out_dir,
-             own, rec.geometry_hash);
+  fmt::print(
+      "  wrote {}/plant.obj, plant.ply, plant.glb, skeleton.obj, skeleton.ply{}, record.json (geometry hash {})\n",
+      out_dir, own, rec.geometry_hash);
   if (rec.frames)
     fmt::print("  kept {} frames in {}/frames (capture took {:.3f} s, not counted in growth)\n", rec.frames->count,
                out_dir, ph.growth.value().frame_capture_wall_s.value());

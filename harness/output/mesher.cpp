@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numbers>
 
 #include <fmt/format.h>
@@ -49,51 +50,198 @@ glm::vec3 any_perpendicular(const glm::vec3& t) {
   return glm::normalize(glm::cross(t, h));
 }
 
-void add_tube(OutputMesh& m, const Plant& plant, const std::vector<std::int32_t>& chain, const MesherOptions& o) {
-  // Points and radii along the chain; a side branch starts at its parent's node with its own radius.
-  std::vector<glm::vec3> pts;
-  std::vector<float> rad;
-  for (std::size_t j = 0; j < chain.size(); ++j) {
-    const auto& node = plant.nodes[static_cast<std::size_t>(chain[j])];
-    const glm::vec3 p = node.position;
-    if (!pts.empty() && glm::length(p - pts.back()) < 1e-7f) continue;  // drop zero-length segments
-    // A lateral branch (its first node's shoot differs from the parent's) starts with its own radius.
-    float r = node.radius;
-    if (j == 0 && chain.size() > 1) {
-      const auto& next = plant.nodes[static_cast<std::size_t>(chain[1])];
-      if (next.shoot != node.shoot) r = std::min(r, next.radius);
-    }
-    r = std::max(r, o.min_radius > 0.0f ? o.min_radius : 1e-4f);
-    pts.push_back(p);
-    rad.push_back(r);
+// What tubes carry from the plant's optional per-node data; all null for most plants, whose tubes are
+// then made exactly as before that data existed.
+struct TubeExtras {
+  const std::vector<TubeShape>* tubes = nullptr;      // F(l, w, s, d)
+  const std::vector<std::int32_t>* groups = nullptr;  // g
+  const NodeAttribute* cd = nullptr;                  // a("Cd", ...): vertex colours
+  std::vector<const NodeAttribute*> attributes;       // the other a(): OutputMesh::attributes from `first_attribute`
+  std::size_t first_attribute = 0;
+  [[nodiscard]] bool vertex_data() const { return cd != nullptr || !attributes.empty(); }
+};
+
+// Whose per-node values a ring carries: node a's mixed with node b's by t (a ring inside a segment cut
+// into sections lies between its two nodes). b is the node whose segment ends at the ring.
+struct RingSource {
+  std::int32_t a, b;
+  float t;
+};
+
+float attribute_value(const NodeAttribute& x, const RingSource& s, int component) {
+  if (component >= x.components) return 0.0f;  // the reference's zero defaults
+  const auto c = static_cast<std::size_t>(x.components);
+  const float va = x.values[static_cast<std::size_t>(s.a) * c + static_cast<std::size_t>(component)];
+  const float vb = x.values[static_cast<std::size_t>(s.b) * c + static_cast<std::size_t>(component)];
+  return s.t == 0.0f ? vb : va + (vb - va) * s.t;
+}
+
+// `count` vertices' colours and attributes from the ring's source nodes.
+void add_vertex_data(OutputMesh& m, const TubeExtras& x, const RingSource& s, std::size_t count) {
+  if (x.cd) {
+    const glm::vec3 c(attribute_value(*x.cd, s, 0), attribute_value(*x.cd, s, 1), attribute_value(*x.cd, s, 2));
+    m.colors.insert(m.colors.end(), count, c);
   }
-  if (pts.size() < 2) return;
-  const int sides = std::clamp(o.sides, 3, 64);
+  for (std::size_t k = 0; k < x.attributes.size(); ++k) {
+    VertexAttribute& out = m.attributes[x.first_attribute + k];
+    for (std::size_t v = 0; v < count; ++v)
+      for (int c = 0; c < out.components; ++c) out.values.push_back(attribute_value(*x.attributes[k], s, c));
+  }
+}
+
+std::int32_t group_of(const TubeExtras& x, std::int32_t node) {
+  const std::int32_t g = (*x.groups)[static_cast<std::size_t>(node)];
+  return g < 0 ? -1 : g;
+}
+
+// Rings start..end of a tube with `sides` vertices each, the frame carried along from `normal`
+// (parallel transport in projection form: the previous normal made perpendicular to the tangent), then
+// the quads between them. One loop with its values in locals, as this is most of a big plant's meshing.
+void add_strip(OutputMesh& m, const std::vector<glm::vec3>& pts, const std::vector<float>& rad, std::size_t start,
+               std::size_t end, int sides, glm::vec3& normal) {
   const auto base = static_cast<std::uint32_t>(m.positions.size());
-  glm::vec3 normal(0.0f);
-  for (std::size_t j = 0; j < pts.size(); ++j) {
-    const glm::vec3 a = pts[j == 0 ? 0 : j - 1], b = pts[j + 1 < pts.size() ? j + 1 : j];
+  const std::size_t n = pts.size();
+  const float fsides = static_cast<float>(sides);
+  glm::vec3 carried = normal;
+  for (std::size_t j = start; j <= end; ++j) {
+    const glm::vec3 a = pts[j == 0 ? 0 : j - 1], b = pts[j + 1 < n ? j + 1 : j];
     const glm::vec3 t = glm::normalize(b - a);
-    // Parallel transport (projection form): keep the previous normal, made perpendicular to t.
-    glm::vec3 nrm = j == 0 ? any_perpendicular(t) : normal - glm::dot(normal, t) * t;
+    glm::vec3 nrm = j == 0 ? any_perpendicular(t) : carried - glm::dot(carried, t) * t;
     if (glm::length(nrm) < 1e-6f) nrm = any_perpendicular(t);
-    normal = glm::normalize(nrm);
-    const glm::vec3 binormal = glm::cross(t, normal);
+    carried = glm::normalize(nrm);
+    const glm::vec3 binormal = glm::cross(t, carried);
     for (int s = 0; s < sides; ++s) {
-      const float ang = 2.0f * std::numbers::pi_v<float> * static_cast<float>(s) / static_cast<float>(sides);
-      const glm::vec3 d = std::cos(ang) * normal + std::sin(ang) * binormal;
+      const float ang = 2.0f * std::numbers::pi_v<float> * static_cast<float>(s) / fsides;
+      const glm::vec3 d = std::cos(ang) * carried + std::sin(ang) * binormal;
       m.positions.push_back(pts[j] + rad[j] * d);
       m.normals.push_back(d);
     }
   }
+  normal = carried;
   const auto S = static_cast<std::uint32_t>(sides);
-  for (std::uint32_t j = 0; j + 1 < pts.size(); ++j) {
+  const auto segments = static_cast<std::uint32_t>(end - start);
+  for (std::uint32_t j = 0; j < segments; ++j) {
     for (std::uint32_t s = 0; s < S; ++s) {
       const std::uint32_t a = base + j * S + s, b = base + j * S + (s + 1) % S;
       const std::uint32_t c = a + S, d = b + S;
       m.triangles.emplace_back(a, b, d);
       m.triangles.emplace_back(a, d, c);
     }
+  }
+}
+
+// The rings of a tube along a chain: points and radii; and, only when needed, the divisions of each
+// segment (ring j to j + 1) and each ring's source of per-node values.
+struct TubePath {
+  std::vector<glm::vec3> pts;
+  std::vector<float> rad;
+  std::vector<std::uint16_t> divisions;  // when the plant has node tubes
+  std::vector<RingSource> src;           // when `sources`
+  bool sources = false;
+};
+
+// Points and radii along the chain, with the rings inside each segment's sections; a side branch starts
+// at its parent's node with its own radius.
+void tube_path(TubePath& t, const Plant& plant, const std::vector<std::int32_t>& chain, const MesherOptions& o,
+               const TubeExtras& x, int sides) {
+  if (!x.tubes && !t.sources) {  // most plants: points and radii alone, in vectors that do not escape
+    std::vector<glm::vec3> pts;
+    std::vector<float> rad;
+    for (std::size_t j = 0; j < chain.size(); ++j) {
+      const auto& node = plant.nodes[static_cast<std::size_t>(chain[j])];
+      const glm::vec3 p = node.position;
+      if (!pts.empty() && glm::length(p - pts.back()) < 1e-7f) continue;  // drop zero-length segments
+      float r = node.radius;
+      if (j == 0 && chain.size() > 1) {
+        const auto& next = plant.nodes[static_cast<std::size_t>(chain[1])];
+        if (next.shoot != node.shoot) r = std::min(r, next.radius);
+      }
+      pts.push_back(p);
+      rad.push_back(std::max(r, o.min_radius > 0.0f ? o.min_radius : 1e-4f));
+    }
+    t.pts = std::move(pts);
+    t.rad = std::move(rad);
+    return;
+  }
+  for (std::size_t j = 0; j < chain.size(); ++j) {
+    const auto id = chain[j];
+    const auto& node = plant.nodes[static_cast<std::size_t>(id)];
+    const glm::vec3 p = node.position;
+    if (!t.pts.empty() && glm::length(p - t.pts.back()) < 1e-7f) continue;  // drop zero-length segments
+    // A lateral branch (its first node's shoot differs from the parent's) starts with its own radius,
+    // and its own values: those of its first segment's end.
+    float r = node.radius;
+    std::int32_t own = id;
+    if (j == 0 && chain.size() > 1) {
+      const auto& next = plant.nodes[static_cast<std::size_t>(chain[1])];
+      if (next.shoot != node.shoot) {
+        r = std::min(r, next.radius);
+        own = chain[1];
+      }
+    }
+    r = std::max(r, o.min_radius > 0.0f ? o.min_radius : 1e-4f);
+    if (x.tubes && !t.pts.empty()) {
+      const TubeShape shape = (*x.tubes)[static_cast<std::size_t>(id)];
+      const auto d = static_cast<std::uint16_t>(shape.divisions != 0 ? shape.divisions : sides);
+      const glm::vec3 p0 = t.pts.back();
+      const float r0 = t.rad.back();
+      const std::int32_t from = t.sources ? t.src.back().b : id;
+      for (int k = 1; k < shape.sections; ++k) {  // the section boundaries inside the segment
+        const float f = static_cast<float>(k) / static_cast<float>(shape.sections);
+        t.pts.push_back(p0 + (p - p0) * f);
+        t.rad.push_back(r0 + (r - r0) * f);
+        t.divisions.push_back(d);
+        if (t.sources) t.src.push_back({from, id, f});
+      }
+      t.divisions.push_back(d);
+    }
+    t.pts.push_back(p);
+    t.rad.push_back(r);
+    if (t.sources) t.src.push_back({own, own, 0.0f});
+  }
+}
+
+// A tube along one chain. Each segment's cross sections and divisions come from the node it ends at
+// (Plant::node_tubes; else one section of o.sides). A run of segments with the same divisions is one
+// strip of rings; where the divisions change, the next strip starts with a ring of its own at the same
+// joint (the two rings' polygons differ, so the tube is open there). Caps close the chain's two ends.
+// `triangle_groups`, when given, receives the group of each triangle: that of the segment's end node.
+void add_tube(OutputMesh& m, const Plant& plant, const std::vector<std::int32_t>& chain, const MesherOptions& o,
+              const TubeExtras& x, std::vector<std::int32_t>* triangle_groups) {
+  const int sides = std::clamp(o.sides, 3, 64);
+  const bool vertex_data = x.vertex_data();
+  TubePath path;
+  path.sources = vertex_data || triangle_groups != nullptr;
+  tube_path(path, plant, chain, o, x, sides);
+  const std::vector<glm::vec3>& pts = path.pts;
+  const std::vector<float>& rad = path.rad;
+  const std::vector<std::uint16_t>& divisions = path.divisions;
+  const std::vector<RingSource>& src = path.src;
+  if (pts.size() < 2) return;
+  auto segment_divisions = [&](std::size_t j) { return divisions.empty() ? sides : int{divisions[j]}; };
+  // Strips of equal divisions: [strip_start, j] rings, emitted as rings then quads.
+  glm::vec3 normal(0.0f);
+  std::uint32_t first_ring = 0, last_ring = 0;  // the vertex of the chain's first and last ring
+  int first_sides = sides, last_sides = sides;
+  for (std::size_t start = 0; start + 1 < pts.size();) {
+    const int d = segment_divisions(start);
+    std::size_t end = divisions.empty() ? pts.size() - 1 : start + 1;
+    while (end + 1 < pts.size() && segment_divisions(end) == d) ++end;
+    const auto base = static_cast<std::uint32_t>(m.positions.size());
+    add_strip(m, pts, rad, start, end, d, normal);
+    const auto S = static_cast<std::uint32_t>(d);
+    if (vertex_data)
+      for (std::size_t j = start; j <= end; ++j) add_vertex_data(m, x, src[j], S);
+    if (triangle_groups)
+      for (std::size_t j = start; j < end; ++j)
+        triangle_groups->insert(triangle_groups->end(), 2 * S, group_of(x, src[j + 1].b));
+    if (start == 0) {
+      first_ring = base;
+      first_sides = d;
+    }
+    last_ring = base + static_cast<std::uint32_t>(end - start) * S;
+    last_sides = d;
+    start = end;
   }
   if (o.caps) {
     for (const bool start : {true, false}) {
@@ -102,7 +250,9 @@ void add_tube(OutputMesh& m, const Plant& plant, const std::vector<std::int32_t>
       const auto centre = static_cast<std::uint32_t>(m.positions.size());
       m.positions.push_back(pts[j]);
       m.normals.push_back(start ? -t : t);
-      const std::uint32_t ring = base + static_cast<std::uint32_t>(j) * S;
+      if (vertex_data) add_vertex_data(m, x, src[j], 1);
+      const std::uint32_t ring = start ? first_ring : last_ring;
+      const auto S = static_cast<std::uint32_t>(start ? first_sides : last_sides);
       for (std::uint32_t s = 0; s < S; ++s) {
         const std::uint32_t a = ring + s, b = ring + (s + 1) % S;
         if (start)
@@ -110,8 +260,117 @@ void add_tube(OutputMesh& m, const Plant& plant, const std::vector<std::int32_t>
         else
           m.triangles.emplace_back(centre, a, b);
       }
+      if (triangle_groups) triangle_groups->insert(triangle_groups->end(), S, group_of(x, src[start ? 1 : j].b));
     }
   }
+}
+
+// Branch geometry skeleton: every node a vertex (normal +Y: lines have none), every segment a line.
+void add_skeleton_lines(OutputMesh& m, const Plant& plant, const TubeExtras& x,
+                        std::vector<std::int32_t>* line_groups) {
+  const auto base = static_cast<std::uint32_t>(m.positions.size());
+  for (std::size_t i = 0; i < plant.nodes.size(); ++i) {
+    m.positions.push_back(plant.nodes[i].position);
+    m.normals.emplace_back(0.0f, 1.0f, 0.0f);
+    const auto id = static_cast<std::int32_t>(i);
+    if (x.vertex_data()) add_vertex_data(m, x, {id, id, 0.0f}, 1);
+  }
+  for (std::size_t i = 0; i < plant.nodes.size(); ++i) {
+    const std::int32_t p = plant.nodes[i].parent;
+    if (p == kNoParent) continue;
+    m.lines.emplace_back(base + static_cast<std::uint32_t>(p), base + static_cast<std::uint32_t>(i));
+    if (line_groups) line_groups->push_back(group_of(x, static_cast<std::int32_t>(i)));
+  }
+}
+
+// Reorders items[first, end) by their groups (stable, -1 first) and returns each group with its count.
+template <class T>
+std::vector<std::pair<std::int32_t, std::uint32_t>> sort_by_group(std::vector<T>& items, std::size_t first,
+                                                                  const std::vector<std::int32_t>& groups) {
+  std::map<std::int32_t, std::uint32_t> counts;
+  for (const std::int32_t g : groups) ++counts[g];
+  std::map<std::int32_t, std::size_t> next;
+  std::size_t offset = first;
+  for (const auto& [g, n] : counts) {
+    next[g] = offset;
+    offset += n;
+  }
+  std::vector<T> sorted(groups.size());
+  for (std::size_t k = 0; k < groups.size(); ++k) sorted[next[groups[k]]++ - first] = items[first + k];
+  std::copy(sorted.begin(), sorted.end(), items.begin() + static_cast<std::ptrdiff_t>(first));
+  return {counts.begin(), counts.end()};
+}
+
+// The branches: tubes (or lines, for branch geometry skeleton) with the plant's per-node colours and
+// attributes, as one "branches" part, or one per plant group (ungrouped first) when the plant has groups.
+void add_branches(OutputMesh& m, const Plant& plant, const MesherOptions& o) {
+  TubeExtras x;
+  if (!plant.node_tubes.empty()) x.tubes = &plant.node_tubes;
+  if (!plant.node_groups.empty()) x.groups = &plant.node_groups;
+  x.first_attribute = m.attributes.size();
+  for (const auto& a : plant.node_attributes) {
+    if (a.name == "Cd") {
+      x.cd = &a;
+      continue;
+    }
+    x.attributes.push_back(&a);
+    m.attributes.push_back({a.name, a.components, {}});
+    m.attributes.back().values.resize(m.positions.size() * static_cast<std::size_t>(a.components), 0.0f);
+  }
+  if (x.cd) pad_colors(m);
+  std::vector<std::int32_t> groups;  // per triangle or line, when the plant has groups
+  const auto first_triangle = m.triangles.size(), first_line = m.lines.size();
+  if (plant.branch_geometry == BranchGeometry::Skeleton) {
+    add_skeleton_lines(m, plant, x, x.groups ? &groups : nullptr);
+  } else {
+    for (const auto& chain : plant_chains(plant)) add_tube(m, plant, chain, o, x, x.groups ? &groups : nullptr);
+  }
+  const auto triangles = static_cast<std::uint32_t>(m.triangles.size() - first_triangle);
+  const auto lines = static_cast<std::uint32_t>(m.lines.size() - first_line);
+  if (triangles + lines == 0) return;
+  MeshGroup part("branches", "bark", static_cast<std::uint32_t>(first_triangle), triangles);
+  part.first_line = static_cast<std::uint32_t>(first_line);
+  part.line_count = lines;
+  if (!x.groups) {
+    m.groups.push_back(part);
+    return;
+  }
+  const bool skeleton = plant.branch_geometry == BranchGeometry::Skeleton;
+  const auto counts =
+      skeleton ? sort_by_group(m.lines, first_line, groups) : sort_by_group(m.triangles, first_triangle, groups);
+  std::uint32_t offset = skeleton ? part.first_line : part.first_triangle;
+  for (const auto& [g, n] : counts) {
+    MeshGroup piece("branches", "bark", skeleton ? 0 : offset, skeleton ? 0 : n);
+    if (skeleton) {
+      piece.first_line = offset;
+      piece.line_count = n;
+    }
+    if (g >= 0) piece.plant_group = plant.group_name(g);
+    m.groups.push_back(piece);
+    offset += n;
+  }
+}
+
+constexpr float kUncoloured = std::numeric_limits<float>::quiet_NaN();
+
+// Completes the per-vertex data (OutputMesh::colors, attributes): a vertex left without a colour gets
+// its group's material colour, a vertex without an attribute's value gets zeros.
+void complete_vertex_data(OutputMesh& m) {
+  if (!m.colors.empty()) {
+    m.colors.resize(m.positions.size(), glm::vec3(kUncoloured));
+    for (const auto& g : m.groups) {
+      const glm::vec3 c = material_color(g.material);
+      for (std::uint32_t t = g.first_triangle; t < g.first_triangle + g.triangle_count; ++t)
+        for (int k = 0; k < 3; ++k)
+          if (std::isnan(m.colors[m.triangles[t][k]].x)) m.colors[m.triangles[t][k]] = c;
+      for (std::uint32_t l = g.first_line; l < g.first_line + g.line_count; ++l)
+        for (int k = 0; k < 2; ++k)
+          if (std::isnan(m.colors[m.lines[l][k]].x)) m.colors[m.lines[l][k]] = c;
+    }
+    for (auto& c : m.colors)
+      if (std::isnan(c.x)) c = material_color("");  // in no part
+  }
+  for (auto& a : m.attributes) a.values.resize(m.positions.size() * static_cast<std::size_t>(a.components), 0.0f);
 }
 
 void add_organ(OutputMesh& m, const Organ& organ, const OrganShape& shape, const glm::vec3* color) {
@@ -151,19 +410,17 @@ OutputMesh mesh_plant(const Plant& plant, const MesherOptions& o) {
   const bool colored = shapes.any_color(plant);
   auto organ_mesh = [&](const Organ& organ) {
     if (!colored) return add_organ(m, organ, shapes.of(organ), nullptr);
+    pad_colors(m);
     const glm::vec3 c = shapes.linear_color(organ);
     add_organ(m, organ, shapes.of(organ), &c);
   };
   auto group = [&](const char* name, const char* material, auto&& body) {
     const auto first = static_cast<std::uint32_t>(m.triangles.size());
     body();
-    if (colored) m.colors.resize(m.positions.size(), srgb_to_linear(material_srgb(material)));
     const auto count = static_cast<std::uint32_t>(m.triangles.size()) - first;
     if (count > 0) m.groups.push_back({name, material, first, count});
   };
-  group("branches", "bark", [&] {
-    for (const auto& chain : plant_chains(plant)) add_tube(m, plant, chain, o);
-  });
+  add_branches(m, plant, o);
   group("leaves", "leaf", [&] {
     for (const auto& organ : plant.organs)
       if (organ.kind == OrganKind::Leaf || organ.kind == OrganKind::YoungLeaf) organ_mesh(organ);
@@ -190,7 +447,30 @@ OutputMesh mesh_plant(const Plant& plant, const MesherOptions& o) {
         m.triangles.emplace_back(base, base + i, base + i + 1);
     }
   });
+  complete_vertex_data(m);
   return m;
+}
+
+const std::vector<MaterialColor>& material_colors() {
+  static const std::vector<MaterialColor> kMaterials = [] {
+    std::vector<MaterialColor> v;
+    for (const char* name : {"bark", "leaf", "flower"}) {
+      const glm::vec3 c = srgb_to_linear(material_srgb(name));
+      v.push_back({name, c.r, c.g, c.b});
+    }
+    return v;
+  }();
+  return kMaterials;
+}
+
+glm::vec3 material_color(const std::string& material) {
+  for (const auto& c : material_colors())
+    if (material == c.material) return {static_cast<float>(c.r), static_cast<float>(c.g), static_cast<float>(c.b)};
+  return glm::vec3(0.5f);
+}
+
+void pad_colors(OutputMesh& m) {
+  if (m.colors.size() < m.positions.size()) m.colors.resize(m.positions.size(), glm::vec3(kUncoloured));
 }
 
 }  // namespace growbench

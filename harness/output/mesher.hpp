@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -17,21 +18,55 @@
 namespace growbench {
 
 struct MeshGroup {
+  MeshGroup() = default;
+  // A part of triangles (the form every part had before lines and plant groups; brace lists keep working).
+  MeshGroup(std::string n, std::string mat, std::uint32_t first, std::uint32_t count)
+      : name(std::move(n)), material(std::move(mat)), first_triangle(first), triangle_count(count) {}
   std::string name;      // "branches", "leaves", "flowers", "polygons"
   std::string material;  // "bark", "leaf", "flower"
   std::uint32_t first_triangle = 0;
   std::uint32_t triangle_count = 0;
+  // The plant's own group this part belongs to (Plant::group_name of an L-system g), empty for none.
+  // Exporters write it as an OBJ group beside `name` and as a glTF node of its own.
+  std::string plant_group;
+  std::uint32_t first_line = 0;  // line segments (OutputMesh::lines) of the part: branch geometry skeleton
+  std::uint32_t line_count = 0;
+};
+
+// The base colour of each material, linear RGB (material_srgb's colours, linearised): the
+// OBJ materials' Kd, the glTF materials' base colour, and the colour mesh_plant gives the vertices of a
+// part without colours of its own when another part has them. Unknown materials are mid grey.
+struct MaterialColor {
+  const char* material;
+  double r, g, b;
+};
+const std::vector<MaterialColor>& material_colors();
+glm::vec3 material_color(const std::string& material);
+
+// A float attribute per vertex (the L-system's a("NAME", ...) other than Cd): `components` values per
+// position; 0 on vertices of parts that do not carry it (the reference's "zero defaults").
+struct VertexAttribute {
+  std::string name;
+  int components = 1;
+  std::vector<float> values;
 };
 
 struct OutputMesh {
   std::vector<glm::vec3> positions;
   std::vector<glm::vec3> normals;
   std::vector<glm::uvec3> triangles;
+  std::vector<glm::uvec2> lines;  // line segments (Plant::branch_geometry skeleton), in the groups' ranges
   std::vector<MeshGroup> groups;
   // Linear RGB per vertex: empty when nothing in the plant is coloured, else one per position (organ
   // petal colours with their jitter, the L-system's a("Cd", r, g, b)); exporters write them when present.
+  // A part that colours its vertices calls pad_colors before adding them and then pushes one colour per
+  // vertex it adds; mesh_plant gives the vertices left without one their group's material_color.
   std::vector<glm::vec3> colors;
+  std::vector<VertexAttribute> attributes;  // each empty or complete, as colors
 };
+
+// Marks the vertices so far that have no colour as uncoloured (see OutputMesh::colors).
+void pad_colors(OutputMesh& m);
 
 struct MesherOptions {
   int sides = 6;            // tube cross-section sides (3..64)

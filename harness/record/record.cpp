@@ -292,6 +292,7 @@ json to_json(const OutputBytes& v) {
   put(j, "ply", v.ply);
   put(j, "glb", v.glb);
   put(j, "skeleton_obj", v.skeleton_obj);
+  put(j, "skeleton_ply", v.skeleton_ply);
   if (!v.algorithm_files.empty()) put(j, "algorithm_files", v.algorithm_files);
   return j;
 }
@@ -301,6 +302,7 @@ void read(const Node& n, OutputBytes& v) {
   f.field("ply", v.ply);
   f.field("glb", v.glb);
   f.field("skeleton_obj", v.skeleton_obj);
+  f.field("skeleton_ply", v.skeleton_ply);
   f.field("algorithm_files", v.algorithm_files);
   f.done();
 }

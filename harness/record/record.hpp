@@ -76,7 +76,7 @@ struct Counts {
 
 // Bytes written per output format; empty when the trial wrote no files.
 struct OutputBytes {
-  std::optional<std::uint64_t> obj, ply, glb, skeleton_obj;
+  std::optional<std::uint64_t> obj, ply, glb, skeleton_obj, skeleton_ply;
   // The files only the algorithm makes (GrowthAlgorithm::write_outputs), by name; absent when none.
   std::map<std::string, std::uint64_t> algorithm_files;
 };

@@ -200,12 +200,14 @@ void write_settings(Out out, const Scene& scene, const Plant& plant, const Rende
                    "  radiosity {{ pretrace_start 0.08 pretrace_end 0.01 count 60 nearest_count 5 error_bound 0.8\n"
                    "              recursion_limit 1 low_error_factor 0.5 gray_threshold 0 brightness 1 }}\n");
   fmt::format_to(out, "}}\n");
+  const glm::vec3 bark = material_srgb("bark");
   // One material set for every algorithm. Colours are sRGB; with radiosity the sky lights the scene, so
   // ambient is off; in the preview a little ambient stands in for it.
   fmt::format_to(
       out,
       "#default {{ finish {{ ambient {} diffuse 0.75 }} }}\n"
-      "#declare GB_Bark = texture {{ pigment {{ srgb <0.40,0.27,0.17> }} finish {{ specular 0.05 roughness 0.1 }} }}\n"
+      "#declare GB_Bark = texture {{ pigment {{ srgb <{:.3g},{:.3g},{:.3g}> }} finish {{ specular 0.05 roughness 0.1 "
+      "}} }}\n"
       "#declare GB_Leaf = texture {{ pigment {{ srgb <0.24,0.52,0.16> }} finish {{ specular 0.15 roughness 0.04 }} }}\n"
       "#declare GB_YoungLeaf = texture {{ pigment {{ srgb <0.52,0.72,0.24> }} finish {{ specular 0.15 roughness 0.04 "
       "}} }}\n"
@@ -215,7 +217,7 @@ void write_settings(Out out, const Scene& scene, const Plant& plant, const Rende
       "#declare GB_Surface = texture {{ pigment {{ srgb <0.80,0.78,0.74> }} }}\n"
       "#declare GB_Ground = texture {{ pigment {{ checker srgb <0.56,0.55,0.52> srgb <0.62,0.61,0.58> scale {:.4g} }} "
       "}}\n",
-      paper ? 0.0 : 0.12, std::max(0.25f, 0.05f * diag));
+      paper ? 0.0 : 0.12, bark.r, bark.g, bark.b, std::max(0.25f, 0.05f * diag));
   if (o.backdrop == Backdrop::Studio) {
     // A neutral grey: the sweep, and the background behind it (which radiosity sees as the sky).
     fmt::format_to(out,
@@ -418,46 +420,66 @@ void write_studio(Out out, const Camera& camera, float aspect, const Aabb& conte
   fmt::format_to(out, "  texture {{ GB_Studio }}\n}}\n");
 }
 
-// Branches as cones between each node and its parent, with a sphere at each joint and tip.
+// Branches as cones between each node and its parent, with a sphere at each joint and tip. A plant with
+// the attribute Cd (the L-system's a("Cd", r, g, b), linear RGB) colours each cone and sphere by its node
+// (a segment by its child, as its tube is): the bark texture with that pigment.
 void write_cones(Out out, const Plant& plant) {
   std::vector<std::uint8_t> has_child(plant.nodes.size(), 0);
   for (const auto& n : plant.nodes)
     if (n.parent != kNoParent) has_child[static_cast<std::size_t>(n.parent)] = 1;
-  group(out, "branches: cones with a sphere at each joint", "GB_Bark", [&](Out o2) {
-    std::size_t count = 0;
-    for (std::size_t i = 0; i < plant.nodes.size(); ++i) {
-      const PlantNode& n = plant.nodes[i];
-      const float r = std::max(n.radius, kMinRadius);
-      if (n.parent != kNoParent) {
-        const PlantNode& p = plant.nodes[static_cast<std::size_t>(n.parent)];
-        if (glm::length(n.position - p.position) > 1e-5f) {
-          fmt::format_to(o2, "  cone {{ ");
-          vec(o2, pov(p.position));
-          // A lateral branch starts with its own radius, as the mesher's tubes do, not its parent's.
-          const float base = n.shoot != p.shoot ? std::min(p.radius, n.radius) : p.radius;
-          fmt::format_to(o2, ",{:.5g},", std::max(base, kMinRadius));
-          vec(o2, pov(n.position));
-          fmt::format_to(o2, ",{:.5g} }}\n", r);
-          ++count;
-        }
-      }
-      // Joints and tips are rounded; a root without children is a lone point and is skipped.
-      if (n.parent != kNoParent || has_child[i]) {
-        fmt::format_to(o2, "  sphere {{ ");
-        vec(o2, pov(n.position));
-        fmt::format_to(o2, ",{:.5g} }}\n", r);
-        ++count;
-      }
-    }
-    return count;
-  });
+  const auto cd = std::find_if(plant.node_attributes.begin(), plant.node_attributes.end(),
+                               [](const NodeAttribute& a) { return a.name == "Cd"; });
+  const NodeAttribute* colour = cd == plant.node_attributes.end() ? nullptr : &*cd;
+  auto texture = [&](Out o2, std::size_t node) {
+    if (!colour) return;
+    const auto c = static_cast<std::size_t>(colour->components);
+    float rgb[3] = {0.0f, 0.0f, 0.0f};
+    for (std::size_t k = 0; k < 3 && k < c; ++k) rgb[k] = std::clamp(colour->values[node * c + k], 0.0f, 1.0f);
+    fmt::format_to(o2, " texture {{ GB_Bark pigment {{ rgb <{:.4g},{:.4g},{:.4g}> }} }}", rgb[0], rgb[1], rgb[2]);
+  };
+  group(out,
+        colour ? "branches: cones with a sphere at each joint, coloured by Cd"
+               : "branches: cones with a sphere at each joint",
+        "GB_Bark", [&](Out o2) {
+          std::size_t count = 0;
+          for (std::size_t i = 0; i < plant.nodes.size(); ++i) {
+            const PlantNode& n = plant.nodes[i];
+            const float r = std::max(n.radius, kMinRadius);
+            if (n.parent != kNoParent) {
+              const PlantNode& p = plant.nodes[static_cast<std::size_t>(n.parent)];
+              if (glm::length(n.position - p.position) > 1e-5f) {
+                fmt::format_to(o2, "  cone {{ ");
+                vec(o2, pov(p.position));
+                // A lateral branch starts with its own radius, as the mesher's tubes do, not its parent's.
+                const float base = n.shoot != p.shoot ? std::min(p.radius, n.radius) : p.radius;
+                fmt::format_to(o2, ",{:.5g},", std::max(base, kMinRadius));
+                vec(o2, pov(n.position));
+                fmt::format_to(o2, ",{:.5g}", r);
+                texture(o2, i);
+                fmt::format_to(o2, " }}\n");
+                ++count;
+              }
+            }
+            // Joints and tips are rounded; a root without children is a lone point and is skipped.
+            if (n.parent != kNoParent || has_child[i]) {
+              fmt::format_to(o2, "  sphere {{ ");
+              vec(o2, pov(n.position));
+              fmt::format_to(o2, ",{:.5g}", r);
+              texture(o2, i);
+              fmt::format_to(o2, " }}\n");
+              ++count;
+            }
+          }
+          return count;
+        });
 }
 
 // Branches as RenderOptions::branches asks: cone chains, or the mesher's tubes as one mesh2.
 void write_branches(Out out, const Plant& plant, const RenderOptions& o) {
   if (o.branches == "mesh") {
-    Plant branches;
+    Plant branches;  // the tubes alone, with the cross sections and divisions F(l,w,s,d) gave them
     branches.nodes = plant.nodes;
+    branches.node_tubes = plant.node_tubes;
     const OutputMesh tubes = mesh_plant(branches, o.mesher);
     if (!tubes.triangles.empty()) {
       fmt::format_to(out, "// branches: {} nodes as one mesh2\n", plant.nodes.size());

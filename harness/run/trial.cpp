@@ -488,6 +488,7 @@ void mesh_export_measure(const TrialSpec& spec, const MesherOptions& mesher, Tri
     rec.output_bytes.ply = write_ply((d / "plant.ply").string(), st.mesh);
     rec.output_bytes.glb = write_glb((d / "plant.glb").string(), st.mesh);
     rec.output_bytes.skeleton_obj = write_skeleton_obj((d / "skeleton.obj").string(), plant);
+    rec.output_bytes.skeleton_ply = write_skeleton_ply((d / "skeleton.ply").string(), plant);
     for (const auto& f : algorithm_outputs(*st.algo, plant, {d.string(), "", false}))
       rec.output_bytes.algorithm_files[f.name] = f.bytes;
   });

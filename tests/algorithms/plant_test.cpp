@@ -44,5 +44,40 @@ TEST(Plant, LengthHashAndValidation) {
   EXPECT_NE(r.validate().find("organ 0"), std::string::npos);
 }
 
+TEST(Plant, OptionalDataEntersTheHashOnlyWhenPresent) {
+  Plant p = y_plant();
+  const std::string h = p.geometry_hash();
+  EXPECT_EQ(h, "4c837999314598b7");  // as before the prefix, tubes and geometry type existed (commit 1d14bd5)
+  p.group_prefix = "lsys";           // names no group: the plant is the same
+  EXPECT_EQ(p.geometry_hash(), h);
+  p.node_tubes.assign(4, TubeShape{});
+  EXPECT_EQ(p.validate(), "");
+  EXPECT_NE(p.geometry_hash(), h);
+  p.node_tubes[2] = {3, 5};
+  const std::string tubes = p.geometry_hash();
+  p.node_tubes[2].divisions = 6;
+  EXPECT_NE(p.geometry_hash(), tubes);
+  p.node_tubes[2].divisions = 2;
+  EXPECT_NE(p.validate().find("node 2 has 2 tube divisions"), std::string::npos) << p.validate();
+  p.node_tubes[2] = {65, 0};
+  EXPECT_NE(p.validate().find("node 2 has 65 tube sections"), std::string::npos) << p.validate();
+  p.node_tubes.resize(3);
+  EXPECT_NE(p.validate().find("3 node tubes for 4 nodes"), std::string::npos) << p.validate();
+  Plant g = y_plant();
+  g.branch_geometry = BranchGeometry::Skeleton;
+  EXPECT_NE(g.geometry_hash(), h);
+  g.node_groups = {0, 0, 1, -1};
+  g.group_prefix = "a b";
+  EXPECT_NE(g.validate().find("group prefix 'a b'"), std::string::npos) << g.validate();
+  g.group_prefix = "twig";
+  EXPECT_EQ(g.validate(), "");
+  EXPECT_EQ(g.group_name(3), "twig3");
+  const std::string named = g.geometry_hash();
+  g.group_prefix = "branch";
+  EXPECT_NE(g.geometry_hash(), named);
+  g.group_prefix.clear();
+  EXPECT_EQ(g.group_name(0), "group0");
+}
+
 }  // namespace
 }  // namespace growbench

@@ -100,7 +100,7 @@ TEST(Cli, RunWritesMeshesSkeletonAndRecord) {
   const auto r = growbench("run -q -a spacecol -s column --set surface=cling --set point_count=3000 --seed 3 -j 2 -o " +
                            dir.string());
   ASSERT_EQ(r.status, 0) << r.out;
-  for (const char* f : {"plant.obj", "plant.mtl", "plant.ply", "skeleton.obj", "record.json"})
+  for (const char* f : {"plant.obj", "plant.mtl", "plant.ply", "skeleton.obj", "skeleton.ply", "record.json"})
     EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
   std::ifstream in(dir / "record.json");
   const auto rec = nlohmann::json::parse(in);
@@ -109,6 +109,8 @@ TEST(Cli, RunWritesMeshesSkeletonAndRecord) {
   EXPECT_EQ(rec["seed"], 3);
   EXPECT_EQ(rec["params"]["surface"], "cling");
   EXPECT_EQ(rec["output_bytes"]["ply"].get<std::uintmax_t>(), std::filesystem::file_size(dir / "plant.ply"));
+  EXPECT_EQ(rec["output_bytes"]["skeleton_ply"].get<std::uintmax_t>(),
+            std::filesystem::file_size(dir / "skeleton.ply"));
   for (const char* ph : {"scene_load", "query_build", "growth", "meshing", "export"}) {
     EXPECT_TRUE(rec["phases"].contains(ph)) << ph;
     EXPECT_GE(rec["phases"][ph]["wall_s"].get<double>(), 0.0);

@@ -241,7 +241,8 @@ TEST(Suite, QuickSuiteEndToEndAndSummary) {
     EXPECT_EQ(t["status"], "ok") << t["id"];
     for (const char* k : {"geometry_hash", "metrics", "output_bytes", "alloc", "curve", "scene_hash"})
       EXPECT_TRUE(t.contains(k)) << k;
-    for (const char* f : {"obj", "ply", "glb", "skeleton_obj"}) EXPECT_GT(t["output_bytes"][f].get<long>(), 0) << f;
+    for (const char* f : {"obj", "ply", "glb", "skeleton_obj", "skeleton_ply"})
+      EXPECT_GT(t["output_bytes"][f].get<long>(), 0) << f;
   }
   const auto s = growbench("summary " + out + "/results.json");
   EXPECT_EQ(s.status, 0);
