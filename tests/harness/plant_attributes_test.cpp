@@ -317,6 +317,50 @@ TEST_F(PlantAttributes, CdBecomesVertexColoursInGltfPlyAndObj) {
   EXPECT_NEAR(rgb[2], 0.5371, 1e-4);
 }
 
+// An organ's own colour (its shape's, times its tint) reaches glTF as linear COLOR_0 and PLY as sRGB bytes;
+// the branch vertices then carry the bark material's colour.
+TEST_F(PlantAttributes, OrganColoursBecomeVertexColoursInGltfAndPly) {
+  Plant p = grow("FK");
+  ASSERT_EQ(p.organs.size(), 1u);
+  p.organs[0].tint = glm::vec3(1.0f, 0.5f, 0.25f);
+  const OrganShapes shapes = organ_shapes(p);
+  const glm::vec3 petal = shapes.linear_color(p.organs[0]), bark = material_color("bark");
+  const std::size_t petal_vertices = shapes.of(p.organs[0]).mesh.vertices.size();
+  const OutputMesh m = mesh_plant(p);
+  ASSERT_EQ(m.colors.size(), m.positions.size());
+  EXPECT_EQ(std::count(m.colors.begin(), m.colors.end(), petal), static_cast<std::ptrdiff_t>(petal_vertices));
+  EXPECT_EQ(std::count(m.colors.begin(), m.colors.end(), bark),
+            static_cast<std::ptrdiff_t>(m.positions.size() - petal_vertices));
+
+  const auto dir = test::temp_dir("attr_organ_colour");
+  write_glb((dir / "p.glb").string(), m);
+  const tinygltf::Model model = load_glb(dir / "p.glb");
+  std::size_t petal_in_gltf = 0;
+  for (const auto& prim : model.meshes[0].primitives) {
+    ASSERT_TRUE(prim.attributes.count("COLOR_0"));
+    const std::vector<float> colors = floats_of(model, prim.attributes.at("COLOR_0"));
+    ASSERT_EQ(colors.size(), 3 * m.positions.size());
+    for (std::size_t v = 0; v < m.positions.size(); ++v)
+      ASSERT_EQ(glm::vec3(colors[3 * v], colors[3 * v + 1], colors[3 * v + 2]), m.colors[v]) << v;
+    petal_in_gltf = static_cast<std::size_t>(std::count(m.colors.begin(), m.colors.end(), petal));
+  }
+  EXPECT_EQ(petal_in_gltf, petal_vertices);
+
+  write_ply((dir / "p.ply").string(), m);
+  const PlyElement& vertex = read_ply(dir / "p.ply").element("vertex");
+  auto srgb_byte = [](float linear) {
+    const double s = linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
+    return std::round(255.0 * s);
+  };
+  std::size_t petal_in_ply = 0;
+  for (std::size_t v = 0; v < vertex.count; ++v)
+    if (std::abs(vertex.columns.at("red")[v] - srgb_byte(petal.r)) <= 1.0 &&
+        std::abs(vertex.columns.at("green")[v] - srgb_byte(petal.g)) <= 1.0 &&
+        std::abs(vertex.columns.at("blue")[v] - srgb_byte(petal.b)) <= 1.0)
+      ++petal_in_ply;
+  EXPECT_EQ(petal_in_ply, petal_vertices);
+}
+
 TEST_F(PlantAttributes, OtherAttributesBecomePlyPropertiesAndGltfUnderscoreAttributes) {
   const Plant p = grow("a(\"wet\",0.5)a(\"uv2\",1,2)F[a(\"wet\",0.75)F]F");
   const OutputMesh m = mesh_plant(p);
