@@ -140,7 +140,8 @@ bool shapes_meet(const Candidate& a, const Candidate& b) {
 
 }  // namespace
 
-OrientedBox organ_box(const Organ& organ, const OrganShape& shape, double pad) {
+OrientedBox organ_box(const Organ& organ, const OrganShape& shape) {
+  const double pad = pad_for(organ);
   const glm::dmat3 r = glm::mat3_cast(organ.orientation);
   const double s = organ.size;
   OrientedBox b;
@@ -256,7 +257,7 @@ struct Placement {
   }
 
   void add(std::uint32_t organ, std::uint8_t variant, const Organ& o) {
-    const OrientedBox b = organ_box(o, shapes.of(o), pad_for(o));
+    const OrientedBox b = organ_box(o, shapes.of(o));
     cand.push_back({organ, variant, o, &shapes.of(o), b, glm::length(b.half)});
   }
 

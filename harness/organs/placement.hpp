@@ -27,12 +27,12 @@ void vary_organs(Plant& plant, const OrganOptions& options, std::uint64_t seed);
 // sequential sweep decides: O(n log n) and deterministic. With placement=free, only counts.
 PlacementCounts place_organs(Plant& plant, const OrganOptions& options, const OrganShape* custom_leaf = nullptr);
 
-// An organ's oriented box: the shape's bounds in the organ's frame, scaled by its size and padded by
-// `pad` in every direction.
+// An organ's oriented box: the shape's bounds in the organ's frame, scaled by its size and padded in
+// every direction by more than the rounding of placing its vertices, so it holds them.
 struct OrientedBox {
   glm::dvec3 centre{0.0}, axis[3]{}, half{0.0};
 };
-OrientedBox organ_box(const Organ& organ, const OrganShape& shape, double pad);
+OrientedBox organ_box(const Organ& organ, const OrganShape& shape);
 bool boxes_overlap(const OrientedBox& a, const OrientedBox& b);
 // Whether the capsule from p to q with radius r meets the box.
 bool capsule_meets_box(const glm::dvec3& p, const glm::dvec3& q, double r, const OrientedBox& box);
