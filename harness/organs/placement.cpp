@@ -1,11 +1,16 @@
 #include "harness/organs/placement.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <span>
 
 #include <glm/gtc/quaternion.hpp>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_for_each.h>
 
 #include "core/kdtree.hpp"
 #include "core/random.hpp"
@@ -31,42 +36,26 @@ bool is_blossom(const Plant& plant, const Organ& o) {
   return plant.organ_shapes[o.shape].rfind("blossom", 0) == 0;
 }
 
-// The organ as its fallback, or false when it has none.
-bool fallback_of(Plant& plant, const OrganOptions& opt, Organ& o) {
-  switch (o.kind) {
-    case OrganKind::Leaf:
-    case OrganKind::YoungLeaf:
-      if (!(opt.fallback_leaf > 0.0)) return false;
-      o.size = static_cast<float>(o.size * opt.fallback_leaf);
-      return true;
-    case OrganKind::Flower:
-    case OrganKind::Bud: {
-      const std::string& f = o.kind == OrganKind::Flower ? opt.fallback_flower : opt.fallback_bud;
-      if (f == "none") return false;
-      o.shape = shape_index(plant, f);
-      if (f.rfind("bud", 0) == 0) o.kind = OrganKind::Bud;
-      return true;
-    }
-  }
-  return false;
-}
-
 double pad_for(const Organ& o) {
   const glm::vec3 p = glm::abs(o.position);
   return 1e-6 * o.size + 4.0 * std::numeric_limits<float>::epsilon() * std::max({p.x, p.y, p.z, o.size});
 }
 
-// The distance from the segment (a, b) to the box [-h, h], both in the box's frame: a convex function of
-// the segment's parameter, minimised by golden-section search.
-double segment_box_distance(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& h) {
+// Whether the segment (a, b) comes closer than r to the box [-h, h], both in the box's frame: the
+// distance is a convex function of the segment's parameter, minimised by golden-section search. Each
+// step keeps the lower of its two points, so the least distance found is the least of all evaluated:
+// the search can stop at the first below r, with the verdict the full search gives.
+bool segment_near_box(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& h, double r) {
   auto dist = [&](double t) {
     const glm::dvec3 p = a + t * (b - a);
     return glm::length(glm::max(glm::abs(p) - h, glm::dvec3(0.0)));
   };
+  if (dist(0.0) < r || dist(1.0) < r) return true;
   double lo = 0.0, hi = 1.0;
   constexpr double g = 0.6180339887498949;
   double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo), f1 = dist(x1), f2 = dist(x2);
   for (int k = 0; k < 60 && hi - lo > 1e-9; ++k) {
+    if (f1 < r || f2 < r) return true;
     if (f1 <= f2) {
       hi = x2;
       x2 = x1;
@@ -81,66 +70,215 @@ double segment_box_distance(const glm::dvec3& a, const glm::dvec3& b, const glm:
       f2 = dist(x2);
     }
   }
-  return std::min({dist(0.0), dist(1.0), f1, f2});
+  return f1 < r || f2 < r;
 }
 
-// What one candidate (an organ as grown, or its fallback) needs for the tests.
-struct Candidate {
-  std::uint32_t organ;
-  std::uint8_t variant;  // 0: as grown, 1: fallback
-  Organ as;              // the organ as this candidate places it
-  const OrganShape* shape;
-  OrientedBox box;
-  double reach;  // the box's bounding-sphere radius
+// What an organ becomes when it does not fit, by kind. The fallback shapes are named in the plant
+// before its shapes are resolved, so making a fallback only reads.
+class Fallbacks {
+ public:
+  Fallbacks(Plant& plant, const OrganOptions& opt)
+      : leaf_(opt.fallback_leaf), flower_(named(plant, opt.fallback_flower)), bud_(named(plant, opt.fallback_bud)) {}
+
+  [[nodiscard]] bool exist(OrganKind kind) const {
+    switch (kind) {
+      case OrganKind::Leaf:
+      case OrganKind::YoungLeaf:
+        return leaf_ > 0.0;
+      case OrganKind::Flower:
+        return flower_.some;
+      case OrganKind::Bud:
+        return bud_.some;
+    }
+    return false;
+  }
+
+  // The organ as its fallback; only for a kind that has one.
+  [[nodiscard]] Organ of(Organ o) const {
+    if (o.kind == OrganKind::Leaf || o.kind == OrganKind::YoungLeaf) {
+      o.size = static_cast<float>(o.size * leaf_);
+      return o;
+    }
+    const Shape& s = o.kind == OrganKind::Flower ? flower_ : bud_;
+    o.shape = s.index;
+    if (s.is_bud) o.kind = OrganKind::Bud;
+    return o;
+  }
+
+ private:
+  struct Shape {
+    bool some = false;
+    std::uint16_t index = 0;
+    bool is_bud = false;
+  };
+  static Shape named(Plant& plant, const std::string& f) {
+    if (f == "none") return {};
+    return {true, shape_index(plant, f), f.rfind("bud", 0) == 0};
+  }
+  double leaf_;
+  Shape flower_, bud_;
 };
 
-// Whether two candidates' shapes intersect, triangle by triangle, as the leaf_overlap metric tests
-// them (geom::triangles_overlap on the triangles organ_point places): organs that only touch, such as
-// leaves of one tuft sharing their base, do not. Only triangles whose bounds meet the other organ's are
-// paired: disjoint bounds cannot hold a shared point, so this changes no verdict.
-bool shapes_meet(const Candidate& a, const Candidate& b) {
-  struct Placed {
-    std::vector<glm::vec3> v;
-    std::vector<Aabb> box;  // per triangle
+// A candidate (an organ as grown, or its fallback) ready for the box tests: its box, and bounds that
+// hold the box.
+struct Probe {
+  OrientedBox box;
+  double reach;       // the box's bounding-sphere radius
+  glm::dvec3 extent;  // the half size of the box's axis-aligned bounds
+};
+
+// The bounds reject only boxes that cannot meet; the factor covers their rounding, so they never reject
+// a pair boxes_overlap keeps.
+constexpr double kBoundsSlack = 1.0 + 1e-9;
+
+// boxes_overlap's verdict, after the cheap bounds.
+bool boxes_meet(const Probe& a, const Probe& b) {
+  const glm::dvec3 d = a.box.centre - b.box.centre;
+  const double r = (a.reach + b.reach) * kBoundsSlack;
+  if (glm::dot(d, d) > r * r) return false;
+  if (glm::any(glm::greaterThan(glm::abs(d), (a.extent + b.extent) * kBoundsSlack))) return false;
+  return boxes_overlap(a.box, b.box);
+}
+
+bool disjoint(const Aabb& x, const Aabb& y) {
+  return glm::any(glm::lessThan(x.max, y.min)) || glm::any(glm::lessThan(y.max, x.min));
+}
+
+// Shape tests for deciding an organ: whether the candidate it tries meets the candidates that earlier
+// organs took. The tried one is placed once (its triangles and their bounds); a taken one's vertices are
+// placed the first time it is asked for and kept under its organ, since later organs are tested against
+// it again. One per thread: what is kept changes no verdict.
+class ShapeTests {
+ public:
+  explicit ShapeTests(std::size_t organs) : at_(organs, kNone) {}
+
+  // The candidate the next calls test; nothing is placed until a test needs it.
+  void begin(const Organ& organ, const OrganShape& shape) {
+    tried_ = organ;
+    tried_shape_ = &shape;
+    tried_placed_ = false;
+  }
+
+  // Whether the tried candidate's shape and `other`'s (what organ `owner` took) intersect, triangle by
+  // triangle, as the leaf_overlap metric tests them (geom::triangles_overlap on the triangles
+  // organ_point places): organs that only touch, such as leaves of one tuft sharing their base, do not.
+  // Only triangles whose bounds meet the other organ's are paired: disjoint bounds cannot hold a shared
+  // point, so this changes no verdict.
+  bool meets(std::uint32_t owner, const Organ& other, const OrganShape& shape) {
+    place_tried();
+    const Kept& kept = keep(owner, other, shape);
+    if (disjoint(tried_all_, kept.all)) return false;
+    const glm::vec3* v = &vertices_[kept.first];
+    near_.clear();
+    for (const auto& t : shape.mesh.triangles) {
+      Tri x{{v[t.x], v[t.y], v[t.z]}, {}};
+      for (const auto& p : x.v) x.box.extend(p);
+      if (!disjoint(x.box, tried_all_)) near_.push_back(x);
+    }
+    for (const Tri& a : tri_) {
+      if (disjoint(a.box, kept.all)) continue;
+      for (const Tri& b : near_)
+        if (!disjoint(a.box, b.box) && geom::triangles_overlap(a.v, b.v)) return true;
+    }
+    return false;
+  }
+
+ private:
+  static constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+  struct Tri {
+    glm::vec3 v[3];
+    Aabb box;
+  };
+  struct Kept {
+    std::uint32_t first;  // its vertices in vertices_
     Aabb all;
   };
-  thread_local Placed pa, pb;
-  auto place = [](const Candidate& c, Placed& p) {
-    p.v.clear();
-    p.box.clear();
-    p.all = Aabb{};
-    for (const auto& v : c.shape->mesh.vertices) p.v.push_back(organ_point(c.as, v));
-    for (const auto& t : c.shape->mesh.triangles) {
-      Aabb b;
-      for (int k = 0; k < 3; ++k) b.extend(p.v[t[k]]);
-      p.box.push_back(b);
-      p.all.extend(b.min);
-      p.all.extend(b.max);
-    }
-  };
-  auto disjoint = [](const Aabb& x, const Aabb& y) {
-    return glm::any(glm::lessThan(x.max, y.min)) || glm::any(glm::lessThan(y.max, x.min));
-  };
-  place(a, pa);
-  place(b, pb);
-  if (disjoint(pa.all, pb.all)) return false;
-  const auto& ta = a.shape->mesh.triangles;
-  const auto& tb = b.shape->mesh.triangles;
-  for (std::size_t i = 0; i < ta.size(); ++i) {
-    if (disjoint(pa.box[i], pb.all)) continue;
-    const glm::vec3 x[3] = {pa.v[ta[i].x], pa.v[ta[i].y], pa.v[ta[i].z]};
-    for (std::size_t j = 0; j < tb.size(); ++j) {
-      if (disjoint(pa.box[i], pb.box[j])) continue;
-      const glm::vec3 y[3] = {pb.v[tb[j].x], pb.v[tb[j].y], pb.v[tb[j].z]};
-      if (geom::triangles_overlap(x, y)) return true;
+
+  void place_tried() {
+    if (tried_placed_) return;
+    tried_placed_ = true;
+    local_.clear();
+    for (const auto& v : tried_shape_->mesh.vertices) local_.push_back(organ_point(tried_, v));
+    tri_.clear();
+    tried_all_ = Aabb{};
+    for (const auto& t : tried_shape_->mesh.triangles) {
+      Tri x{{local_[t.x], local_[t.y], local_[t.z]}, {}};
+      for (const auto& p : x.v) x.box.extend(p);
+      tried_all_.extend(x.box);
+      tri_.push_back(x);
     }
   }
-  return false;
-}
+
+  const Kept& keep(std::uint32_t owner, const Organ& organ, const OrganShape& shape) {
+    if (at_[owner] != kNone) return kept_[at_[owner]];
+    Kept e{static_cast<std::uint32_t>(vertices_.size()), {}};
+    for (const auto& v : shape.mesh.vertices) {
+      vertices_.push_back(organ_point(organ, v));
+      e.all.extend(vertices_.back());
+    }
+    at_[owner] = static_cast<std::uint32_t>(kept_.size());
+    kept_.push_back(e);
+    return kept_.back();
+  }
+
+  std::vector<std::uint32_t> at_;  // organ -> kept_, or kNone before its candidate is placed
+  std::vector<Kept> kept_;
+  std::vector<glm::vec3> vertices_;
+  Organ tried_;
+  const OrganShape* tried_shape_ = nullptr;
+  bool tried_placed_ = false;
+  std::vector<glm::vec3> local_;
+  std::vector<Tri> tri_, near_;
+  Aabb tried_all_;
+};
+
+// The branch segments, for the test that an organ's box meets no segment's capsule but its stem's.
+class Branches {
+ public:
+  explicit Branches(const std::vector<PlantNode>& nodes) : nodes_(nodes) {
+    for (std::size_t c = 0; c < nodes.size(); ++c) {
+      if (nodes[c].parent == kNoParent) continue;
+      const auto& p = nodes[static_cast<std::size_t>(nodes[c].parent)];
+      mid_.push_back(0.5f * (p.position + nodes[c].position));
+      child_.push_back(static_cast<std::uint32_t>(c));
+      reach_ = std::max(reach_, 0.5 * glm::length(glm::dvec3(p.position - nodes[c].position)) +
+                                    std::max({p.radius, nodes[c].radius, 1e-4f}));
+    }
+    if (!mid_.empty()) tree_ = std::make_unique<Vec3Tree>(3, cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  }
+  Branches(const Branches&) = delete;  // the tree refers to cloud_
+  Branches& operator=(const Branches&) = delete;
+
+  // Whether a segment other than those ending or starting at node `own` (the organ's stem) meets the box.
+  [[nodiscard]] bool block(const Probe& c, std::int32_t own) const {
+    if (!tree_) return false;
+    bool blocked = false;
+    kd_visit_within(*tree_, glm::vec3(c.box.centre), static_cast<float>((c.reach + reach_) * (1.0 + 1e-6)),
+                    [&](std::uint32_t s, float) {
+                      const std::uint32_t ci = child_[s];
+                      const auto& n = nodes_[ci];
+                      if (own != kNoParent && (static_cast<std::int32_t>(ci) == own || n.parent == own)) return true;
+                      const auto& p = nodes_[static_cast<std::size_t>(n.parent)];
+                      const double r = std::max({p.radius, n.radius, 1e-4f});
+                      blocked = capsule_meets_box(glm::dvec3(p.position), glm::dvec3(n.position), r, c.box);
+                      return !blocked;
+                    });
+    return blocked;
+  }
+
+ private:
+  const std::vector<PlantNode>& nodes_;
+  std::vector<glm::vec3> mid_;        // each segment's midpoint
+  std::vector<std::uint32_t> child_;  // each segment's child node
+  double reach_ = 0.0;                // the farthest any segment's capsule reaches from its midpoint
+  Vec3Cloud cloud_{&mid_};
+  std::unique_ptr<Vec3Tree> tree_;
+};
 
 }  // namespace
 
-OrientedBox organ_box(const Organ& organ, const OrganShape& shape, double pad) {
+OrientedBox organ_box(const Organ& organ, const OrganShape& shape) {
+  const double pad = pad_for(organ);
   const glm::dmat3 r = glm::mat3_cast(organ.orientation);
   const double s = organ.size;
   OrientedBox b;
@@ -191,7 +329,7 @@ bool capsule_meets_box(const glm::dvec3& p, const glm::dvec3& q, double r, const
   if (glm::any(glm::greaterThan(glm::min(a, b) - r, box.half)) ||
       glm::any(glm::lessThan(glm::max(a, b) + r, -box.half)))
     return false;
-  return segment_box_distance(a, b, box.half) < r;
+  return segment_near_box(a, b, box.half, r);
 }
 
 void vary_organs(Plant& plant, const OrganOptions& opt, std::uint64_t seed) {
@@ -226,151 +364,194 @@ void vary_organs(Plant& plant, const OrganOptions& opt, std::uint64_t seed) {
 
 namespace {
 
-struct Placement {
-  Plant& plant;
-  const OrganOptions& opt;
-  const OrganShapes shapes;
-  std::vector<Candidate> cand;       // per organ: its own, then its fallback when it has one
-  std::vector<std::uint32_t> first;  // organ -> its first candidate; first[n] = cand.size()
+// What each organ took.
+enum Decision : std::uint8_t { kGrown = 0, kFallback = 1, kDropped = 2 };
 
+// Each organ's own box's centre, and how far its candidates' boxes reach from it.
+struct Reach {
+  std::vector<glm::vec3> centres;
+  std::vector<double> spread;
+};
+
+// The organs' k-d tree (their own boxes' centres) and, for each organ, the earlier organs whose
+// candidates' boxes may meet its own: each organ's `spread` reaches the farthest point of any of its
+// candidates' boxes, so two organs whose candidates can meet are within the sum of theirs. Organs are
+// named by their place in the tree's order, where organs near in space are near in memory. The tree is
+// built once, over every organ in their order; its searches decide which organs are compared.
+class Neighbours {
+ public:
+  explicit Neighbours(Reach r) : centres_(std::move(r.centres)), spread_(std::move(r.spread)) {
+    smax_ = spread_.empty() ? 0.0 : *std::max_element(spread_.begin(), spread_.end());
+    tree_ = std::make_unique<Vec3Tree>(3, cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(8));
+    place_.resize(centres_.size());
+    for (std::size_t p = 0; p < place_.size(); ++p) place_[organ(p)] = static_cast<std::uint32_t>(p);
+    find();
+  }
+  Neighbours(const Neighbours&) = delete;  // the tree refers to cloud_
+  Neighbours& operator=(const Neighbours&) = delete;
+
+  [[nodiscard]] std::uint32_t organ(std::size_t place) const { return tree_->vAcc[place]; }
+  [[nodiscard]] std::uint32_t place(std::size_t organ) const { return place_[organ]; }
+
+  // The places of the earlier organs near the organ at place p.
+  [[nodiscard]] std::span<const std::uint32_t> of(std::size_t p) const {
+    const auto& list = lists_[p / kChunk];
+    const bool last = (p + 1) % kChunk == 0 || p + 1 == place_.size();
+    return {list.data() + at_[p], list.data() + (last ? list.size() : at_[p + 1])};
+  }
+
+ private:
+  static constexpr std::size_t kChunk = 256;
+
+  // Each organ's search, in parallel in fixed chunks of the tree's order, each listing its organs'
+  // neighbours in a buffer of its own. Every list is what its own organ's search finds, so none
+  // depends on the thread count.
+  void find() {
+    const std::size_t n = centres_.size(), chunks = (n + kChunk - 1) / kChunk;
+    at_.resize(n);
+    lists_.resize(chunks);
+    tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t ch) {
+      auto& list = lists_[ch];
+      for (std::size_t p = ch * kChunk; p < std::min(n, (ch + 1) * kChunk); ++p) {
+        const std::uint32_t i = organ(p);
+        at_[p] = static_cast<std::uint32_t>(list.size());
+        kd_visit_within(*tree_, centres_[i], static_cast<float>((spread_[i] + smax_) * (1.0 + 1e-6)),
+                        [&](std::uint32_t o, float d2) {
+                          if (o >= i || std::sqrt(d2) > (spread_[i] + spread_[o]) * (1.0 + 1e-6)) return true;
+                          list.push_back(place_[o]);
+                          return true;
+                        });
+      }
+    });
+  }
+
+  std::vector<glm::vec3> centres_;
+  std::vector<double> spread_;
+  double smax_ = 0.0;
+  Vec3Cloud cloud_{&centres_};
+  std::unique_ptr<Vec3Tree> tree_;
+  std::vector<std::uint32_t> place_;               // organ -> its place in the tree's order
+  std::vector<std::uint32_t> at_;                  // place -> its list's start in its chunk's buffer
+  std::vector<std::vector<std::uint32_t>> lists_;  // by chunk of places
+};
+
+// The avoid placement. Every organ's candidates are tested lazily, only against the candidates its
+// earlier neighbours took: a candidate not taken cannot block one, so the tests it would need are never
+// made. An organ is decided once its earlier neighbours are, in parallel with any other organ ready.
+class Placement {
+ public:
   Placement(Plant& p, const OrganOptions& o, const OrganShape* custom)
-      : plant(p), opt(o), shapes(with_fallbacks(p, o), custom) {}
+      : plant_(p), fallbacks_(p, o), shapes_(p, custom), branches_(p.nodes), neighbours_(reach()) {}
 
-  // The fallback shapes are named in the plant before the shapes are resolved.
-  static const Plant& with_fallbacks(Plant& p, const OrganOptions& o) {
-    for (const auto* f : {&o.fallback_flower, &o.fallback_bud})
-      if (*f != "none") (void)shape_index(p, *f);
+  PlacementCounts run() {
+    const std::size_t n = plant_.organs.size();
+    organs_.resize(n);
+    tbb::parallel_for(std::size_t{0}, n, [&](std::size_t p) { organs_[p] = plant_.organs[neighbours_.organ(p)]; });
+    const std::vector<std::uint8_t> decision = decide_all();
+    // The organs kept, moved down in place in their order.
+    PlacementCounts counts;
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::uint32_t p = neighbours_.place(i);
+      if (decision[p] == kDropped) {
+        ++counts.dropped;
+        continue;
+      }
+      ++(decision[p] == kGrown ? counts.placed : counts.fallen_back);
+      plant_.organs[kept++] = as(p, decision[p]);
+    }
+    plant_.organs.resize(kept);
+    return counts;
+  }
+
+ private:
+  // The organ at place p as grown or as its fallback.
+  [[nodiscard]] Organ as(std::uint32_t p, std::uint8_t variant) const {
+    return variant == kGrown ? organs_[p] : fallbacks_.of(organs_[p]);
+  }
+
+  [[nodiscard]] Probe probe(const Organ& o) const {
+    Probe p{organ_box(o, shapes_.of(o)), 0.0, glm::dvec3(0.0)};
+    p.reach = glm::length(p.box.half);
+    for (int k = 0; k < 3; ++k) p.extent += glm::abs(p.box.axis[k]) * p.box.half[k];
     return p;
   }
 
-  void make_candidates() {
-    const std::size_t n = plant.organs.size();
-    first.resize(n + 1);
-    for (std::size_t i = 0; i < n; ++i) {
-      first[i] = static_cast<std::uint32_t>(cand.size());
-      add(static_cast<std::uint32_t>(i), 0, plant.organs[i]);
-      Organ f = plant.organs[i];
-      if (fallback_of(plant, opt, f)) add(static_cast<std::uint32_t>(i), 1, f);
-    }
-    first[n] = static_cast<std::uint32_t>(cand.size());
-  }
-
-  void add(std::uint32_t organ, std::uint8_t variant, const Organ& o) {
-    const OrientedBox b = organ_box(o, shapes.of(o), pad_for(o));
-    cand.push_back({organ, variant, o, &shapes.of(o), b, glm::length(b.half)});
-  }
-
-  // Each candidate blocked by a branch other than its own stem.
-  std::vector<std::uint8_t> blocked_by_branches() const {
-    std::vector<std::uint8_t> blocked(cand.size(), 0);
-    const auto& nodes = plant.nodes;
-    std::vector<glm::vec3> mid;
-    std::vector<std::uint32_t> child;
-    double reach = 0.0;
-    for (std::size_t c = 0; c < nodes.size(); ++c) {
-      if (nodes[c].parent == kNoParent) continue;
-      const auto& p = nodes[static_cast<std::size_t>(nodes[c].parent)];
-      mid.push_back(0.5f * (p.position + nodes[c].position));
-      child.push_back(static_cast<std::uint32_t>(c));
-      reach = std::max(reach, 0.5 * glm::length(glm::dvec3(p.position - nodes[c].position)) +
-                                  std::max({p.radius, nodes[c].radius, 1e-4f}));
-    }
-    if (mid.empty()) return blocked;
-    Vec3Cloud cloud{&mid};
-    Vec3Tree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-    tbb::parallel_for(std::size_t{0}, cand.size(), [&](std::size_t k) {
-      const Candidate& c = cand[k];
-      const std::int32_t own = plant.organs[c.organ].node;
-      kd_visit_within(tree, glm::vec3(c.box.centre), static_cast<float>((c.reach + reach) * (1.0 + 1e-6)),
-                      [&](std::uint32_t s, float) {
-                        const std::uint32_t ci = child[s];
-                        const auto& n = nodes[ci];
-                        if (own != kNoParent && (static_cast<std::int32_t>(ci) == own || n.parent == own)) return true;
-                        const auto& p = nodes[static_cast<std::size_t>(n.parent)];
-                        const double r = std::max({p.radius, n.radius, 1e-4f});
-                        if (!capsule_meets_box(glm::dvec3(p.position), glm::dvec3(n.position), r, c.box)) return true;
-                        blocked[k] = 1;
-                        return false;
-                      });
+  [[nodiscard]] Reach reach() const {
+    const std::size_t n = plant_.organs.size();
+    Reach r{std::vector<glm::vec3>(n), std::vector<double>(n)};
+    tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+      const Organ& o = plant_.organs[i];
+      const OrientedBox own = organ_box(o, shapes_.of(o));
+      r.centres[i] = glm::vec3(own.centre);
+      r.spread[i] = glm::length(own.half);
+      if (!fallbacks_.exist(o.kind)) return;
+      const Organ f = fallbacks_.of(o);
+      const OrientedBox b = organ_box(f, shapes_.of(f));
+      r.spread[i] = std::max(r.spread[i], glm::length(b.centre - own.centre) + glm::length(b.half));
     });
-    return blocked;
+    return r;
   }
 
-  // For each candidate, the candidates of earlier organs whose boxes it meets (CSR by candidate).
-  void conflicts(std::vector<std::uint32_t>& offset, std::vector<std::uint32_t>& other) const {
-    // A tree of the organs (their own boxes' centres); each organ's `spread` reaches the farthest point
-    // of any of its candidates' boxes, so two organs whose candidates can meet are within the sum.
-    const std::size_t organs = first.size() - 1;
-    std::vector<glm::vec3> centres(organs);
-    std::vector<double> spread(organs, 0.0);
-    double smax = 0.0;
-    for (std::size_t i = 0; i < organs; ++i) {
-      const std::uint32_t k0 = first[i];
-      centres[i] = glm::vec3(cand[k0].box.centre);
-      for (std::uint32_t k = k0; k < first[i + 1]; ++k)
-        spread[i] = std::max(spread[i], glm::length(cand[k].box.centre - cand[k0].box.centre) + cand[k].reach);
-      smax = std::max(smax, spread[i]);
+  // Every organ's decision, by place. An organ is decided when the last of its earlier neighbours is:
+  // its decision reads only theirs, so each is the one visiting the organs in their order makes,
+  // whichever thread makes it and when.
+  [[nodiscard]] std::vector<std::uint8_t> decide_all() const {
+    const std::size_t n = organs_.size();
+    // For each organ, the later organs it is an earlier neighbour of (CSR by place).
+    std::vector<std::uint32_t> at(n + 1, 0), later;
+    for (std::size_t q = 0; q < n; ++q)
+      for (const std::uint32_t p : neighbours_.of(q)) ++at[p + 1];
+    for (std::size_t p = 0; p < n; ++p) at[p + 1] += at[p];
+    later.resize(at[n]);
+    std::vector<std::uint32_t> next(at.begin(), at.end() - 1);
+    for (std::uint32_t q = 0; q < n; ++q)
+      for (const std::uint32_t p : neighbours_.of(q)) later[next[p]++] = q;
+    std::vector<std::atomic<std::uint32_t>> waiting(n);  // earlier neighbours not yet decided
+    std::vector<std::uint32_t> ready;
+    for (std::uint32_t p = 0; p < n; ++p) {
+      waiting[p].store(static_cast<std::uint32_t>(neighbours_.of(p).size()), std::memory_order_relaxed);
+      if (neighbours_.of(p).empty()) ready.push_back(p);
     }
-    Vec3Cloud cloud{&centres};
-    Vec3Tree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(8));
-    // Fixed chunks of organs, joined in order: the lists do not depend on the thread count.
-    constexpr std::size_t kChunk = 1024;
-    const std::size_t chunks = (organs + kChunk - 1) / kChunk;
-    std::vector<std::vector<std::uint32_t>> counts(chunks), lists(chunks);
-    tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t ch) {
-      std::vector<std::uint32_t> found[2];
-      for (std::size_t i = ch * kChunk; i < std::min(organs, (ch + 1) * kChunk); ++i) {
-        const std::uint32_t k0 = first[i], k1 = first[i + 1];
-        found[0].clear();
-        found[1].clear();
-        kd_visit_within(tree, centres[i], static_cast<float>((spread[i] + smax) * (1.0 + 1e-6)),
-                        [&](std::uint32_t o, float d2) {
-                          if (o >= i || std::sqrt(d2) > (spread[i] + spread[o]) * (1.0 + 1e-6)) return true;
-                          for (std::uint32_t j = first[o]; j < first[o + 1]; ++j)
-                            for (std::uint32_t k = k0; k < k1; ++k)
-                              if (boxes_overlap(cand[k].box, cand[j].box) && shapes_meet(cand[k], cand[j]))
-                                found[k - k0].push_back(j);
-                          return true;
-                        });
-        for (std::uint32_t k = k0; k < k1; ++k) {
-          counts[ch].push_back(static_cast<std::uint32_t>(found[k - k0].size()));
-          lists[ch].insert(lists[ch].end(), found[k - k0].begin(), found[k - k0].end());
-        }
-      }
+    std::vector<std::uint8_t> decision(n, kDropped);
+    tbb::enumerable_thread_specific<ShapeTests> tests([n] { return ShapeTests(n); });
+    tbb::parallel_for_each(ready.begin(), ready.end(), [&](std::uint32_t p, tbb::feeder<std::uint32_t>& feeder) {
+      decision[p] = decide(p, decision, tests.local());
+      // Release: the organ this makes ready reads the decision.
+      for (std::uint32_t e = at[p]; e < at[p + 1]; ++e)
+        if (waiting[later[e]].fetch_sub(1, std::memory_order_acq_rel) == 1) feeder.add(later[e]);
     });
-    offset.assign(1, 0);
-    for (std::size_t ch = 0; ch < chunks; ++ch) {
-      for (const auto c : counts[ch]) offset.push_back(offset.back() + c);
-      other.insert(other.end(), lists[ch].begin(), lists[ch].end());
-    }
+    return decision;
   }
 
-  PlacementCounts run() {
-    make_candidates();
-    const std::vector<std::uint8_t> blocked = blocked_by_branches();
-    std::vector<std::uint32_t> offset, other;
-    conflicts(offset, other);
-    // The sweep: an organ takes its first candidate that meets no candidate already taken.
-    std::vector<std::uint8_t> taken(cand.size(), 0);
-    PlacementCounts counts;
-    std::vector<Organ> kept;
-    kept.reserve(plant.organs.size());
-    for (std::size_t i = 0; i + 1 < first.size(); ++i) {
-      bool placed = false;
-      for (std::uint32_t k = first[i]; k < first[i + 1] && !placed; ++k) {
-        if (blocked[k] || std::any_of(other.begin() + offset[k], other.begin() + offset[k + 1],
-                                      [&](std::uint32_t j) { return taken[j] != 0; }))
-          continue;
-        taken[k] = 1;
-        placed = true;
-        kept.push_back(cand[k].as);
-        ++(cand[k].variant == 1 ? counts.fallen_back : counts.placed);
+  // What the organ at place p takes: its first candidate that no branch but its own stem blocks and
+  // that meets no candidate its earlier neighbours took.
+  std::uint8_t decide(std::uint32_t p, const std::vector<std::uint8_t>& decision, ShapeTests& tests) const {
+    const std::uint8_t variants = fallbacks_.exist(organs_[p].kind) ? 2 : 1;
+    for (std::uint8_t v = 0; v < variants; ++v) {
+      const Organ o = as(p, v);
+      const Probe box = probe(o);
+      if (branches_.block(box, o.node)) continue;
+      tests.begin(o, shapes_.of(o));
+      bool meets = false;
+      for (const std::uint32_t q : neighbours_.of(p)) {
+        if (decision[q] == kDropped) continue;
+        const Organ taken = as(q, decision[q]);
+        if (!boxes_meet(box, probe(taken)) || !tests.meets(q, taken, shapes_.of(taken))) continue;
+        meets = true;
+        break;
       }
-      if (!placed) ++counts.dropped;
+      if (!meets) return v;
     }
-    plant.organs = std::move(kept);
-    return counts;
+    return kDropped;
   }
+
+  Plant& plant_;
+  const Fallbacks fallbacks_;
+  const OrganShapes shapes_;
+  const Branches branches_;
+  const Neighbours neighbours_;
+  std::vector<Organ> organs_;  // by place in the neighbours' tree: organs near in space, near in memory
 };
 
 }  // namespace

@@ -20,19 +20,20 @@ struct PlacementCounts {
 void vary_organs(Plant& plant, const OrganOptions& options, std::uint64_t seed);
 
 // With placement=avoid: visits the organs in the plant's order and keeps each whose oriented box meets
-// neither the box of an organ kept before it nor a branch segment's capsule other than its own stem
-// (the segments ending or starting at its node); otherwise its fallback under the same test; otherwise
-// it is dropped. The boxes hold the shapes' triangles, so kept leaves never overlap by the
-// leaf_overlap metric's test. The candidate pairs are found in parallel with a k-d tree, then one
-// sequential sweep decides: O(n log n) and deterministic. With placement=free, only counts.
+// no branch segment's capsule other than its own stem (the segments ending or starting at its node) and
+// whose triangles meet those of no organ kept before it (geom::triangles_overlap, the leaf_overlap
+// metric's test, after the boxes); otherwise its fallback under the same test; otherwise it is dropped.
+// A k-d tree finds each organ's earlier neighbours in parallel; each organ is then decided, in parallel
+// with others, once its earlier neighbours are, testing only against the candidates they took. The
+// result is the in-order visit's, the same for any thread count. With placement=free, only counts.
 PlacementCounts place_organs(Plant& plant, const OrganOptions& options, const OrganShape* custom_leaf = nullptr);
 
-// An organ's oriented box: the shape's bounds in the organ's frame, scaled by its size and padded by
-// `pad` in every direction.
+// An organ's oriented box: the shape's bounds in the organ's frame, scaled by its size and padded in
+// every direction by more than the rounding of placing its vertices, so it holds them.
 struct OrientedBox {
   glm::dvec3 centre{0.0}, axis[3]{}, half{0.0};
 };
-OrientedBox organ_box(const Organ& organ, const OrganShape& shape, double pad);
+OrientedBox organ_box(const Organ& organ, const OrganShape& shape);
 bool boxes_overlap(const OrientedBox& a, const OrientedBox& b);
 // Whether the capsule from p to q with radius r meets the box.
 bool capsule_meets_box(const glm::dvec3& p, const glm::dvec3& q, double r, const OrientedBox& box);

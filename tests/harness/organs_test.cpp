@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 
 #include <glm/gtc/quaternion.hpp>
 #include <gtest/gtest.h>
@@ -187,6 +188,150 @@ TEST(OrganPlacement, KeptOrgansNeverMeetAndTheResultIsTheSameForAnyThreadCount) 
   for (std::size_t i = 0; i < 300; ++i)
     for (std::size_t j = i + 1; j < grown.organs.size(); ++j) before += meet(all, grown.organs[i], grown.organs[j]);
   EXPECT_GT(before, 50u);
+}
+
+// The avoid placement by its definition, by brute force over every pair: each organ in order takes its
+// first candidate (as grown, then its fallback) whose box meets no branch segment's capsule but its
+// stem's, and whose triangles meet those of no organ kept before it. `blocked` counts the candidates a
+// branch turned away.
+PlacementCounts reference_placement(Plant& p, const OrganOptions& opt, std::size_t& blocked) {
+  auto named = [&](const std::string& f) {
+    const auto it = std::find(p.organ_shapes.begin(), p.organ_shapes.end(), f);
+    if (it != p.organ_shapes.end()) return static_cast<std::uint16_t>(it - p.organ_shapes.begin());
+    p.organ_shapes.push_back(f);
+    return static_cast<std::uint16_t>(p.organ_shapes.size() - 1);
+  };
+  for (const auto* f : {&opt.fallback_flower, &opt.fallback_bud})
+    if (*f != "none") named(*f);
+  const OrganShapes shapes(p);
+  auto fallback = [&](Organ o) -> std::optional<Organ> {
+    if (o.kind == OrganKind::Leaf || o.kind == OrganKind::YoungLeaf) {
+      if (!(opt.fallback_leaf > 0.0)) return std::nullopt;
+      o.size = static_cast<float>(o.size * opt.fallback_leaf);
+      return o;
+    }
+    const std::string& f = o.kind == OrganKind::Flower ? opt.fallback_flower : opt.fallback_bud;
+    if (f == "none") return std::nullopt;
+    o.shape = named(f);
+    if (f.rfind("bud", 0) == 0) o.kind = OrganKind::Bud;
+    return o;
+  };
+  auto branch_blocks = [&](const Organ& o) {
+    const OrientedBox box = organ_box(o, shapes.of(o));
+    for (std::size_t c = 0; c < p.nodes.size(); ++c) {
+      const auto& n = p.nodes[c];
+      if (n.parent == kNoParent || static_cast<std::int32_t>(c) == o.node ||
+          (o.node != kNoParent && n.parent == o.node))
+        continue;
+      const auto& q = p.nodes[static_cast<std::size_t>(n.parent)];
+      if (capsule_meets_box(glm::dvec3(q.position), glm::dvec3(n.position), std::max({q.radius, n.radius, 1e-4f}), box))
+        return true;
+    }
+    return false;
+  };
+  auto triangles_meet = [&](const Organ& a, const Organ& b) {
+    const auto &ma = shapes.of(a).mesh, &mb = shapes.of(b).mesh;
+    for (const auto& t : ma.triangles)
+      for (const auto& u : mb.triangles) {
+        const glm::vec3 ta[3] = {organ_point(a, ma.vertices[t.x]), organ_point(a, ma.vertices[t.y]),
+                                 organ_point(a, ma.vertices[t.z])};
+        const glm::vec3 tb[3] = {organ_point(b, mb.vertices[u.x]), organ_point(b, mb.vertices[u.y]),
+                                 organ_point(b, mb.vertices[u.z])};
+        if (geom::triangles_overlap(ta, tb)) return true;
+      }
+    return false;
+  };
+  PlacementCounts counts;
+  std::vector<Organ> kept;
+  for (const Organ& grown : p.organs) {
+    std::vector<Organ> candidates{grown};
+    if (const auto f = fallback(grown)) candidates.push_back(*f);
+    bool fitted = false;
+    for (std::size_t v = 0; v < candidates.size() && !fitted; ++v) {
+      const Organ& o = candidates[v];
+      if (branch_blocks(o)) {
+        ++blocked;
+        continue;
+      }
+      const OrientedBox box = organ_box(o, shapes.of(o));
+      fitted = std::none_of(kept.begin(), kept.end(), [&](const Organ& k) {
+        return boxes_overlap(box, organ_box(k, shapes.of(k))) && triangles_meet(o, k);
+      });
+      if (!fitted) continue;
+      kept.push_back(o);
+      ++(v == 0 ? counts.placed : counts.fallen_back);
+    }
+    if (!fitted) ++counts.dropped;
+  }
+  p.organs = std::move(kept);
+  return counts;
+}
+
+// Shoots of nodes wandering through a small cube, with leaves, young leaves, flowers and buds of sizes
+// a factor of six apart on the nodes and between them, so that organs meet each other and branches.
+Plant cluster(std::size_t organs) {
+  Plant p;
+  Rng rng(5, 2);
+  for (int s = 0; s < 8; ++s) {
+    glm::vec3 at(rng.uniform(0, 0.5), rng.uniform(0, 0.5), rng.uniform(0, 0.5));
+    std::int32_t parent = kNoParent;
+    for (int k = 0; k < 12; ++k) {
+      p.nodes.push_back(
+          {at, static_cast<float>(rng.uniform(0.002, 0.01)), parent, 0, static_cast<std::uint32_t>(s), 0});
+      parent = static_cast<std::int32_t>(p.nodes.size() - 1);
+      at += 0.06f * rng.unit_vector();
+    }
+  }
+  constexpr OrganKind kinds[] = {OrganKind::Leaf, OrganKind::YoungLeaf, OrganKind::Flower, OrganKind::Bud};
+  for (std::size_t i = 0; i < organs; ++i) {
+    const auto node = static_cast<std::int32_t>(rng.next_u64() % p.nodes.size());
+    const bool on_node = i % 3 != 0;  // the others float free, with no stem
+    const glm::vec3 at = on_node ? p.nodes[static_cast<std::size_t>(node)].position
+                                 : glm::vec3(rng.uniform(0, 0.5), rng.uniform(0, 0.5), rng.uniform(0, 0.5));
+    const glm::quat q =
+        glm::normalize(glm::quat(static_cast<float>(rng.uniform(-1, 1)), static_cast<float>(rng.uniform(-1, 1)),
+                                 static_cast<float>(rng.uniform(-1, 1)), static_cast<float>(rng.uniform(-1, 1))));
+    Organ o = organ_at(at, static_cast<float>(rng.uniform(0.02, 0.12)), kinds[rng.next_u64() % 4], q);
+    o.node = on_node ? node : kNoParent;
+    p.organs.push_back(o);
+  }
+  return p;
+}
+
+TEST(OrganPlacement, DecidesAsTheBruteForceDefinitionForAnyThreadCount) {
+  const Plant grown = cluster(400);
+  for (const auto& set :
+       {std::vector<std::string>{"placement=avoid"},
+        {"placement=avoid", "fallback_leaf=0.3", "fallback_flower=half_bloom", "fallback_bud=bud:width=0.15"}}) {
+    SCOPED_TRACE(set.back());
+    const OrganOptions opt = options(set);
+    Plant reference = grown;
+    std::size_t blocked = 0;
+    const PlacementCounts want = reference_placement(reference, opt, blocked);
+    // The cluster exercises every outcome, and branches turn some candidates away.
+    EXPECT_GT(want.placed, 50u);
+    EXPECT_GT(want.fallen_back, 10u);
+    EXPECT_GT(want.dropped, 10u);
+    EXPECT_GT(blocked, 10u);
+    for (const int threads : {1, 2}) {
+      tbb::global_control gc(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+      Plant placed = grown;
+      const PlacementCounts got = place_organs(placed, opt);
+      EXPECT_EQ(got.placed, want.placed) << threads;
+      EXPECT_EQ(got.fallen_back, want.fallen_back) << threads;
+      EXPECT_EQ(got.dropped, want.dropped) << threads;
+      EXPECT_EQ(placed.organ_shapes, reference.organ_shapes) << threads;
+      EXPECT_EQ(placed.geometry_hash(), reference.geometry_hash()) << threads;
+    }
+  }
+}
+
+TEST(OrganPlacement, AnEmptyPlantStaysEmpty) {
+  Plant p;
+  const PlacementCounts c = place_organs(p, options({"placement=avoid"}));
+  EXPECT_EQ(c.placed + c.fallen_back + c.dropped, 0u);
+  EXPECT_TRUE(p.organs.empty());
+  EXPECT_EQ(p.organ_shapes, std::vector<std::string>{"bud"});  // the flowers' fallback, named as always
 }
 
 TEST(OrganVariation, DrawsStayInTheirRangesAndRepeat) {
