@@ -77,16 +77,25 @@ def change_points(values, min_step=0.01):
     return sorted(found)
 
 
+def fail(message):
+    """Bad input: the message, and exit status 2 (growbench's contract; 1 would read as a regression)."""
+    print(f"history: error: {message}", file=sys.stderr)
+    sys.exit(2)
+
+
 def load(dir_):
     groups = {}
     for path in sorted(glob.glob(os.path.join(dir_, "*", "*", "*.json"))):
         try:
-            doc = json.load(open(path))
-        except (OSError, ValueError) as e:
-            sys.exit(f"{path}: not a history file ({e})")
-        if doc.get("kind") != "growbench-history":
-            sys.exit(f"{path}: not a history file (kind {doc.get('kind')!r})")
-        groups.setdefault((doc["machine"], doc["suite"]), []).append(doc)
+            with open(path, encoding="utf-8") as f:
+                doc = json.load(f)
+        except (OSError, ValueError, RecursionError) as e:
+            fail(f"{path}: not a history file ({e})")
+        if not isinstance(doc, dict) or doc.get("kind") != "growbench-history":
+            fail(f"{path}: not a history file (kind {doc.get('kind') if isinstance(doc, dict) else None!r})")
+        if not isinstance(doc.get("runs"), list):
+            fail(f"{path}: at runs: expected an array of runs")
+        groups.setdefault((doc.get("machine", ""), doc.get("suite", "")), []).append(doc)
     for docs in groups.values():
         docs.sort(key=lambda d: (d.get("commit_time") or 0, d["runs"][0].get("date", "") if d["runs"] else ""))
     return groups
@@ -137,7 +146,7 @@ def main():
 
     groups = load(a.dir)
     if not groups:
-        sys.exit(f"{a.dir}: no history files (MACHINE/SUITE/COMMIT.json); add runs with growbench history add")
+        fail(f"{a.dir}: no history files (MACHINE/SUITE/COMMIT.json); add runs with growbench history add")
     os.makedirs(a.out, exist_ok=True)
     report = {"min_step": a.min_step, "groups": []}
     body = []
@@ -209,4 +218,7 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except OSError as e:  # the output directory cannot be made or written (a file in the way, a full disk)
+        fail(f"{e.filename}: cannot write: {e.strerror}")

@@ -127,12 +127,16 @@ def validate(doc, path, schema=None):
 
 def load_results(path):
     try:
-        with open(path) as f:
+        with open(path, encoding="utf-8") as f:
             doc = json.load(f)
     except OSError as e:
         raise ReportError(f"{path}: cannot open: {e.strerror}")
     except json.JSONDecodeError as e:
         raise ReportError(f"{path}: not valid JSON: line {e.lineno} column {e.colno}: {e.msg}")
+    except UnicodeDecodeError as e:
+        raise ReportError(f"{path}: not valid JSON: byte {e.start} is not UTF-8 ({e.reason})")
+    except (ValueError, RecursionError) as e:  # a number beyond a float, nesting deeper than Python recurses
+        raise ReportError(f"{path}: not valid JSON: {e}")
     if not isinstance(doc, dict) or doc.get("kind") != "growbench-results" or "trials" not in doc:
         raise ReportError(f"{path}: not a growbench results file (expected kind 'growbench-results' and trials)")
     validate(doc, path)
@@ -695,6 +699,9 @@ def main(argv=None):
               f"in {args.out}", file=sys.stderr)
     except ReportError as e:
         print(f"report: error: {e}", file=sys.stderr)
+        return 2
+    except OSError as e:  # the output directory cannot be made or written (a file in the way, a full disk)
+        print(f"report: error: {e.filename or args.out}: cannot write: {e.strerror}", file=sys.stderr)
         return 2
     except ImportError as e:
         print(f"report: error: {e}; install Debian's python3-matplotlib, python3-numpy and python3-jsonschema (scripts/install-deps) "

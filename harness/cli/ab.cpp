@@ -21,12 +21,12 @@ struct AbArgs {
   std::vector<std::string> plugins;
 };
 
-int run_ab_suite(const AbArgs& a) {
+ExitStatus run_ab_suite(const AbArgs& a) {
   load_plugins(a.plugins);  // each side's trials load them again: their specs list every plugin loaded
   const Suite suite = load_suite(a.suite);
   const AbResult r = run_ab(suite, a.options);
   fmt::print("{}", r.table);
-  return r.regression ? 1 : 0;
+  return r.regression ? kExitRegression : kExitOk;
 }
 
 }  // namespace
@@ -48,12 +48,19 @@ Command add_ab(CLI::App& app) {
                   "side B loads this plugin file instead of --plugin's and the suite's (repeatable): A/B of two "
                   "builds of one plugin");
   cmd->add_option("-o,--out", o.out_dir, "output directory: ab.json and the trials (default: out/ab/SUITE)");
-  cmd->add_option("--effect", o.effect, "the smallest median ratio B/A to detect")->default_val(1.03);
-  cmd->add_option("--alpha", o.alpha, "significance level of the Mann-Whitney U test")->default_val(0.01);
-  cmd->add_option("--min-reps", o.min_repetitions, "pilot repetitions per side")->default_val(6);
+  cmd->add_option("--effect", o.effect, "the smallest median ratio B/A to detect")
+      ->default_val(1.03)
+      ->check(number_in(1, 100, true));
+  cmd->add_option("--alpha", o.alpha, "significance level of the Mann-Whitney U test")
+      ->default_val(0.01)
+      ->check(number_in(0, 1, true));
+  cmd->add_option("--min-reps", o.min_repetitions, "pilot repetitions per side")
+      ->default_val(6)
+      ->check(integer_in(3, 1000));
   cmd->add_option("--max-reps", o.max_repetitions,
                   "at most this many per side and batch; noisier cells are 'inconclusive'")
-      ->default_val(30);
+      ->default_val(30)
+      ->check(integer_in(3, 1000));
   cmd->add_option("--phases", o.phases, "phases whose wall and CPU time are compared")
       ->default_val(std::vector<std::string>{"growth"})
       ->delimiter(',');

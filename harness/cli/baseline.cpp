@@ -10,6 +10,7 @@
 #include "harness/cli/command.hpp"
 #include "harness/gate/compare.hpp"
 #include "harness/record/files.hpp"
+#include "harness/record/record.hpp"
 
 namespace growbench::cli {
 
@@ -19,27 +20,25 @@ struct BaselineArgs {
   std::string results, file = "reports/baselines/quick.json";
 };
 
-int update_baseline(const BaselineArgs& a) {
-  const auto results = read_results_file(a.results);
-  if (results.value("mode", "") != "instructions")
+ExitStatus update_baseline(const BaselineArgs& a) {
+  const ResultsFile results = read_results(a.results);
+  if (results.mode != "instructions")
     fmt::print(stderr,
                "growbench: warning: {} was not run with --instructions: the baseline will hold no instruction "
                "counts\n",
                a.results);
-  const auto fresh = baseline_of(results);
+  const Baseline fresh = baseline_of(results);
   if (std::filesystem::exists(a.file)) {
-    const auto r = compare_results(read_results_file(a.file), fresh, {});
+    const auto r = compare_results(read_gate_file(a.file), fresh, {});
     fmt::print(
         "changes accepted into {}:\n{}", a.file,
         r.changes.empty() && r.missing_cells.empty() && r.new_cells.empty() ? std::string("(none)\n") : r.table());
   } else {
-    fmt::print("new baseline {} with {} cells\n", a.file, fresh["trials"].size());
+    fmt::print("new baseline {} with {} cells\n", a.file, fresh.trials.size());
   }
-  std::filesystem::create_directories(std::filesystem::path(a.file).parent_path().empty()
-                                          ? std::filesystem::path(".")
-                                          : std::filesystem::path(a.file).parent_path());
-  write_file_atomic(a.file, fresh.dump(1) + "\n");
-  return 0;
+  make_directories(std::filesystem::path(a.file).parent_path().string());
+  write_file_atomic(a.file, json_text(to_json(fresh), 1));
+  return kExitOk;
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 namespace CLI {
 class App;
 class Option;
+class Validator;
 }  // namespace CLI
 
 namespace growbench {
@@ -20,11 +21,32 @@ enum class RenderQuality;
 
 namespace growbench::cli {
 
+// The exit-status contract (README, "Exit status"). main is the one place that maps exceptions to it: an
+// InputError or a command-line error is kExitBadInput, any other exception kExitInternalError.
+enum ExitStatus : int {
+  kExitOk = 0,
+  kExitRegression = 1,     // compare or ab found a regression; nothing else exits 1
+  kExitBadInput = 2,       // bad input or usage, or an output path that cannot be written
+  kExitInternalError = 3,  // a bug: an unexpected exception, or a tool growbench runs failing on its own files
+};
+
 struct Command {
   CLI::App* app = nullptr;  // the subcommand: true when it was chosen
-  // Its exit status. Bad input throws InputError (main exits 2), any other failure another exception (1).
-  std::function<int()> run;
+  // Its exit status; a failure throws instead (InputError for bad input, anything else is a bug).
+  std::function<ExitStatus()> run;
 };
+
+// Checks for numeric options (->check(...)): a value outside is refused before anything runs, with the
+// option's name, the range it takes and what was given ("--voxel-size: expected a finite number in [1e-06,
+// 1e+06], got 'nan'"), instead of being replaced by another. number_in takes finite numbers from lo (or
+// just above it, when lo_open) to hi. integer_in takes whole numbers in [lo, hi]: an unsigned option's
+// "-1", which CLI11 would wrap around to the largest value, is refused.
+CLI::Validator number_in(double lo, double hi, bool lo_open = false);
+CLI::Validator integer_in(long long lo, unsigned long long hi);
+
+// A Python script's exit status (reports/report.py, reports/history.py) under the contract: 0, and 2 for
+// bad input, whose message the script printed; anything else (a traceback, a signal) is a bug, said so.
+ExitStatus script_status(int status, const std::string& script);
 
 // Adds --plugin PATH (repeatable), bound to `paths`, to a command that looks algorithms up. The command
 // loads them (algorithms/plugins/loader.hpp's load_plugins, which adds GROWBENCH_PLUGIN_PATH's) first

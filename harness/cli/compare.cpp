@@ -17,10 +17,13 @@ struct CompareArgs {
   CompareOptions options;
 };
 
-int compare_files(const CompareArgs& a) {
-  const auto r = compare_results(read_results_file(a.base), read_results_file(a.fresh), a.options);
+ExitStatus compare_files(const CompareArgs& a) {
+  // Both files are read before anything is compared: a file that cannot be read is bad input (2), never a
+  // regression (1).
+  const GateFile base = read_gate_file(a.base), fresh = read_gate_file(a.fresh);
+  const auto r = compare_results(base, fresh, a.options);
   fmt::print("{}", r.table());
-  return r.fails() ? 1 : 0;
+  return r.fails() ? kExitRegression : kExitOk;
 }
 
 }  // namespace
@@ -35,10 +38,12 @@ Command add_compare(CLI::App& app) {
   cmd->add_option("new", a->fresh, "the new results.json")->required();
   cmd->add_option("--threshold", a->options.instructions_threshold,
                   "fail when a phase's instruction count rises by more than this fraction")
-      ->default_val(0.02);
+      ->default_val(0.02)
+      ->check(number_in(0, 1e6));
   cmd->add_option("--floor", a->options.instructions_floor,
                   "... and by more than this many instructions (tiny phases move with the heap layout)")
-      ->default_val(1e5);
+      ->default_val(1e5)
+      ->check(number_in(0, 1e18));
   return {cmd, [a] { return compare_files(*a); }};
 }
 

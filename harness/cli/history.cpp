@@ -34,9 +34,9 @@ Command add_history(CLI::App& app) {
   return {cmd, [a, add] {
             if (*add) {
               fmt::print("appended to {}\n", history_add(a->results, a->dir, a->machine));
-              return 0;
+              return kExitOk;
             }
-            return history_plot(a->dir, a->out);
+            return script_status(history_plot(a->dir, a->out), "reports/history.py");
           }};
 }
 

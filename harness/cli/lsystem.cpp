@@ -30,10 +30,10 @@ struct LsystemArgs {
   std::size_t limit = 0;
 };
 
-int derive(const LsystemArgs& a) {
+ExitStatus derive(const LsystemArgs& a) {
   if (a.examples) {
     for (const auto& name : lsystem_examples()) fmt::print("{}\n", name);
-    return 0;
+    return kExitOk;
   }
   Params params = default_params(find_algorithm("lsystem"));
   if (!a.file.empty()) params.set("grammar", a.file);
@@ -56,7 +56,7 @@ int derive(const LsystemArgs& a) {
   fmt::print(stderr, "generation {}: {} modules, {} parameters, {:.1f} MiB, derived in {:.3f} s\n", d.generations,
              d.modules, d.params, d.bytes / (1024.0 * 1024.0), secs);
   for (const auto& [c, n] : d.counts) fmt::print(stderr, "  {}  {}\n", c, n);
-  return 0;
+  return kExitOk;
 }
 
 }  // namespace
@@ -68,10 +68,12 @@ Command add_lsystem(CLI::App& app) {
   cmd->add_option("grammar", a->file, "a .lsys grammar file or an example name (see --examples)");
   cmd->add_option("-g,--generations", a->generations, "generations (default: the grammar's)");
   cmd->add_option("--set", a->sets, "L-system parameter key=value (repeatable; see `growbench list`)");
-  cmd->add_option("--seed", a->seed, "random seed")->default_val(1);
+  cmd->add_option("--seed", a->seed, "random seed")->default_val(1)->check(integer_in(0, UINT64_MAX));
   cmd->add_option("--scene", a->scene, "scene for in() and the start point (default: none; in() is 0)");
   cmd->add_flag("-p,--print", a->print, "print the derived string");
-  cmd->add_option("--limit", a->limit, "print at most this many modules (0: all)")->default_val(0);
+  cmd->add_option("--limit", a->limit, "print at most this many modules (0: all)")
+      ->default_val(0)
+      ->check(integer_in(0, SIZE_MAX));
   cmd->add_flag("--examples", a->examples, "list the example grammars");
   return {cmd, [a] { return derive(*a); }};
 }

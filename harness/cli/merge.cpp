@@ -9,8 +9,8 @@
 #include <fmt/format.h>
 
 #include "harness/cli/command.hpp"
-#include "harness/gate/compare.hpp"
 #include "harness/record/files.hpp"
+#include "harness/record/record.hpp"
 #include "harness/suite/suite.hpp"
 
 namespace growbench::cli {
@@ -23,20 +23,18 @@ struct MergeArgs {
   bool mixed = false;
 };
 
-int merge_shards(const MergeArgs& a) {
-  std::vector<nlohmann::json> shards;
-  for (const auto& f : a.inputs) shards.push_back(read_results_file(f));
-  const auto merged = merge_results(shards, a.inputs, a.mixed);
-  const auto parent = std::filesystem::path(a.out).parent_path();
-  if (!parent.empty()) std::filesystem::create_directories(parent);
-  const std::string text = merged.dump(1) + "\n";
-  write_file_atomic(a.out, text.data(), text.size());
-  if (merged["context"].value("mixed_machines", false))
+ExitStatus merge_shards(const MergeArgs& a) {
+  std::vector<ResultsFile> shards;
+  for (const auto& f : a.inputs) shards.push_back(read_results(f));
+  const ResultsFile merged = merge_results(shards, a.inputs, a.mixed);
+  make_directories(std::filesystem::path(a.out).parent_path().string());
+  write_file_atomic(a.out, json_text(to_json(merged), 1));
+  if (merged.context.mixed_machines.value_or(false))
     fmt::print(
         stderr,
         "growbench: warning: the shards ran on different machines or builds; their timings are not comparable\n");
-  fmt::print("merged {} shards, {} cells, into {}\n", shards.size(), merged["trials"].size(), a.out);
-  return 0;
+  fmt::print("merged {} shards, {} cells, into {}\n", shards.size(), merged.trials.size(), a.out);
+  return kExitOk;
 }
 
 }  // namespace

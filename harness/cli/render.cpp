@@ -8,6 +8,7 @@
 
 #include "harness/cli/command.hpp"
 #include "harness/render/render_results.hpp"
+#include "harness/run/trial.hpp"
 
 namespace growbench::cli {
 
@@ -19,13 +20,15 @@ struct RenderArgs {
   RenderDirOptions options;
 };
 
-int render_dir(RenderArgs& a) {
+ExitStatus render_dir(RenderArgs& a) {
   apply_render_flags(a.flags, parse_render_quality(a.quality), a.options);
   const RenderSummary r = render_directory_record(a.dir, a.options);
   fmt::print("rendered {} images ({} failed, {} POV-Ray warnings) in {:.1f} s with {} POV-Ray processes at once\n",
              r.renders, r.failed, r.warnings, r.wall_s, r.jobs);
   if (r.grid) fmt::print("grid: {}\n", (std::filesystem::path(a.dir) / *r.grid).string());
-  return r.failed > 0 ? 1 : 0;
+  // A failed render is POV-Ray failing on the scene file growbench wrote (the record's message and the log
+  // say why): an internal error.
+  return r.failed > 0 ? kExitInternalError : kExitOk;
 }
 
 }  // namespace
@@ -40,9 +43,13 @@ Command add_render(CLI::App& app) {
                   "preview (480x360, no anti-aliasing) or paper (1600x1200, "
                   "anti-aliased, soft shadows, radiosity)")
       ->default_val("preview");
-  cmd->add_option("-j,--jobs", a->options.jobs, "POV-Ray processes at once (0: one per core)")->default_val(0);
-  cmd->add_option("--width", ro.width, "image width (0: the quality's)")->default_val(0);
-  cmd->add_option("--height", ro.height, "image height (0: the quality's)")->default_val(0);
+  cmd->add_option("-j,--jobs", a->options.jobs, "POV-Ray processes at once (0: one per core)")
+      ->default_val(0)
+      ->check(integer_in(0, kMaxThreads));
+  cmd->add_option("--width", ro.width, "image width (0: the quality's)")->default_val(0)->check(integer_in(0, 16384));
+  cmd->add_option("--height", ro.height, "image height (0: the quality's)")
+      ->default_val(0)
+      ->check(integer_in(0, 16384));
   cmd->add_option("--branches", ro.branches,
                   "branches as cones (cone and sphere chains) or mesh "
                   "(the mesher's tubes as mesh2)")

@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include "harness/cli/command.hpp"
+#include "harness/record/record.hpp"
 #include "harness/report/report.hpp"
 
 namespace growbench::cli {
@@ -16,9 +17,12 @@ struct ReportArgs {
   std::string results, out;
 };
 
-int report(ReportArgs& a) {
+ExitStatus report(ReportArgs& a) {
   if (a.out.empty()) a.out = (std::filesystem::path(a.results).parent_path() / "report").string();
-  return run_report(a.results, a.out, {});
+  // Read first as the typed record: a file that does not fit is refused here with its JSON path, before
+  // Python starts.
+  (void)read_results(a.results);
+  return script_status(run_report(a.results, a.out, {}), "reports/report.py");
 }
 
 }  // namespace

@@ -2,6 +2,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <climits>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -76,8 +78,9 @@ std::string camera_note(const RenderRecord& rr) {
                      rr.scene_extent.value_or(0.0));
 }
 
-// Renders the run directory and reports what the record says of it: 1 when the render failed.
-int render_run(const std::string& out_dir, const RenderDirOptions& ro) {
+// Renders the run directory and reports what the record says of it. A render that failed is POV-Ray failing
+// on the scene file growbench wrote (its log says why): an internal error.
+ExitStatus render_run(const std::string& out_dir, const RenderDirOptions& ro) {
   const RenderQuality quality = ro.render.quality;
   const RenderSummary r = render_directory_record(out_dir, ro);
   const std::string record_path = (std::filesystem::path(out_dir) / "record.json").string();
@@ -94,10 +97,10 @@ int render_run(const std::string& out_dir, const RenderDirOptions& ro) {
                ro.turntable > 0 ? video(updated.turntable, "turntable") : "");
   else
     fmt::print(stderr, "growbench: render failed: {}\n", rr.message.value_or(rr.status));
-  return r.failed > 0 ? 1 : 0;
+  return r.failed > 0 ? kExitInternalError : kExitOk;
 }
 
-int run_one(RunArgs& a) {
+ExitStatus run_one(RunArgs& a) {
   TrialSpec& spec = a.spec;
   for (const auto& s : a.seed_at) spec.seed_at.push_back(parse_point(s));
   if (a.out_dir.empty()) a.out_dir = default_out_dir(spec);
@@ -122,7 +125,7 @@ int run_one(RunArgs& a) {
   const TrialRecord rec = run_trial_record(spec, progress);
   if (!a.quiet && isatty(STDERR_FILENO)) fmt::print(stderr, "\r{:60}\r", "");
   print_record(rec, spec, a.out_dir);
-  return render ? render_run(a.out_dir, *render) : 0;
+  return render ? render_run(a.out_dir, *render) : kExitOk;
 }
 
 }  // namespace
@@ -138,16 +141,22 @@ Command add_run(CLI::App& app) {
          "for a bundled mesh (e.g. mesh:stanford-bunny)")
       ->required();
   run->add_option("--scene-param", spec.scene_params, "scene parameter key=value (repeatable)");
-  run->add_option("--seed", spec.seed, "random seed")->default_val(1);
+  run->add_option("--seed", spec.seed, "random seed")->default_val(1)->check(integer_in(0, UINT64_MAX));
   run->add_option("--set", spec.params, "algorithm parameter key=value (repeatable)");
   add_plugin_option(run, spec.plugins);
   run->add_option("--seed-at", a->seed_at,
                   "seed position X,Y,Z, snapped to the nearest surface (repeatable; replaces the scene's seeds)");
-  run->add_option("--max-steps", spec.max_steps, "step cap")->default_val(5000);
-  run->add_option("--time-limit", spec.time_limit_s, "stop growing after this many seconds (0: none)")->default_val(0);
-  run->add_option("-j,--threads", spec.threads, "worker threads (0: all cores)")->default_val(0);
-  run->add_option("--voxel-size", spec.voxel_size, "distance-field voxel size in metres (0: scene diagonal / 256)")
-      ->default_val(0);
+  run->add_option("--max-steps", spec.max_steps, "step cap")->default_val(5000)->check(integer_in(0, INT_MAX));
+  run->add_option("--time-limit", spec.time_limit_s, "stop growing after this many seconds (0: none)")
+      ->default_val(0)
+      ->check(number_in(0, kMaxTimeLimitS));
+  run->add_option("-j,--threads", spec.threads, "worker threads (0: all cores)")
+      ->default_val(0)
+      ->check(integer_in(0, kMaxThreads));
+  // No default: absent, the scene query picks its own (SceneQueryOptions); given, it must be a size.
+  run->add_option("--voxel-size", spec.voxel_size,
+                  "distance-field voxel size in metres (default: scene diagonal / 256)")
+      ->check(number_in(kMinVoxelSize, kMaxVoxelSize));
   run->add_option("--sides", spec.mesher.sides, "tube sides of the branch mesh (3..64)")
       ->default_val(6)
       ->check(CLI::Range(3, 64));
@@ -166,7 +175,10 @@ Command add_run(CLI::App& app) {
   run->add_option("--frames", spec.frame_every,
                   "growth animation: keep the plant every K steps (frames/); with --render, render them and make "
                   "animation.mp4 with ffmpeg")
-      ->default_val(0);
+      ->default_val(0)
+      ->check(integer_in(0, INT_MAX));
+  // Test hook, not listed: fault=throw is an unexpected exception, which must exit 3 (README, "Exit status").
+  run->add_option("--fault", spec.fault, "inject a fault into the trial (tests)")->group("");
   return {run, [a] { return run_one(*a); }};
 }
 

@@ -10,7 +10,7 @@ namespace growbench::cli {
 
 namespace {
 
-int list_scenes() {
+ExitStatus list_scenes() {
   for (const auto& s : standard_scenes()) {
     fmt::print("{}\n  {}\n", s.name, s.summary);
     print_param_table(s.params);
@@ -24,7 +24,7 @@ int list_scenes() {
   fmt::print(
       "FILE.json\n  a scene file (schema_version 1): meshes, seeds, light, envelope, zones, camera; see "
       "scenes/README.md\n");
-  return 0;
+  return kExitOk;
 }
 
 }  // namespace

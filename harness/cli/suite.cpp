@@ -53,7 +53,7 @@ void render_suite(const std::string& results_path, const RenderDirOptions& ro) {
              (std::filesystem::path(results_path).parent_path() / r.grid.value_or("")).string());
 }
 
-int run_suite_file(const SuiteArgs& a) {
+ExitStatus run_suite_file(const SuiteArgs& a) {
   // First, while this process is small: the launcher that forks the trials (harness/run/process.hpp).
   std::unique_ptr<Launcher> launcher;
   if (!a.instructions) launcher = start_trial_launcher();
@@ -84,7 +84,7 @@ int run_suite_file(const SuiteArgs& a) {
   fmt::print("\nwrote {} and results.csv beside it\n", path);
   if (!a.history.empty()) fmt::print("history: appended to {}\n", history_add(path, a.history));
   if (render) render_suite(path, *render);
-  return 0;
+  return kExitOk;
 }
 
 }  // namespace

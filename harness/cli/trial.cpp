@@ -16,10 +16,12 @@ struct TrialArgs {
   std::string spec_file, fault;
 };
 
-int run_spec(const TrialArgs& a) {
+ExitStatus run_spec(const TrialArgs& a) {
   TrialSpec ts = read_trial_spec(a.spec_file);  // errors name the spec file and the JSON path
   if (!a.fault.empty()) ts.fault = a.fault;
-  return run_trial_child(ts, ts.out_dir);
+  // Not the command line's contract: the statuses a trial's process reports to the suite or ab that ran it
+  // (suite.hpp's run_trial_child).
+  return static_cast<ExitStatus>(run_trial_child(ts, ts.out_dir));
 }
 
 }  // namespace

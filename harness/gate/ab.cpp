@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <map>
 
@@ -83,8 +84,10 @@ void check_options(const AbOptions& o) {
   for (const auto& b : {o.a_binary, o.b_binary})
     if (access(b.c_str(), X_OK) != 0)
       throw InputError(fmt::format("ab: '{}' is not an executable growbench binary", b));
-  if (o.effect <= 1.0) throw InputError(fmt::format("ab: --effect must be above 1, got {}", o.effect));
-  if (o.alpha <= 0.0 || o.alpha >= 1.0) throw InputError(fmt::format("ab: --alpha must be in (0, 1), got {}", o.alpha));
+  if (!(o.effect > 1.0 && std::isfinite(o.effect)))  // written so that NaN fails too
+    throw InputError(fmt::format("ab: --effect must be a finite number above 1, got {}", o.effect));
+  if (!(o.alpha > 0.0 && o.alpha < 1.0))
+    throw InputError(fmt::format("ab: --alpha must be in (0, 1), got {}", o.alpha));
   if (o.min_repetitions < 3 || o.max_repetitions < o.min_repetitions)
     throw InputError(
         fmt::format("ab: expected 3 <= --min-reps <= --max-reps, got {} and {}", o.min_repetitions, o.max_repetitions));
@@ -98,14 +101,13 @@ std::vector<Cell> make_cells(const Suite& suite, const fs::path& out, const std:
     cell.config = &c;
     cell.dir = out / "cells" / c.id;
     for (int s = 0; s < 2; ++s) {
-      fs::create_directories(cell.dir / kSides[s]);
+      make_directories((cell.dir / kSides[s]).string());
       json job = trial_job(c, (cell.dir / kSides[s]).string());
       if (s == 1 && !b_plugins.empty()) {
         job["plugins"] = json::array();
         for (const auto& p : b_plugins) job["plugins"].push_back(fs::absolute(p).lexically_normal().string());
       }
-      const std::string text = job.dump() + "\n";
-      write_file_atomic((cell.dir / kSides[s] / "spec.json").string(), text.data(), text.size());
+      write_file_atomic((cell.dir / kSides[s] / "spec.json").string(), json_text(job, -1));
     }
     cells.push_back(std::move(cell));
   }
@@ -354,7 +356,7 @@ json doc_of(Findings&& f, const Suite& suite, const AbOptions& o, const Binaries
 AbResult run_ab(const Suite& suite, const AbOptions& o) {
   check_options(o);
   const fs::path out = o.out_dir.empty() ? fs::path("out/ab") / suite.name : fs::path(o.out_dir);
-  fs::create_directories(out);
+  make_directories(out.string());
   const Binaries bins = {fs::absolute(o.a_binary).string(), fs::absolute(o.b_binary).string()};
   std::vector<Cell> cells = make_cells(suite, out, o.b_plugins);
 
@@ -374,8 +376,7 @@ AbResult run_ab(const Suite& suite, const AbOptions& o) {
   res.regression = f.regression;
   res.table = table_of(f, bins, trials.trials_run(), o);
   res.doc = doc_of(std::move(f), suite, o, bins, out, trials.trials_run());
-  const std::string text = res.doc.dump(1) + "\n";
-  write_file_atomic((out / "ab.json").string(), text.data(), text.size());
+  write_file_atomic((out / "ab.json").string(), json_text(res.doc, 1));
   return res;
 }
 

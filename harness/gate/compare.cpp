@@ -224,10 +224,11 @@ void compare_cell(const GateCell& gb, const GateCell& gn, const CompareOptions& 
 
 // A results or baseline document read as JSON from `source`.
 GateFile gate_file_from_json(const json& j, const std::string& source) {
-  const std::string kind = j.is_object() ? j.value("kind", "") : "";
-  if (kind == kBaselineKind) return from_json<Baseline>(j, source);
-  if (kind == kResultsKind) return from_json<ResultsFile>(j, source);
-  throw InputError(fmt::format("{}: not a growbench results or baseline file (kind '{}')", source, kind));
+  const json* kind = j.is_object() && j.contains("kind") ? &j["kind"] : nullptr;
+  if (kind && *kind == kBaselineKind) return baseline_from_json(j, source);
+  if (kind && *kind == kResultsKind) return results_from_json(j, source);
+  throw InputError(fmt::format("{}: not a growbench results or baseline file (kind {}, expected '{}' or '{}')", source,
+                               kind ? kind->dump() : "absent", kResultsKind, kBaselineKind));
 }
 
 }  // namespace
@@ -292,15 +293,6 @@ json baseline_of(const json& results) {
 
 GateFile read_gate_file(const std::string& path) {
   return gate_file_from_json(read_json_file(path), path);
-}
-
-json read_results_file(const std::string& path) {
-  const GateFile f = read_gate_file(path);
-  if (const auto* r = std::get_if<ResultsFile>(&f)) {
-    if (r->schema_version > kSchemaVersion) return to_json(read_results(path));  // refused there, with the reason
-    return to_json(*r);
-  }
-  return to_json(std::get<Baseline>(f));
 }
 
 }  // namespace growbench

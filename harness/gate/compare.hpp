@@ -69,10 +69,8 @@ Baseline baseline_of(const ResultsFile& results);
 BaselineCell baseline_cell_of(const SuiteCell& cell);
 nlohmann::json baseline_of(const nlohmann::json& results);
 
-// Reads a results or baseline file; InputError naming the file when it is neither, and naming the JSON path
-// of a field that does not fit.
+// Reads a results or baseline file; InputError naming the file when it is neither or of a newer schema, and
+// naming the JSON path of a field that does not fit.
 GateFile read_gate_file(const std::string& path);
-// The same as JSON (to_json of what read_gate_file read), for callers that still work on JSON.
-nlohmann::json read_results_file(const std::string& path);
 
 }  // namespace growbench

@@ -95,13 +95,27 @@ std::string history_add(const std::string& results_path, const std::string& dir,
     doc.suite = suite;
   }
   doc.runs.push_back(history_entry(results));
-  fs::create_directories(file.parent_path());
+  make_directories(file.parent_path().string());
   write_file_atomic(file.string(), json_text(to_json(doc), 1));
   return file.string();
 }
 
 int history_plot(const std::string& dir, const std::string& out) {
   if (!fs::is_directory(dir)) throw InputError(fmt::format("{}: no such history directory", dir));
+  // Every file history.py will read (DIR/MACHINE/SUITE/COMMIT.json) is read first as the typed record: one
+  // that does not fit is refused here, naming its JSON path.
+  bool any = false;
+  std::error_code ec;
+  for (const auto& machine : fs::directory_iterator(dir, ec))
+    for (const auto& suite : fs::directory_iterator(machine.path(), ec))
+      for (const auto& f : fs::directory_iterator(suite.path(), ec))
+        if (f.path().extension() == ".json") {
+          (void)read_history_file(f.path().string());
+          any = true;
+        }
+  if (!any)
+    throw InputError(
+        fmt::format("{}: no history files (MACHINE/SUITE/COMMIT.json); add runs with growbench history add", dir));
   return run_reports_script("history.py", {dir, "--out", out});
 }
 

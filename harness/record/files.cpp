@@ -1,19 +1,48 @@
 #include "harness/record/files.hpp"
 
+#include <sys/stat.h>
+
 #include <cctype>
+#include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
+#include "core/errors.hpp"
 #include "core/json_util.hpp"
 
 namespace growbench {
 
+namespace {
+
+// Whether `path` exists and is something other than a regular file; InputError for a directory.
+bool is_special_file(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return false;  // absent (or unreachable: opening says why)
+  if (S_ISDIR(st.st_mode)) throw InputError(fmt::format("{}: is a directory, expected a file to write", path));
+  return !S_ISREG(st.st_mode);
+}
+
+}  // namespace
+
 AtomicFile::AtomicFile(std::string path)
-    : path_(std::move(path)), tmp_(path_ + ".tmp"), f_(std::fopen(tmp_.c_str(), "wb"), &std::fclose) {
-  if (!f_) throw std::runtime_error(fmt::format("{}: cannot open for writing", tmp_));
+    : path_(std::move(path)), tmp_(is_special_file(path_) ? path_ : path_ + ".tmp"), f_(nullptr, &std::fclose) {
+  f_.reset(std::fopen(tmp_.c_str(), "wb"));
+  if (!f_) throw InputError(fmt::format("{}: cannot open for writing: {}", path_, std::strerror(errno)));
+}
+
+AtomicFile::~AtomicFile() {
+  if (!f_) return;  // finished, or failed after closing
+  f_.reset();
+  if (tmp_ != path_) std::remove(tmp_.c_str());
+}
+
+void AtomicFile::fail(const char* what) const {
+  throw InputError(fmt::format("{}: cannot {}: {}", path_, what, std::strerror(errno)));
 }
 
 void AtomicFile::bytes(const void* p, std::size_t n) {
@@ -25,8 +54,14 @@ void AtomicFile::bytes(const void* p, std::size_t n) {
 
 std::uint64_t AtomicFile::finish() {
   flush();
-  if (std::fclose(f_.release()) != 0) throw std::runtime_error(fmt::format("{}: write failed", tmp_));
-  rename_into_place(tmp_, path_);
+  // stdio's own buffer is written out here: a device that takes nothing (/dev/full) fails now, not before.
+  if (std::fflush(f_.get()) != 0) fail("write");
+  const int closed = std::fclose(f_.release());
+  if (closed != 0) {
+    if (tmp_ != path_) std::remove(tmp_.c_str());
+    fail("write");
+  }
+  if (tmp_ != path_) rename_into_place(tmp_, path_);
   return total_;
 }
 
@@ -36,8 +71,25 @@ void AtomicFile::flush() {
 }
 
 void AtomicFile::write(const void* p, std::size_t n) {
-  if (n > 0 && std::fwrite(p, 1, n, f_.get()) != n) throw std::runtime_error(fmt::format("{}: write failed", tmp_));
+  if (n > 0 && std::fwrite(p, 1, n, f_.get()) != n) fail("write");
   total_ += n;
+}
+
+void make_directories(const std::string& path) {
+  std::error_code ec;
+  if (path.empty() || std::filesystem::is_directory(path, ec)) return;
+  std::filesystem::create_directories(path, ec);
+  if (ec) throw InputError(fmt::format("{}: cannot create the directory: {}", path, ec.message()));
+}
+
+void append_to_file(const std::string& path, std::string_view text) {
+  std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(path.c_str(), "ab"), &std::fclose);
+  auto fail = [&](const char* what) {
+    throw InputError(fmt::format("{}: cannot {}: {}", path, what, std::strerror(errno)));
+  };
+  if (!f) fail("open for appending");
+  if (std::fwrite(text.data(), 1, text.size(), f.get()) != text.size() || std::fflush(f.get()) != 0) fail("write");
+  if (std::fclose(f.release()) != 0) fail("write");
 }
 
 std::uint64_t write_file_atomic(const std::string& path, const char* data, std::size_t size) {
@@ -49,7 +101,10 @@ std::uint64_t write_file_atomic(const std::string& path, const char* data, std::
 void rename_into_place(const std::string& tmp, const std::string& path) {
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);
-  if (ec) throw std::runtime_error(fmt::format("{}: cannot rename into place: {}", path, ec.message()));
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw InputError(fmt::format("{}: cannot rename into place: {}", path, ec.message()));
+  }
 }
 
 std::string safe_name(std::string s) {
@@ -59,8 +114,45 @@ std::string safe_name(std::string s) {
   return s;
 }
 
+std::string read_input_file(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (fs::is_directory(st)) throw InputError(fmt::format("{}: is a directory, expected a file", path));
+  // A device never ends (/dev/zero) or gives nothing (/dev/null); a pipe (/dev/stdin) is read.
+  if (fs::is_character_file(st) || fs::is_block_file(st))
+    throw InputError(fmt::format("{}: is a device, expected a file", path));
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(fmt::format("{}: cannot open: {}", path, std::strerror(errno)));
+  std::ostringstream text;
+  try {
+    text << in.rdbuf();
+  } catch (const std::ios_base::failure& e) {  // libstdc++'s filebuf throws on a read error
+    throw InputError(fmt::format("{}: cannot read: {}", path, e.code().message()));
+  }
+  if (in.bad()) throw InputError(fmt::format("{}: cannot read", path));
+  return text.str();
+}
+
+nlohmann::json parse_input_json(const std::string& path, const std::string& text) {
+  // Syntax errors are InputErrors already. What else the parser throws is nlohmann's number overflow
+  // (406), which gives no position but quotes the number.
+  auto message = [](const nlohmann::json::exception& e) {
+    const std::string msg = e.what();
+    const auto p = msg.find("] ");
+    return p == std::string::npos ? msg : msg.substr(p + 2);
+  };
+  try {
+    return parse_json_file_text(path, text);
+  } catch (const nlohmann::json::out_of_range& e) {
+    throw InputError(fmt::format("{}: invalid JSON: {}; expected a number within a double's range", path, message(e)));
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(fmt::format("{}: invalid JSON: {}", path, message(e)));
+  }
+}
+
 nlohmann::json read_json_file(const std::string& path) {
-  return parse_json_file_text(path, read_text_file(path));
+  return parse_input_json(path, read_input_file(path));
 }
 
 }  // namespace growbench

@@ -1,6 +1,9 @@
 // Files the harness writes and reads: every output is written atomically (PATH.tmp renamed into place), so an
 // interrupted run leaves either the old file or the new one, never half of one; names built from user text
 // are made safe for paths; and JSON files are read with errors that name the file, line and column.
+//
+// Where output goes is the user's choice, so a path that cannot be written (a directory, a missing folder,
+// a full disk, /dev/full) is an InputError naming it and why: never a success that wrote nothing.
 #pragma once
 
 #include <array>
@@ -16,24 +19,38 @@ namespace growbench {
 
 // A file written atomically through a fixed 64 KiB buffer. A buffer the size of the file would be fresh
 // memory, whose page faults on a virtual machine cost more than the writing. Nothing appears at PATH until
-// finish(); a writer destroyed before finish() leaves PATH untouched (the .tmp file stays behind).
+// finish(); a writer destroyed before finish() leaves PATH untouched and removes its .tmp file. A PATH that
+// exists and is not a regular file (a device such as /dev/null, a pipe) is written directly, as there is
+// nothing to replace; a directory is refused. Every write, the flush and the close are checked: a failure
+// is an InputError "PATH: cannot write: REASON".
 class AtomicFile {
  public:
   explicit AtomicFile(std::string path);
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+  ~AtomicFile();
   void bytes(const void* p, std::size_t n);
   std::uint64_t finish();  // flushes, closes and renames into place; returns the bytes written
 
  private:
   void flush();
   void write(const void* p, std::size_t n);
-  std::string path_, tmp_;
+  [[noreturn]] void fail(const char* what) const;
+  std::string path_, tmp_;  // tmp_ == path_ when written directly
   std::unique_ptr<FILE, int (*)(FILE*)> f_;
   std::array<char, 1 << 16> buf_;  // only the bytes written into it are read
   std::size_t used_ = 0;
   std::uint64_t total_ = 0;
 };
 
-// Writes `data` to `path` atomically; returns the bytes written. std::runtime_error naming the path on failure.
+// Creates the directory `path` and its parents (nothing when it exists); InputError "PATH: cannot create
+// the directory: REASON" when it cannot (a file in the way, no permission).
+void make_directories(const std::string& path);
+
+// Appends `text` to `path` (created if absent), flushed and closed; InputError "PATH: cannot write: REASON".
+void append_to_file(const std::string& path, std::string_view text);
+
+// Writes `data` to `path` atomically; returns the bytes written. InputError naming the path on failure.
 std::uint64_t write_file_atomic(const std::string& path, const char* data, std::size_t size);
 inline std::uint64_t write_file_atomic(const std::string& path, std::string_view text) {
   return write_file_atomic(path, text.data(), text.size());
@@ -46,7 +63,13 @@ void rename_into_place(const std::string& tmp, const std::string& path);
 // scene or sweep value.
 std::string safe_name(std::string s);
 
-// Reads and parses a JSON file: InputError "PATH: cannot open" or "PATH:LINE:COL: invalid JSON: ...".
+// The whole of an input file: InputError "PATH: cannot open: REASON", "PATH: is a directory, expected a
+// file" (or a device), or "PATH: cannot read: REASON". A pipe is read to its end.
+std::string read_input_file(const std::string& path);
+// Parses the JSON text of `path`: InputError "PATH:LINE:COL: invalid JSON: ..." for a syntax error, and
+// "PATH: invalid JSON: number overflow parsing '1e400' (...)" for a number beyond a double's range.
+nlohmann::json parse_input_json(const std::string& path, const std::string& text);
+// Both: reads and parses a JSON file.
 nlohmann::json read_json_file(const std::string& path);
 
 }  // namespace growbench

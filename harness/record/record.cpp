@@ -1,6 +1,9 @@
 #include "harness/record/record.hpp"
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <type_traits>
@@ -8,8 +11,8 @@
 #include <fmt/format.h>
 
 #include "core/errors.hpp"
-#include "core/json_util.hpp"
 #include "core/params.hpp"
+#include "harness/record/files.hpp"
 
 namespace growbench {
 using nlohmann::json;
@@ -1093,51 +1096,57 @@ GROWBENCH_RECORD_TYPE(HistoryFile)
 namespace {
 
 json parse_file(const std::string& path) {
-  return parse_json_file_text(path, read_text_file(path));
+  return read_json_file(path);
 }
 
-void check_version(int version, const std::string& path) {
-  if (version > kSchemaVersion)
+// Before the typed read, so that a newer file's new fields are not taken for mistakes.
+void check_version(const json& j, const std::string& path) {
+  const json* v = j.is_object() && j.contains("schema_version") ? &j["schema_version"] : nullptr;
+  if (v && v->is_number() && v->get<double>() > kSchemaVersion)
     throw InputError(fmt::format("{}: schema_version {} is newer than this growbench reads ({}); use a newer growbench",
-                                 path, version, kSchemaVersion));
+                                 path, v->dump(), kSchemaVersion));
 }
 
 void check_kind(const json& j, std::string_view kind, const std::string& path, const char* what) {
-  const std::string k =
-      j.is_object() && j.contains("kind") && j["kind"].is_string() ? j["kind"].get<std::string>() : "";
-  if (k != kind) throw InputError(fmt::format("{}: not a {} (kind '{}', expected '{}')", path, what, k, kind));
+  const json* k = j.is_object() && j.contains("kind") ? &j["kind"] : nullptr;
+  if (!k || *k != kind)
+    throw InputError(fmt::format("{}: not a {} (kind {}, expected '{}')", path, what,
+                                 k ? k->dump(-1, ' ', false, json::error_handler_t::replace) : "absent", kind));
 }
 
 }  // namespace
 
 TrialRecord read_trial_record(const std::string& path) {
-  auto r = from_json<TrialRecord>(parse_file(path), path);
-  check_version(r.schema_version, path);
-  return r;
+  const json j = parse_file(path);
+  check_version(j, path);
+  return from_json<TrialRecord>(j, path);
+}
+
+ResultsFile results_from_json(const json& j, const std::string& path) {
+  check_kind(j, kResultsKind, path, "growbench results file");
+  check_version(j, path);
+  return from_json<ResultsFile>(j, path);
 }
 
 ResultsFile read_results(const std::string& path) {
-  const json j = parse_file(path);
-  check_kind(j, kResultsKind, path, "growbench results file");
-  auto r = from_json<ResultsFile>(j, path);
-  check_version(r.schema_version, path);
-  return r;
+  return results_from_json(parse_file(path), path);
+}
+
+Baseline baseline_from_json(const json& j, const std::string& path) {
+  check_kind(j, kBaselineKind, path, "growbench baseline");
+  check_version(j, path);
+  return from_json<Baseline>(j, path);
 }
 
 Baseline read_baseline(const std::string& path) {
-  const json j = parse_file(path);
-  check_kind(j, kBaselineKind, path, "growbench baseline");
-  auto b = from_json<Baseline>(j, path);
-  check_version(b.schema_version, path);
-  return b;
+  return baseline_from_json(parse_file(path), path);
 }
 
 HistoryFile read_history_file(const std::string& path) {
   const json j = parse_file(path);
   check_kind(j, kHistoryKind, path, "growbench history file");
-  auto h = from_json<HistoryFile>(j, path);
-  check_version(h.schema_version, path);
-  return h;
+  check_version(j, path);
+  return from_json<HistoryFile>(j, path);
 }
 
 std::vector<JournalEntry> read_journal(const std::string& path) {
@@ -1157,8 +1166,49 @@ std::vector<JournalEntry> read_journal(const std::string& path) {
   return out;
 }
 
+std::string repair_journal(const std::string& path) {
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec || size == 0) return "";
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(fmt::format("{}: cannot open the journal: {}", path, std::strerror(errno)));
+  // The last line: read back from the end in blocks until a newline.
+  std::string tail;
+  std::uintmax_t start = size;
+  for (std::uintmax_t block = 4096; start > 0; block *= 2) {
+    const std::uintmax_t from = start > block ? start - block : 0;
+    std::string chunk(static_cast<std::size_t>(start - from), '\0');
+    in.seekg(static_cast<std::streamoff>(from));
+    if (!in.read(chunk.data(), static_cast<std::streamsize>(chunk.size())))
+      throw InputError(fmt::format("{}: cannot read the journal", path));
+    tail.insert(0, chunk);
+    start = from;
+    if (const auto nl = tail.rfind('\n'); nl != std::string::npos) {
+      if (nl + 1 == tail.size()) return "";  // ends with a newline: nothing torn
+      start += nl + 1;
+      tail.erase(0, nl + 1);
+      break;
+    }
+  }
+  in.close();
+  bool whole = false;
+  try {
+    (void)from_json<JournalEntry>(json::parse(tail), path);
+    whole = true;
+  } catch (const std::exception&) {
+  }
+  if (whole) {
+    append_to_file(path, "\n");
+    return "";
+  }
+  append_to_file(path + ".torn", tail + "\n");  // first, so that the bytes are kept whatever happens next
+  std::filesystem::resize_file(path, start, ec);
+  if (ec) throw InputError(fmt::format("{}: cannot cut off its torn last line: {}", path, ec.message()));
+  return tail;
+}
+
 std::string json_text(const json& j, int indent) {
-  return j.dump(indent) + "\n";
+  return j.dump(indent, ' ', false, json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace growbench

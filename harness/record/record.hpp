@@ -453,12 +453,22 @@ T from_json(const nlohmann::json& j, const std::string& source);
 TrialRecord read_trial_record(const std::string& path);
 ResultsFile read_results(const std::string& path);
 Baseline read_baseline(const std::string& path);
+// The same for a document already parsed from `path`.
+ResultsFile results_from_json(const nlohmann::json& j, const std::string& path);
+Baseline baseline_from_json(const nlohmann::json& j, const std::string& path);
 HistoryFile read_history_file(const std::string& path);
 // journal.jsonl, skipping lines that do not parse (a line cut short by a kill: its trial runs again).
 std::vector<JournalEntry> read_journal(const std::string& path);
+// Readies journal.jsonl for appending after an interruption, so that no append can glue onto a line cut
+// short. A last line without its newline is either a whole entry (killed just before the newline: the
+// newline is added) or torn: its bytes are appended to PATH.torn, for the record, and cut off the journal.
+// Returns the torn bytes ("" when there were none). InputError naming the file when it cannot be repaired.
+std::string repair_journal(const std::string& path);
 
 // The document as a file's text: one line of compact JSON (journal lines, a suite child's record) when
-// indent < 0, else indented.
+// indent < 0, else indented; a newline at the end. Strings holding invalid UTF-8 (a message quoting half of
+// a multi-byte character) are written with U+FFFD in place of each invalid byte instead of throwing, so a
+// record is never lost to its text. Every JSON file the harness writes goes through here.
 std::string json_text(const nlohmann::json& j, int indent);
 
 }  // namespace growbench

@@ -640,7 +640,7 @@ std::uint64_t write_pov_view(const std::string& path, const Scene& scene, const 
     write_organs(out, plant, o.mesher);
     write_polygons(out, plant);
   }
-  fs::create_directories(fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path());
+  make_directories(fs::path(path).parent_path().string());
   return write_file_atomic(path, b.data(), b.size());
 }
 

@@ -61,7 +61,8 @@ std::string cell_row(const SuiteCell& t, std::vector<std::string>& warnings) {
   const CellResults& r = t.results;
   const json m = r.metrics.value_or(json::object());
   auto metric = [&](const char* k) {
-    return m.contains(k) ? fmt::format("{:.3f}", m[k].get<double>()) : std::string("-");
+    // Metrics are open-ended in the file: a value that is not a number (a hand-edited file) shows as such.
+    return !m.contains(k) ? std::string("-") : m[k].is_number() ? fmt::format("{:.3f}", m[k].get<double>()) : "?";
   };
   std::string row = fmt::format(
       "{:<40} {:>6} {:>30} {:>10} {:>11} {:>8} {:>9} {:>10} {:>8} {:>8} {:>8}\n", cell.substr(0, 40), t.status, ci,

@@ -16,8 +16,10 @@
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <filesystem>
 #include <fstream>
+#include <new>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -28,6 +30,45 @@
 #include <fmt/format.h>
 
 namespace growbench {
+
+namespace {
+
+// What exit_on_escaped_bad_alloc set: kept ready, as the handler must not allocate.
+struct EscapedBadAlloc {
+  int status = 0;
+  std::string message, file;
+} g_escaped_bad_alloc;
+
+[[noreturn]] void terminate_handler() {
+  bool bad_alloc = false;
+  if (const std::exception_ptr e = std::current_exception()) {
+    try {
+      std::rethrow_exception(e);
+    } catch (const std::bad_alloc&) {
+      bad_alloc = true;
+    } catch (...) {
+    }
+  }
+  if (!bad_alloc) std::abort();
+  const EscapedBadAlloc& h = g_escaped_bad_alloc;
+  [[maybe_unused]] ssize_t n = write(STDERR_FILENO, h.message.data(), h.message.size());
+  n = write(STDERR_FILENO, "\n", 1);
+  if (!h.file.empty()) {
+    const int fd = open(h.file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd >= 0) {
+      n = write(fd, h.message.data(), h.message.size());
+      close(fd);
+    }
+  }
+  _exit(h.status);
+}
+
+}  // namespace
+
+void exit_on_escaped_bad_alloc(int status, const std::string& message, const std::string& file) {
+  g_escaped_bad_alloc = {status, message, file};
+  std::set_terminate(terminate_handler);
+}
 
 int process_thread_count() {
   std::ifstream in("/proc/self/status");

@@ -32,6 +32,12 @@ struct ChildResult {
 // Threads in this process (from /proc/self/status).
 int process_thread_count();
 
+// A std::bad_alloc that escapes where nothing can catch it (a noexcept function in a library, a library's
+// own thread) makes std::terminate abort the process: a crash that is really the memory limit. After this
+// call such a terminate writes `message` and a newline to stderr, and to `file` when it is not empty, and
+// exits with `status` instead; any other terminate still aborts.
+void exit_on_escaped_bad_alloc(int status, const std::string& message, const std::string& file = "");
+
 // Runs `body` in a forked child (stdout and stderr appended to `log_path` when given) and waits for it.
 // The child exits with body's return value (an escaping exception exits 70). Forking rather than exec'ing
 // keeps the launch to the fork and the child's first page faults and syscalls: exec'ing growbench would

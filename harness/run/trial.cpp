@@ -14,11 +14,14 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <new>
 #include <stdexcept>
+#include <string_view>
 #include <thread>
 #include <vector>
 
 #include <embree3/rtcore_config.h>
+#include <embree3/rtcore_device.h>
 #include <fmt/format.h>
 #include <openvdb/version.h>
 #include <tbb/global_control.h>
@@ -210,6 +213,13 @@ void inject_fault(const std::string& fault) {
 
 }  // namespace
 
+bool is_out_of_memory(const std::exception& e) {
+  if (dynamic_cast<const std::bad_alloc*>(&e)) return true;
+  const std::string_view what = e.what();
+  return what.rfind("Embree: ", 0) == 0 &&
+         what.find(fmt::format("(error {})", static_cast<int>(RTC_ERROR_OUT_OF_MEMORY))) != std::string_view::npos;
+}
+
 // The running binary's content hash: what identifies the build whose timings these are, whatever the
 // source tree's state is by the time it runs (a commit made while a sharded run is under way).
 std::string binary_hash() {
@@ -396,7 +406,7 @@ struct FrameCapture {
     const std::filesystem::path d = std::filesystem::path(spec.out_dir) / "frames";
     if (frames == 0) {
       std::filesystem::remove_all(d);
-      std::filesystem::create_directories(d);
+      make_directories(d.string());
     }
     const Plant& plant = algo.plant();
     // The frame's prefix keeps its images apart from the other frames' and from the run's own.
@@ -476,13 +486,13 @@ void mesh_export_measure(const TrialSpec& spec, const MesherOptions& mesher, Tri
   // The plant itself, for rendering later (`growbench render`); not an output format, not timed. Written
   // before the exports: after them, tens of MB of dirty pages can make the kernel throttle this write.
   if (!spec.out_dir.empty()) {
-    std::filesystem::create_directories(spec.out_dir);
+    make_directories(spec.out_dir);
     rec.snapshot_bytes = write_plant_snapshot((std::filesystem::path(spec.out_dir) / "plant.gbplant").string(), plant);
   }
   st.mesh = timer.run("meshing", rec.phases.meshing, [&] { return mesh_plant(plant, mesher); });
   timer.run("export", rec.phases.exporting, [&] {
     if (spec.out_dir.empty()) return;
-    std::filesystem::create_directories(spec.out_dir);
+    make_directories(spec.out_dir);
     const std::filesystem::path d(spec.out_dir);
     rec.output_bytes.obj = write_obj((d / "plant.obj").string(), st.mesh);
     rec.output_bytes.ply = write_ply((d / "plant.ply").string(), st.mesh);
@@ -556,8 +566,15 @@ TrialRecord run_trial_record(const TrialSpec& spec, const std::function<void(con
   st.algo = entry.make();
   grow(spec, params, st, timer, rec, progress);
   const Plant& plant = st.algo->plant();
-  if (const std::string bad = plant.validate(); !bad.empty())
+  if (const std::string bad = plant.validate(); !bad.empty()) {
+    // An L-system's grammar is a program in the input, whose arithmetic can divide by zero or overflow: its
+    // invalid plant is bad input. Any other algorithm's is a bug (its parameters are range-checked).
+    if (spec.algorithm == "lsystem")
+      throw InputError(fmt::format(
+          "L-system{}: the plant its rules drew is invalid ({}): an expression divided by zero or overflowed",
+          params.text("grammar").empty() ? "" : fmt::format(" grammar '{}'", params.text("grammar")), bad));
     throw std::logic_error(fmt::format("algorithm '{}' produced an invalid plant: {}", spec.algorithm, bad));
+  }
   organ_pass(spec, organ_options, organ_params, mesher, st, timer, rec);
   if (plant_out) *plant_out = st.styled ? *st.styled : plant;
   mesh_export_measure(spec, mesher, st, timer, rec);

@@ -16,6 +16,13 @@
 
 namespace growbench {
 
+// The ranges of a trial's numeric settings, checked where they are given (the command line, suite files).
+inline constexpr int kMaxThreads = 1024;
+inline constexpr double kMaxTimeLimitS = 1e9;  // a deadline in nanoseconds stays within 64 bits
+// Metres (a mesh scene with size=0: the file's units). Below a micrometre a float voxel size loses the
+// precision OpenVDB's transform needs, and no scene's distance field would fit in memory anyway.
+inline constexpr double kMinVoxelSize = 1e-6, kMaxVoxelSize = 1e6;
+
 struct TrialSpec {
   std::string algorithm;
   std::string scene;                      // standard name, *.json, or mesh:PATH
@@ -67,6 +74,10 @@ TrialRecord run_trial_record(const TrialSpec& spec, const std::function<void(con
 // The same record as JSON (to_json of the above).
 nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const Progress&)>& progress = {},
                          Plant* plant_out = nullptr);
+
+// Whether a failure is memory running out, whichever library noticed it: std::bad_alloc, or Embree's
+// RTC_ERROR_OUT_OF_MEMORY (as scenes/ reports an Embree error: "Embree: ... (error 4)").
+bool is_out_of_memory(const std::exception& e);
 
 // The build and machine this binary runs on (commit and dirty flag, compiler, flags, build type,
 // dependency versions, CPU model, cores, date).

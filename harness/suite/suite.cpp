@@ -40,7 +40,7 @@ using nlohmann::json;
 namespace {
 
 std::string read_text(const std::string& path) {
-  return read_text_file(path);
+  return read_input_file(path);
 }
 
 void write_atomic(const fs::path& path, const std::string& text) {
@@ -56,8 +56,16 @@ class SuiteReader : public JsonPathReader {
   explicit SuiteReader(const std::string& file) : JsonPathReader(file), dir_(fs::path(file).parent_path()) {}
   double number(const json& j, const std::string& path, double lo, double hi) const {
     if (!j.is_number() || j.get<double>() < lo || j.get<double>() > hi)
-      fail(path, fmt::format("expected a number in [{}, {}], got {}", lo, hi, j.dump()));
+      fail(path, fmt::format("expected a number in [{}, {}], got {}", lo, hi, json_text(j, -1).substr(0, 80)));
     return j.get<double>();
+  }
+  // The string at j[key] (j an object), or `fallback` when absent; `what` says what it is, for errors.
+  std::string string_field(const json& j, const std::string& path, const char* key, const std::string& fallback,
+                           const char* what) const {
+    if (!j.contains(key)) return fallback;
+    if (!j[key].is_string())
+      fail(fmt::format("{}/{}", path, key), fmt::format("expected {}, got {}", what, j[key].type_name()));
+    return j[key].get<std::string>();
   }
   // A path in a suite file, relative to the suite file.
   std::string relative_to_suite(const std::string& path) const {
@@ -74,7 +82,7 @@ class SuiteReader : public JsonPathReader {
 
   Suite read() const {
     const std::string text = read_text(file());
-    const json j = parse_json_file_text(file(), text);
+    const json j = parse_input_json(file(), text);
     only_keys(j, "",
               {"schema_version", "name", "description", "repetitions", "warmup", "threads", "timeout_s",
                "memory_limit_mb", "max_steps", "seeds", "budget", "scenes", "algorithms", "plugins"});
@@ -108,10 +116,11 @@ class SuiteReader : public JsonPathReader {
     std::vector<std::string> params;
     std::vector<std::pair<std::string, std::vector<json>>> sweep;
     std::vector<json> points;  // explicit sweep points (instead of a product)
+    // Its sweep points, saturating at kMaxSuiteCells + 1 (a product of sweeps can overflow).
     [[nodiscard]] std::size_t count() const {
       if (!points.empty()) return points.size();
       std::size_t n = 1;
-      for (const auto& [k, v] : sweep) n *= v.size();
+      for (const auto& [k, v] : sweep) n = std::min(n * v.size(), kMaxSuiteCells + 1);  // n stays small: no overflow
       return n;
     }
   };
@@ -132,8 +141,8 @@ class SuiteReader : public JsonPathReader {
   }
 
   Common read_settings(const json& j, Suite& s) const {
-    s.name = j.value("name", fs::path(file()).stem().string());
-    s.description = j.value("description", "");
+    s.name = string_field(j, "", "name", fs::path(file()).stem().string(), "the suite's name");
+    s.description = string_field(j, "", "description", "", "a description");
     if (j.contains("repetitions")) s.repetitions = static_cast<int>(number(j["repetitions"], "/repetitions", 1, 1000));
     if (j.contains("warmup")) s.warmup = static_cast<int>(number(j["warmup"], "/warmup", 0, 100));
     if (j.contains("timeout_s")) s.timeout_s = number(j["timeout_s"], "/timeout_s", 0.001, 1e6);
@@ -141,7 +150,7 @@ class SuiteReader : public JsonPathReader {
       s.memory_limit_bytes = static_cast<std::uint64_t>(number(j["memory_limit_mb"], "/memory_limit_mb", 64, 1e7))
                              << 20;
     Common c;
-    if (j.contains("threads")) c.threads = static_cast<int>(number(j["threads"], "/threads", 0, 1024));
+    if (j.contains("threads")) c.threads = static_cast<int>(number(j["threads"], "/threads", 0, kMaxThreads));
     if (j.contains("max_steps")) c.max_steps = static_cast<int>(number(j["max_steps"], "/max_steps", 0, 1e9));
     if (j.contains("seeds")) {
       if (!j["seeds"].is_array() || j["seeds"].empty()) fail("/seeds", "expected a non-empty array of seeds");
@@ -177,7 +186,7 @@ class SuiteReader : public JsonPathReader {
           if (!e["params"].is_object()) fail(path + "/params", "expected an object of scene parameters");
           for (const auto& [k, v] : e["params"].items()) se.params.push_back(k + "=" + value_text(v));
         }
-        if (e.contains("name")) se.name = e["name"].get<std::string>();
+        se.name = string_field(e, path, "name", "", "the scene's display name");
       }
       try {
         const Scene sc = load_scene(se.spec, se.params);
@@ -210,8 +219,8 @@ class SuiteReader : public JsonPathReader {
       only_keys(e, path, {"name", "label", "params", "sweep", "fault", "leaf_obj", "organs"});
       if (!e.contains("name") || !e["name"].is_string()) fail(path + "/name", "expected the algorithm's name");
       a.name = e["name"].get<std::string>();
-      a.label = e.value("label", "");
-      a.fault = e.value("fault", "");
+      a.label = string_field(e, path, "label", "", "the entry's label");
+      a.fault = string_field(e, path, "fault", "", "a fault to inject (crash, hang, oom, throw or slow:N)");
       if (e.contains("leaf_obj")) {
         if (!e["leaf_obj"].is_string()) fail(path + "/leaf_obj", "expected the path of an OBJ file");
         a.leaf_obj = relative_to_suite(e["leaf_obj"].get<std::string>());
@@ -304,8 +313,20 @@ class SuiteReader : public JsonPathReader {
   // Cells. Order: for each scene, seed and sweep point, every algorithm entry in turn (interleaved).
   void make_cells(const Common& common, const std::vector<SceneEntry>& scenes, const std::vector<AlgoEntry>& algos,
                   Suite& s) const {
-    std::size_t max_points = 1;
-    for (const auto& a : algos) max_points = std::max(max_points, a.count());
+    std::size_t max_points = 1, points = 0;
+    for (const auto& a : algos) {
+      max_points = std::max(max_points, a.count());
+      points = std::min(points + a.count(), kMaxSuiteCells + 1);
+    }
+    // Refused before a cell is made: a matrix of a billion cells would exhaust memory before its first trial.
+    const double cells =
+        static_cast<double>(scenes.size()) * static_cast<double>(common.seeds.size()) * static_cast<double>(points);
+    if (cells > static_cast<double>(kMaxSuiteCells))
+      fail("", fmt::format(
+                   "the suite makes {} cells (scenes x seeds x the sweep points of every algorithm entry); "
+                   "a suite may have at most {}: split it into several suites, or sweep fewer values",
+                   points > kMaxSuiteCells ? fmt::format("more than {}", kMaxSuiteCells) : fmt::format("{:.0f}", cells),
+                   kMaxSuiteCells));
     std::set<std::string> ids;
     for (const auto& sc : scenes)
       for (const auto seed : common.seeds)
@@ -694,8 +715,16 @@ json merge_results(const std::vector<json>& shards, const std::vector<std::strin
 
 int run_trial_child(const TrialSpec& spec, const std::string& dir_name, int report_fd) {
   const fs::path dir(dir_name);
-  auto write_error = [&](const std::string& msg) { std::ofstream(dir / "error.txt") << msg; };
+  auto write_error = [&](const std::string& msg) {
+    try {
+      write_file_atomic((dir / "error.txt").string(), msg);
+    } catch (const std::exception& e) {  // the suite then reports the exit status alone; the log keeps both
+      fmt::print(stderr, "{}\n{}\n", msg, e.what());
+    }
+  };
   const auto started = std::chrono::steady_clock::now();
+  const std::string oom = "out of memory (allocation refused under the address-space limit)";
+  exit_on_escaped_bad_alloc(kExitOom, oom, (dir / "error.txt").string());  // a library's noexcept code, its threads
   try {
     run_trial(spec);
     if (report_fd >= 0) {
@@ -709,10 +738,11 @@ int run_trial_child(const TrialSpec& spec, const std::string& dir_name, int repo
   } catch (const InputError& e) {
     write_error(e.what());
     return kExitInvalid;
-  } catch (const std::bad_alloc&) {
-    write_error("out of memory (allocation refused under the address-space limit)");
-    return kExitOom;
   } catch (const std::exception& e) {
+    if (is_out_of_memory(e)) {
+      write_error(dynamic_cast<const std::bad_alloc*>(&e) ? oom : fmt::format("{}: {}", oom, e.what()));
+      return kExitOom;
+    }
     write_error(e.what());
     return kExitError;
   }
@@ -781,7 +811,7 @@ class SuiteRun {
     out_ = o.out_dir.empty() ? fs::path("out/suites") / suite_.name : fs::path(o.out_dir);
     results_path_ = out_ / "results.json";
     journal_path_ = out_ / "journal.jsonl";
-    fs::create_directories(out_ / "trials");
+    make_directories((out_ / "trials").string());
     launcher_ = o.launcher;
     if (!o.instructions && !launcher_) {
       own_launcher_ = start_trial_launcher();
@@ -792,7 +822,15 @@ class SuiteRun {
   std::string run() {
     open_results();
     add_cells();
-    if (o_.resume && fs::exists(journal_path_)) replay_journal();
+    check_inputs();
+    if (o_.resume && fs::exists(journal_path_)) {
+      if (const std::string torn = repair_journal(journal_path_.string()); !torn.empty())
+        fmt::print(stderr,
+                   "growbench: warning: {} ended in a line cut short ({} bytes, set aside in {}.torn); its trial "
+                   "runs again\n",
+                   journal_path_.string(), torn.size(), journal_path_.filename().string());
+      replay_journal();
+    }
     write_atomic(results_path_, results_text(results_));
     journal_.reset(std::fopen(journal_path_.c_str(), "a"));
     if (!journal_) throw std::runtime_error(fmt::format("{}: cannot open the journal", journal_path_.string()));
@@ -886,6 +924,56 @@ class SuiteRun {
     }
   }
 
+  // The files an algorithm's text parameters name (a grammar, a mask, a points file, an organ OBJ) only the
+  // algorithm reads, as it starts. So each cell that sets a text parameter to a combination not seen
+  // before starts once, as a trial of no steps in its own process (with the suite's limits), before any
+  // trial runs; an input it refuses stops the suite here instead of failing every trial of the cell.
+  void check_inputs() {
+    std::set<std::string> seen;
+    const fs::path root = out_ / "checks";
+    for (const SuiteConfig& c : suite_.configs) {
+      const std::string texts = text_assignments(c.spec);
+      if (texts.empty() || !seen.insert(c.spec.algorithm + '\n' + texts).second) continue;
+      SuiteConfig check = c;
+      check.spec.max_steps = 0;
+      check.spec.metrics = false;
+      check.spec.frame_every = 0;
+      const fs::path dir = root / std::to_string(seen.size());
+      make_directories(dir.string());
+      const std::string job = json_text(trial_job(check, dir.string()), -1);
+      const ChildLimits limits{suite_.timeout_s, suite_.memory_limit_bytes};
+      ChildResult r;
+      if (launcher_) {
+        r = launcher_->run(job, limits, {});
+      } else {  // --instructions: no launcher; `growbench trial`, as the trials run, but without callgrind
+        write_atomic(dir / "spec.json", job);
+        r = run_program({self_exe_, "trial", (dir / "spec.json").string()}, "", limits, (dir / "log.txt").string());
+      }
+      // Only refused input stops the suite: a crash or a hang is the trials' to record.
+      if (!r.timed_out && r.signal == 0 && r.exit_code == kExitInvalid) {
+        const std::string error = read_text((dir / "error.txt").string());
+        std::error_code ec;
+        fs::remove_all(root, ec);
+        throw InputError(fmt::format("{}: cell {} cannot start: {}", suite_.file, c.id, error));
+      }
+    }
+    std::error_code ec;
+    fs::remove_all(root, ec);
+  }
+
+  // The cell's assignments to text parameters, one per line ("" when none).
+  static std::string text_assignments(const TrialSpec& spec) {
+    const auto& table = find_algorithm(spec.algorithm).info().params;
+    std::string out;
+    for (const std::string& a : spec.params) {
+      const auto eq = a.find('=');
+      const auto it =
+          std::find_if(table.begin(), table.end(), [&](const ParamSpec& p) { return p.name == a.substr(0, eq); });
+      if (it != table.end() && it->type == ParamType::String && eq + 1 < a.size()) out += a + '\n';
+    }
+    return out;
+  }
+
   // Repetitions finished after the last snapshot (or before a kill) come back from the journal.
   void replay_journal() {
     for (const JournalEntry& e : read_journal(journal_path_.string())) {
@@ -959,7 +1047,7 @@ class SuiteRun {
       p.cr = run_program(args, "", {suite_.timeout_s * kCallgrindSlowdown, 0}, (dir / "log.txt").string());
     } else {
       const ChildLimits limits{suite_.timeout_s, suite_.memory_limit_bytes};
-      p.cr = launcher_->run(trial_job(c, dir.string()).dump(), limits, [&](const std::string& report) {
+      p.cr = launcher_->run(json_text(trial_job(c, dir.string()), -1), limits, [&](const std::string& report) {
         std::istringstream in(report);
         in >> p.started_ns >> p.finished_ns;
         read_record();
@@ -1027,7 +1115,7 @@ class SuiteRun {
   bool run_job(const Job& job) {
     const SuiteConfig& c = *job.cell;
     const fs::path dir = out_ / "trials" / c.id;
-    fs::create_directories(dir);
+    make_directories(dir.string());
     fs::remove(dir / "record.json");
     fs::remove(dir / "error.txt");
     const TrialProcess p = run_process(c, dir);

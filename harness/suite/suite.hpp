@@ -17,6 +17,10 @@
 
 namespace growbench {
 
+// The most cells a suite may have. Sweeps multiply: a suite of a billion cells would run out of memory long
+// before its first trial, so it is refused as its file is read; a study that large is several suites.
+inline constexpr std::size_t kMaxSuiteCells = 100000;
+
 struct SuiteConfig {       // one cell of the matrix (run `repetitions` times)
   std::string id;          // label/scene/seed/sweep, unique in the suite; also the trial's folder name
   std::string label;       // the algorithm entry's label (the algorithm's name unless the suite gives one)

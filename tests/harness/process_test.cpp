@@ -7,9 +7,13 @@
 
 #include <chrono>
 #include <cstring>
+#include <cstdio>
 #include <fstream>
+#include <iterator>
+#include <new>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -50,6 +54,43 @@ TEST(Process, ReportArrivesBeforeTheChildHasExited) {
   EXPECT_LT(std::chrono::duration<double>(reported - t0).count(), 0.25) << "the report waited for the exit";
   EXPECT_GE(std::chrono::duration<double>(done - t0).count(), 0.3);
   EXPECT_GT(r.spawn_ns, 0);
+}
+
+// A std::bad_alloc that nothing can catch (thrown on a library's own thread, or through noexcept code) is the
+// memory limit, not a crash: with exit_on_escaped_bad_alloc the process says so and exits with the status
+// given, where std::terminate would abort it.
+TEST(Process, ABadAllocThatEscapesIsOutOfMemoryNotAnAbort) {
+  const std::string file = ::testing::TempDir() + "escaped_bad_alloc.txt";
+  std::remove(file.c_str());
+  auto escape = [] { std::thread([] { throw std::bad_alloc(); }).join(); };
+  ChildResult r = run_forked(
+      [&] {
+        escape();
+        return 0;
+      },
+      {}, "/dev/null");
+  EXPECT_EQ(r.signal, SIGABRT);  // what happens without it
+  r = run_forked(
+      [&] {
+        exit_on_escaped_bad_alloc(3, "out of memory (test)", file);
+        escape();
+        return 0;
+      },
+      {}, "/dev/null");
+  EXPECT_EQ(r.signal, 0);
+  EXPECT_EQ(r.exit_code, 3);
+  std::ifstream in(file);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text, "out of memory (test)");
+  // Any other exception escaping still aborts: it is a bug, not the memory limit.
+  r = run_forked(
+      [&] {
+        exit_on_escaped_bad_alloc(3, "out of memory (test)");
+        std::thread([] { throw std::runtime_error("a bug"); }).join();
+        return 0;
+      },
+      {}, "/dev/null");
+  EXPECT_EQ(r.signal, SIGABRT);
 }
 
 TEST(Process, NoReportIsFine) {

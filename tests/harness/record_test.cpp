@@ -2,11 +2,14 @@
 // error that names the file and the JSON path.
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include "core/errors.hpp"
+#include "harness/record/files.hpp"
 #include "harness/record/record.hpp"
 #include "test_util.hpp"
 
@@ -45,6 +48,11 @@ ResultsFile small_results() {
 
 json results_json() {
   return to_json(small_results());
+}
+
+std::string file_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 std::string error_of(const json& j) {
@@ -151,6 +159,79 @@ TEST(Record, PhasesInTheOrderTheJsonHoldsThem) {
   p.each([&](std::string_view n, const PhaseMeasures&) { names.emplace_back(n); });
   EXPECT_EQ(names, (std::vector<std::string>{"export", "growth", "scene_load"}));
   EXPECT_EQ(to_json(p).begin().key(), "export");
+}
+
+TEST(Record, InputFilesThatCannotBeReadNameTheFileAndWhy) {
+  const auto dir = test::temp_dir("record_input");
+  const std::string d = dir.string();
+  std::filesystem::create_directories(dir / "adir");
+  test::write_text(dir / "overflow.json", R"({"kind": "growbench-results", "trials": [{"id": "a", "seed": 1e400}]})");
+  test::write_text(dir / "kind5.json", R"({"kind": 5, "trials": []})");
+  test::write_text(dir / "newer.json", R"({"kind": "growbench-results", "schema_version": 2, "new_field": 1})");
+  auto error = [](const std::string& path) { return test::error_of([&] { (void)read_results(path); }); };
+  EXPECT_EQ(error(d + "/adir"), d + "/adir: is a directory, expected a file");
+  EXPECT_EQ(error("/dev/zero"), "/dev/zero: is a device, expected a file");
+  EXPECT_EQ(error(d + "/missing.json"), d + "/missing.json: cannot open: No such file or directory");
+  EXPECT_EQ(
+      error(d + "/overflow.json"),
+      d + "/overflow.json: invalid JSON: number overflow parsing '1e400'; expected a number within a double's range");
+  EXPECT_EQ(error(d + "/kind5.json"),
+            d + "/kind5.json: not a growbench results file (kind 5, expected 'growbench-results')");
+  // The version is checked before the fields: a newer file's new field is not called a mistake.
+  EXPECT_EQ(error(d + "/newer.json"),
+            d + "/newer.json: schema_version 2 is newer than this growbench reads (1); use a newer growbench");
+}
+
+TEST(Record, InvalidUtf8IsWrittenReplacedInsteadOfThrowing) {
+  // A trial's message quoting half of a two-byte character (an L-system error quoting one byte of 'é').
+  SuiteSample sample;
+  sample.status = "invalid_input";
+  sample.message = "unknown symbol '\xc3'";
+  const JournalEntry e{"a/wall/s1", sample, {}};
+  const json j = to_json(e);
+  EXPECT_THROW((void)j.dump(), json::type_error);  // nlohmann's default: type_error.316, the lost journal line
+  const std::string line = json_text(j, -1);
+  EXPECT_NE(line.find("unknown symbol '\xef\xbf\xbd'"), std::string::npos) << line;  // U+FFFD
+  EXPECT_EQ(line.back(), '\n');
+  const auto dir = test::temp_dir("record_utf8");
+  const auto entries = read_journal(test::write_text(dir / "journal.jsonl", line + line));
+  ASSERT_EQ(entries.size(), 2u);
+  EXPECT_EQ(entries[1].sample.message, "unknown symbol '\xef\xbf\xbd'");
+}
+
+// A kill can cut the journal's last line at any byte. Resuming sets a torn line aside (PATH.torn) and cuts
+// it off, keeps a line that lacks only its newline, and the next append starts on a fresh line: every whole
+// entry reads back, and only the torn one's trial runs again.
+TEST(Record, AJournalCutAtEveryByteOfItsLastLineReadsBackEveryWholeEntry) {
+  const auto dir = test::temp_dir("record_torn");
+  const std::string path = (dir / "journal.jsonl").string();
+  const ResultsFile r = small_results();
+  std::vector<JournalEntry> e;
+  for (int k = 0; k < 4; ++k)
+    e.push_back({fmt::format("a/wall/s{}", k), r.trials[0].samples[0], k == 2 ? r.trials[0].results : CellResults{}});
+  std::vector<std::string> lines;
+  for (const auto& x : e) lines.push_back(json_text(to_json(x), -1));
+  const std::string last = lines[2].substr(0, lines[2].size() - 1);  // without its newline
+  for (std::size_t cut = 0; cut <= last.size(); ++cut) {
+    std::filesystem::remove(path + ".torn");
+    test::write_text(path, lines[0] + lines[1] + last.substr(0, cut));
+    const std::string torn = repair_journal(path);
+    append_to_file(path, lines[3]);  // the resumed run's first entry
+    const bool whole = cut == last.size();
+    const bool cut_short = cut > 0 && !whole;
+    EXPECT_EQ(torn, cut_short ? last.substr(0, cut) : "") << cut;
+    EXPECT_EQ(file_text(path), lines[0] + lines[1] + (whole ? lines[2] : "") + lines[3]) << cut;
+    EXPECT_EQ(std::filesystem::exists(path + ".torn"), cut_short) << cut;
+    if (cut_short) {
+      EXPECT_EQ(file_text(path + ".torn"), last.substr(0, cut) + "\n") << cut;
+    }
+    std::vector<std::string> ids;
+    for (const auto& x : read_journal(path)) ids.push_back(x.id);
+    std::vector<std::string> expected = {"a/wall/s0", "a/wall/s1"};
+    if (whole) expected.emplace_back("a/wall/s2");
+    expected.emplace_back("a/wall/s3");
+    EXPECT_EQ(ids, expected) << cut;
+  }
 }
 
 TEST(Record, FilesAreCheckedForKindAndVersion) {

@@ -6,6 +6,8 @@
 
 #include <chrono>
 #include <fstream>
+#include <iterator>
+#include <map>
 #include <sstream>
 #include <thread>
 
@@ -195,6 +197,127 @@ TEST(Suite, ResumeAfterKillLosesNothing) {
           }
     EXPECT_EQ(found, 1) << e["id"];
   }
+}
+
+// The journal's last line cut short by a kill: at its start, its middle, a byte before its end, and whole but
+// for its newline. Resuming runs only that line's trial again (none when the line is whole), never glues its
+// first append onto the fragment, and a second interruption right after loses nothing.
+TEST(Suite, ResumeOverATornJournalLineRunsOnlyThatTrialAgain) {
+  const auto dir = test::temp_dir("suite_torn");
+  const json algos = json::array({{{"name", "spacecol"}, {"label", "a"}, {"params", kSmall}},
+                                  {{"name", "spacecol"}, {"label", "b"}, {"params", kSmall}}});
+  const std::string file = suite_file(dir, {{"algorithms", algos}});
+  const auto out = dir / "out";
+  ASSERT_EQ(growbench("suite -q -o " + out.string() + " " + file).status, 0);
+  auto text = [](const std::filesystem::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  };
+  auto samples = [&] {
+    std::map<std::string, json> by_id;
+    const json results = read_json(out / "results.json");
+    for (const auto& t : results["trials"]) {
+      EXPECT_EQ(t["samples"].size(), 1u) << t["id"];
+      by_id[t["id"]] = t["samples"][0];
+    }
+    return by_id;
+  };
+  const std::map<std::string, json> original = samples();
+  const std::string journal = text(out / "journal.jsonl");
+  const std::size_t first_end = journal.find('\n') + 1;
+  const std::string last = journal.substr(first_end, journal.size() - first_end - 1);  // without its newline
+  ASSERT_EQ(journal.back(), '\n');
+  for (const std::size_t cut : {std::size_t{1}, last.size() / 2, last.size() - 1, last.size()}) {
+    test::write_text(out / "journal.jsonl", journal.substr(0, first_end) + last.substr(0, cut));
+    std::filesystem::remove(out / "results.json");  // killed before its first snapshot
+    std::filesystem::remove(out / "journal.jsonl.torn");
+    const auto r = growbench("suite -q --resume -o " + out.string() + " " + file);
+    ASSERT_EQ(r.status, 0) << r.out;
+    const bool whole = cut == last.size();
+    EXPECT_EQ(r.out.find("set aside in journal.jsonl.torn") != std::string::npos, !whole) << cut << ": " << r.out;
+    if (!whole) {
+      EXPECT_EQ(text(out / "journal.jsonl.torn"), last.substr(0, cut) + "\n") << cut;
+    }
+    const std::map<std::string, json> resumed = samples();
+    EXPECT_EQ(resumed.at("a/column/s1"), original.at("a/column/s1")) << cut << ": run again";
+    EXPECT_EQ(resumed.at("b/column/s1") == original.at("b/column/s1"), whole) << cut;
+    // Every line whole, each on its own: nothing glued onto the fragment.
+    const std::string after = text(out / "journal.jsonl");
+    ASSERT_EQ(after.back(), '\n');
+    std::istringstream lines(after);
+    int n = 0;
+    for (std::string line; std::getline(lines, line); ++n) EXPECT_TRUE(json::accept(line)) << cut << ": " << line;
+    EXPECT_EQ(n, 2) << cut;
+    // Interrupted again before a snapshot: the journal alone has everything, so nothing runs again.
+    std::filesystem::remove(out / "results.json");
+    ASSERT_EQ(growbench("suite -q --resume -o " + out.string() + " " + file).status, 0);
+    EXPECT_EQ(samples(), resumed) << cut;
+  }
+}
+
+TEST(Suite, EveryGrammarIsReadBeforeTheFirstTrial) {
+  const auto dir = test::temp_dir("suite_grammar");
+  const std::string bad = test::write_text(dir / "bad.lsys", "premise: A\nA = F(\n");
+  const std::string out = (dir / "out").string();
+  const struct {
+    std::string grammar, expect;
+  } cases[] = {
+      {bad,
+       "suite.json: cell lsystem/column/s1 cannot start: " + bad + ":2:7: expected ')' before the end of the rule"},
+      {(dir / "missing.lsys").string(), "suite.json: cell lsystem/column/s1 cannot start: grammar '" +
+                                            (dir / "missing.lsys").string() + "': no such file, and not an example"},
+  };
+  for (const auto& c : cases) {
+    const json algos = json::array(
+        {{{"name", "spacecol"}, {"params", kSmall}}, {{"name", "lsystem"}, {"params", {{"grammar", c.grammar}}}}});
+    const auto r = growbench("suite -q -o " + out + " " + suite_file(dir, {{"algorithms", algos}}));
+    EXPECT_EQ(r.status, 2) << r.out;
+    EXPECT_NE(r.out.find(c.expect), std::string::npos) << r.out;
+    EXPECT_FALSE(std::filesystem::exists(dir / "out" / "results.json"));
+    EXPECT_FALSE(std::filesystem::exists(dir / "out" / "journal.jsonl"));
+    EXPECT_FALSE(std::filesystem::exists(dir / "out" / "checks"));
+  }
+}
+
+TEST(Suite, ABillionCellsAreRefusedBeforeAnyIsMade) {
+  const auto dir = test::temp_dir("suite_huge");
+  json values = json::array();
+  for (int i = 0; i < 1000; ++i) values.push_back(0.01 + 1e-5 * i);
+  const json algos =
+      json::array({{{"name", "spacecol"}, {"sweep", {{"step", values}, {"kill", values}, {"influence", values}}}}});
+  const auto r = growbench("suite -q -o " + (dir / "out").string() + " " + suite_file(dir, {{"algorithms", algos}}));
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("suite.json: at /: the suite makes more than 100000 cells (scenes x seeds x the sweep points "
+                       "of every algorithm entry); a suite may have at most 100000"),
+            std::string::npos)
+      << r.out;
+}
+
+// Memory running out is out_of_memory whichever library meets it (here Embree, creating its device under a
+// small address-space limit), and an L-system whose arithmetic fails is invalid input: neither is a crash.
+TEST(Suite, FailuresAreClassifiedByTheirCause) {
+  const auto dir = test::temp_dir("suite_causes");
+  const std::string div0 = test::write_text(dir / "div0.lsys", "premise: A\nA = F(1/0)A\n");
+  const json algos = json::array({{{"name", "spacecol"}, {"label", "small"}, {"params", kSmall}},
+                                  {{"name", "lsystem"}, {"label", "div0"}, {"params", {{"grammar", div0}}}}});
+  auto r = growbench("suite -q -o " + (dir / "lsys").string() + " " + suite_file(dir, {{"algorithms", algos}}));
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::map<std::string, json> by_label;
+  const json results = read_json(dir / "lsys" / "results.json");
+  for (const auto& t : results["trials"]) by_label[t["label"]] = t;
+  EXPECT_EQ(by_label["small"]["status"], "ok");
+  EXPECT_EQ(by_label["div0"]["status"], "invalid_input");
+  EXPECT_EQ(by_label["div0"]["message"],
+            "L-system grammar '" + div0 +
+                "': the plant its rules drew is invalid (node 1 has a non-finite position): an expression divided by "
+                "zero or overflowed");
+  r = growbench(
+      "suite -q -o " + (dir / "oom").string() + " " +
+      suite_file(dir, {{"memory_limit_mb", 300}, {"algorithms", {{{"name", "spacecol"}, {"params", kSmall}}}}}));
+  ASSERT_EQ(r.status, 0) << r.out;
+  const json t = read_json(dir / "oom" / "results.json")["trials"][0];
+  EXPECT_EQ(t["status"], "out_of_memory") << t;
+  EXPECT_EQ(t["message"].get<std::string>().rfind("out of memory", 0), 0u) << t;
 }
 
 TEST(Suite, RepetitionsOverrideIsRecordedAndGuardsResume) {

@@ -1,0 +1,57 @@
+// The helpers of the exit-status contract (command.hpp): numeric checks, so that every number a command
+// takes is checked where it is parsed, and the statuses of the Python scripts commands run.
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "harness/cli/command.hpp"
+
+namespace growbench::cli {
+
+CLI::Validator number_in(double lo, double hi, bool lo_open) {
+  const std::string range = fmt::format("{}{:g}, {:g}]", lo_open ? "(" : "[", lo, hi);
+  return {[=](std::string& text) -> std::string {
+            char* end = nullptr;
+            const double v = std::strtod(text.c_str(), &end);
+            const bool ok = !text.empty() && end == text.c_str() + text.size() && std::isfinite(v) &&
+                            (lo_open ? v > lo : v >= lo) && v <= hi;
+            return ok ? std::string() : fmt::format("expected a finite number in {}, got '{}'", range, text);
+          },
+          "NUMBER in " + range};
+}
+
+CLI::Validator integer_in(long long lo, unsigned long long hi) {
+  const std::string range = fmt::format("[{}, {}]", lo, hi);
+  return {[=](std::string& text) -> std::string {
+            const char* first = text.data();
+            const char* last = first + text.size();
+            bool ok = false;
+            if (!text.empty() && text[0] == '-') {
+              long long v = 0;
+              const auto r = std::from_chars(first, last, v);
+              ok = r.ec == std::errc() && r.ptr == last && v >= lo;
+            } else {
+              unsigned long long v = 0;
+              const auto r = std::from_chars(first + (!text.empty() && text[0] == '+' ? 1 : 0), last, v);
+              ok = r.ec == std::errc() && r.ptr == last && v <= hi &&
+                   (lo <= 0 || v >= static_cast<unsigned long long>(lo));
+            }
+            return ok ? std::string() : fmt::format("expected an integer in {}, got '{}'", range, text);
+          },
+          "INTEGER in " + range};
+}
+
+ExitStatus script_status(int status, const std::string& script) {
+  if (status == kExitOk || status == kExitBadInput) return static_cast<ExitStatus>(status);
+  fmt::print(stderr,
+             "growbench: internal error: {} ended with status {}\n"
+             "This is a bug in growbench: please report it with the command line and the input that caused it.\n",
+             script, status);
+  return kExitInternalError;
+}
+
+}  // namespace growbench::cli

@@ -1,0 +1,295 @@
+// The exit-status contract (README, "Exit status"), command by command, through the binary as a user meets
+// it: 0 success, 1 a regression found by compare or ab and nothing else, 2 bad input or usage, 3 an
+// internal error with a request for a bug report.
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "harness/record/record.hpp"
+#include "test_util.hpp"
+
+namespace growbench {
+namespace {
+
+using json = nlohmann::json;
+namespace fs = std::filesystem;
+
+test::CommandResult growbench(const std::string& args) {
+  return test::run_growbench(args);
+}
+
+// Any command line (a shell command), its status and output, as run_growbench gives them.
+test::CommandResult run_command(const std::string& command) {
+  const auto log = test::temp_dir("exit_cmd") / "log.txt";
+  const int rc = std::system((command + " > " + log.string() + " 2>&1").c_str());
+  std::ifstream in(log);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, ss.str()};
+}
+
+bool has(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+// The subcommands `growbench --help` lists, from its Subcommands section.
+std::vector<std::string> listed_commands() {
+  const std::string help = growbench("--help").out;
+  std::istringstream in(help.substr(help.find("Subcommands:")));
+  std::vector<std::string> out;
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    std::istringstream words(line);
+    std::string name;
+    if (line.rfind("  ", 0) == 0 && words >> name) out.push_back(name);
+  }
+  return out;
+}
+
+// A results file of one ok cell whose plant has `hash`: what compare, merge, baseline, history and summary
+// read.
+std::string write_results(const fs::path& path, const std::string& hash) {
+  ResultsFile r;
+  r.suite = {"t", "t.json", ""};
+  r.suite_hash = "0123456789abcdef";
+  r.repetitions = 1;
+  r.context.growbench_commit = "0123456789ab";
+  r.context.cpu_model = "Test CPU";
+  SuiteCell c;
+  c.id = "spacecol/wall/s1";
+  c.label = c.algorithm = "spacecol";
+  c.scene = c.scene_spec = "wall";
+  c.status = "ok";
+  SuiteSample s;
+  s.status = "ok";
+  s.phases.emplace();
+  s.phases->growth = PhaseMeasures{0.25, 0.5, 1u << 20, true, 10, 4096, {}, {}, {}, {}, {}, {}};
+  c.samples.push_back(s);
+  c.results.geometry_hash = hash;
+  c.results.counts = Counts{10, 9, 2, 2, 0, 100, 50};
+  r.trials.push_back(c);
+  return test::write_text(path, json_text(to_json(r), 1));
+}
+
+TEST(ExitStatus, HelpIsZeroAndEveryCommandLineErrorIsTwo) {
+  // Every command --help lists is covered here: a new command must be added to this list (and to the
+  // cases below) to pass.
+  const std::vector<std::string> commands = listed_commands();
+  EXPECT_EQ(commands, (std::vector<std::string>{"list", "scenes", "run", "suite", "history", "render", "ab", "compare",
+                                                "merge", "baseline", "report", "lsystem", "summary"}));
+  std::vector<std::string> all = commands;
+  for (const char* nested : {"history add", "history plot", "baseline update"}) all.emplace_back(nested);
+  for (const auto& c : all) {
+    auto r = growbench(c + " --help");
+    EXPECT_EQ(r.status, 0) << c << ": " << r.out;
+    r = growbench(c + " --no-such-option");
+    EXPECT_EQ(r.status, 2) << c << ": " << r.out;
+    EXPECT_FALSE(has(r.out, "internal error")) << c << ": " << r.out;
+  }
+  EXPECT_EQ(growbench("--version").status, 0);
+  auto r = growbench("");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_TRUE(has(r.out, "A subcommand is required")) << r.out;
+  r = growbench("frobnicate");
+  EXPECT_EQ(r.status, 2) << r.out;
+  r = growbench("run -a spacecol -s wall --threads abc");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_TRUE(has(r.out, "--threads")) << r.out;
+}
+
+TEST(ExitStatus, BadInputIsTwoForEveryCommandWithItsSourceNamed) {
+  const auto dir = test::temp_dir("exit_bad");
+  const std::string bad = test::write_text(dir / "malformed.json", "{\n");
+  const std::string d = dir.string();
+  fs::create_directories(dir / "empty");
+  const struct {
+    std::string args, expect;
+  } cases[] = {
+      {"list spacel", "did you mean 'spacecol'"},
+      {"scenes extra", "extra"},
+      {"run -a spacecol -s wall --voxel-size nan",
+       "--voxel-size: expected a finite number in [1e-06, 1e+06], got 'nan'"},
+      {"suite " + d + "/missing.json", d + "/missing.json: no such suite file"},
+      {"history add " + bad, bad + ":2:1: invalid JSON"},
+      {"history plot --dir " + d + "/empty", d + "/empty: no history files"},
+      {"render " + d + "/missing", "neither a suite results directory"},
+      {"ab /bin/true /bin/true " + d + "/missing.json", d + "/missing.json: no such suite file"},
+      {"compare " + bad + " " + bad, bad + ":2:1: invalid JSON"},
+      {"merge " + bad + " --out " + d + "/m.json", bad + ":2:1: invalid JSON"},
+      {"baseline update " + bad + " --baseline " + d + "/b.json", bad + ":2:1: invalid JSON"},
+      {"report " + bad, bad + ":2:1: invalid JSON"},
+      {"lsystem busj", "did you mean 'bush'"},
+      {"summary " + bad, bad + ":2:1: invalid JSON"},
+  };
+  for (const auto& c : cases) {
+    const auto r = growbench(c.args);
+    EXPECT_EQ(r.status, 2) << c.args << ": " << r.out;
+    EXPECT_TRUE(has(r.out, c.expect)) << c.args << ": " << r.out;
+    EXPECT_FALSE(has(r.out, "internal error")) << c.args << ": " << r.out;
+  }
+}
+
+TEST(ExitStatus, SuccessIsZeroAndOnlyARegressionIsOne) {
+  const auto dir = test::temp_dir("exit_ok");
+  const std::string d = dir.string();
+  const std::string base = write_results(dir / "base.json", "0123456789abcdef");
+  const std::string changed = write_results(dir / "changed.json", "fedcba9876543210");
+  for (const std::string& args : std::vector<std::string>{
+           "list", "scenes", "lsystem koch-island -g 1", "summary " + base, "compare " + base + " " + base,
+           "merge " + base + " --out " + d + "/merged.json", "baseline update " + base + " --baseline " + d + "/b.json",
+           "compare " + d + "/b.json " + base, "history add " + base + " --dir " + d + "/history"}) {
+    const auto r = growbench(args);
+    EXPECT_EQ(r.status, 0) << args << ": " << r.out;
+  }
+  const auto r = growbench("compare " + base + " " + changed);
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_TRUE(has(r.out, "geometry_hash")) << r.out;
+  EXPECT_TRUE(has(r.out, "REGRESSION")) << r.out;
+}
+
+TEST(ExitStatus, AnInternalErrorIsThreeAndAsksForABugReport) {
+  const auto dir = test::temp_dir("exit_internal");
+  auto r = growbench("run -q -a spacecol -s wall --max-steps 1 --fault throw -o " + (dir / "run").string());
+  EXPECT_EQ(r.status, 3) << r.out;
+  EXPECT_TRUE(has(r.out,
+                  "growbench: internal error: injected internal error\n"
+                  "This is a bug in growbench: please report it"))
+      << r.out;
+  // The report script failing on a valid file is a bug too, never a regression's 1.
+  const std::string script = test::write_text(dir / "broken.py", "raise RuntimeError('broken script')\n");
+  const std::string results = write_results(dir / "results.json", "0123456789abcdef");
+  ::setenv("GROWBENCH_REPORT_SCRIPT", script.c_str(), 1);
+  r = growbench("report " + results + " -o " + (dir / "report").string());
+  ::unsetenv("GROWBENCH_REPORT_SCRIPT");
+  EXPECT_EQ(r.status, 3) << r.out;
+  EXPECT_TRUE(has(r.out, "internal error: reports/report.py ended with status 1")) << r.out;
+}
+
+TEST(ExitStatus, CompareOnAFileItCannotReadIsTwoNeverARegression) {
+  const auto dir = test::temp_dir("exit_compare");
+  const std::string d = dir.string();
+  const std::string ok = write_results(dir / "ok.json", "0123456789abcdef");
+  test::write_text(dir / "kind5.json", R"({"kind": 5, "trials": []})");
+  test::write_text(dir / "overflow.json", R"({"kind": "growbench-results", "trials": [{"id": "a", "seed": 1e400}]})");
+  test::write_text(dir / "idnum.json", R"({"kind": "growbench-results", "trials": [{"id": 5}]})");
+  fs::create_directories(dir / "adir");
+  const struct {
+    std::string file, expect;
+  } cases[] = {
+      {d + "/missing.json", d + "/missing.json: cannot open: No such file or directory"},
+      {d + "/kind5.json",
+       d + "/kind5.json: not a growbench results or baseline file (kind 5, expected 'growbench-results' or "
+           "'growbench-baseline')"},
+      {d + "/overflow.json",
+       d + "/overflow.json: invalid JSON: number overflow parsing '1e400'; expected a number within a double's range"},
+      {d + "/idnum.json", d + "/idnum.json: at trials[0].id: expected a string, got number"},
+      {d + "/adir", d + "/adir: is a directory, expected a file"},
+  };
+  for (const auto& c : cases)
+    for (const std::string& args : {"compare " + c.file + " " + ok, "compare " + ok + " " + c.file}) {
+      const auto r = growbench(args);
+      EXPECT_EQ(r.status, 2) << args << ": " << r.out;
+      EXPECT_TRUE(has(r.out, "growbench: error: " + c.expect)) << args << ": " << r.out;
+    }
+  for (const char* t : {"nan", "-1", "inf"}) {
+    const auto r = growbench(std::string("compare --threshold ") + t + " " + ok + " " + ok);
+    EXPECT_EQ(r.status, 2) << r.out;
+    EXPECT_TRUE(has(r.out, std::string("--threshold: expected a finite number in [0, 1e+06], got '") + t + "'"))
+        << r.out;
+  }
+}
+
+TEST(ExitStatus, AnOutputThatCannotBeWrittenIsTwoNeverASuccess) {
+  const auto dir = test::temp_dir("exit_output");
+  const std::string d = dir.string();
+  const std::string results = write_results(dir / "results.json", "0123456789abcdef");
+  fs::create_directories(dir / "adir");
+  auto r = growbench("merge " + results + " --out /dev/full");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_TRUE(has(r.out, "growbench: error: /dev/full: cannot write: No space left on device")) << r.out;
+  EXPECT_FALSE(has(r.out, "merged")) << r.out;
+  // Written to, not replaced: the device is still a device.
+  struct stat st {};
+  ASSERT_EQ(::stat("/dev/full", &st), 0);
+  EXPECT_TRUE(S_ISCHR(st.st_mode));
+  r = growbench("merge " + results + " --out " + d + "/adir");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_TRUE(has(r.out, "growbench: error: " + d + "/adir: is a directory, expected a file to write")) << r.out;
+  EXPECT_FALSE(has(r.out, "merged")) << r.out;
+  EXPECT_TRUE(fs::is_empty(dir / "adir"));
+  r = growbench("merge " + results + " --out " + d + "/results.json/x.json");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_TRUE(has(r.out, d + "/results.json: cannot create the directory")) << r.out;
+  r = growbench("baseline update " + results + " --baseline " + d + "/adir");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_TRUE(has(r.out, d + "/adir: is a directory")) << r.out;
+  r = growbench("run -q -a spacecol -s wall --max-steps 1 -o /dev/full");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_TRUE(has(r.out, "growbench: error: /dev/full: cannot create the directory: Not a directory")) << r.out;
+}
+
+TEST(ExitStatus, NumericOptionsOutOfRangeAreRefusedNotReplaced) {
+  const auto dir = test::temp_dir("exit_values");
+  const std::string results = write_results(dir / "results.json", "0123456789abcdef");
+  const struct {
+    std::string args, expect;
+  } cases[] = {
+      {"run -a spacecol -s wall --voxel-size nan",
+       "--voxel-size: expected a finite number in [1e-06, 1e+06], got 'nan'"},
+      {"run -a spacecol -s wall --voxel-size -1", "--voxel-size: expected a finite number in [1e-06, 1e+06], got '-1'"},
+      {"run -a spacecol -s wall --voxel-size 0", "--voxel-size: expected a finite number in [1e-06, 1e+06], got '0'"},
+      {"run -a spacecol -s wall --time-limit -5", "--time-limit: expected a finite number in [0, 1e+09], got '-5'"},
+      {"run -a spacecol -s wall --time-limit nan", "--time-limit: expected a finite number in [0, 1e+09], got 'nan'"},
+      {"run -a spacecol -s wall --threads -1", "--threads: expected an integer in [0, 1024], got '-1'"},
+      {"run -a spacecol -s wall --seed -1", "--seed: expected an integer in [0, 18446744073709551615], got '-1'"},
+      {"run -a spacecol -s wall --max-steps -1", "--max-steps: expected an integer in [0, 2147483647], got '-1'"},
+      {"lsystem bush --limit -1", "--limit: expected an integer in [0, 18446744073709551615], got '-1'"},
+      {"render " + dir.string() + " --width -5", "--width: expected an integer in [0, 16384], got '-5'"},
+      {"ab /bin/true /bin/true s.json --effect nan", "--effect: expected a finite number in (1, 100], got 'nan'"},
+      {"compare " + results + " " + results + " --floor -1",
+       "--floor: expected a finite number in [0, 1e+18], got '-1'"},
+  };
+  for (const auto& c : cases) {
+    const auto r = growbench(c.args);
+    EXPECT_EQ(r.status, 2) << c.args << ": " << r.out;
+    EXPECT_TRUE(has(r.out, c.expect)) << c.args << ": " << r.out;
+  }
+}
+
+TEST(ExitStatus, ReportOnBadInputIsTwoWithoutATraceback) {
+  const auto dir = test::temp_dir("exit_report");
+  const std::string d = dir.string();
+  test::write_text(dir / "malformed.json", "{\n");
+  test::write_text(dir / "kind5.json", R"({"kind": 5, "trials": []})");
+  test::write_text(dir / "idnum.json", R"({"kind": "growbench-results", "trials": [{"id": 5}]})");
+  test::write_text(dir / "utf8.json", "{\"kind\": \"growbench-results\", \"trials\": [], \"x\": \"\xff\"}");
+  fs::create_directories(dir / "adir");
+  for (const char* f : {"malformed.json", "kind5.json", "idnum.json", "utf8.json", "adir"}) {
+    const auto r = growbench("report " + d + "/" + f + " -o " + d + "/out");
+    EXPECT_EQ(r.status, 2) << f << ": " << r.out;
+    EXPECT_TRUE(has(r.out, "growbench: error: " + d + "/" + f)) << f << ": " << r.out;
+    EXPECT_FALSE(has(r.out, "Traceback")) << f << ": " << r.out;
+  }
+  // The scripts themselves, as a user may run them: bad input is 2 with a message, not a traceback's 1.
+  const std::string py = std::string("/usr/bin/python3 ") + GROWBENCH_SOURCE_DIR + "/reports/";
+  const auto r = run_command(py + "report.py " + d + "/utf8.json --out " + d + "/out");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_TRUE(has(r.out, "report: error: " + d + "/utf8.json: not valid JSON: byte")) << r.out;
+  const auto h = run_command(py + "history.py " + d + "/adir --out " + d + "/hist");
+  EXPECT_EQ(h.status, 2) << h.out;
+  EXPECT_TRUE(has(h.out, "history: error: " + d + "/adir: no history files")) << h.out;
+}
+
+}  // namespace
+}  // namespace growbench
