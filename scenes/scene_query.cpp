@@ -51,11 +51,12 @@ void embree_error(void*, RTCError code, const char* str) {
 
 // Embree's error `e` (rtcGetDeviceError) as an exception: out of memory is OutOfMemoryError, as every
 // library's is; anything else is a bug here.
-[[noreturn]] void throw_embree(RTCError e, const std::string& what) {
+[[noreturn]] void throw_embree(RTCError e, const char* what) {
   if (e == RTC_ERROR_OUT_OF_MEMORY) throw OutOfMemoryError(fmt::format("Embree: out of memory {}", what));
   throw std::runtime_error(fmt::format("Embree: {} failed (error {})", what, static_cast<int>(e)));
 }
-void check_embree(RTCDevice device, const std::string& what) {
+// `what` is a C string: this runs in phases whose allocations are counted.
+void check_embree(RTCDevice device, const char* what) {
   if (const RTCError e = rtcGetDeviceError(device); e != RTC_ERROR_NONE) throw_embree(e, what);
 }
 // A new buffer of `g`. Embree returns null when it cannot make one; `g` is then released.
