@@ -9,14 +9,23 @@
 
 namespace growbench {
 
-// The whole file as text; InputError "PATH: cannot open" when it cannot be read.
+// The whole file as text; InputError "PATH: cannot open" when it cannot be read (or is a directory).
 std::string read_text_file(const std::string& path);
 
 // 1-based line and column of a byte offset (as nlohmann's parse_error::byte reports it).
 std::pair<std::size_t, std::size_t> line_column(const std::string& text, std::size_t byte);
 
-// Parses `text`; a syntax error becomes InputError "FILE:LINE:COL: invalid JSON: ...".
+// No input file is nested this deep; a bound keeps recursive readers and dump() off the end of the stack.
+constexpr std::size_t kMaxJsonDepth = 256;
+
+// Parses `text`; a syntax error or a number out of range (1e400) becomes InputError
+// "FILE:LINE:COL: invalid JSON: ...", a key given twice in one object or nesting deeper than
+// kMaxJsonDepth InputError "FILE: invalid JSON: at PATH: ...".
 nlohmann::json parse_json_file_text(const std::string& file, const std::string& text);
+
+// A value as a message quotes it: its JSON text, cut to kJsonExcerptBytes at a character boundary.
+constexpr std::size_t kJsonExcerptBytes = 80;
+std::string json_excerpt(const nlohmann::json& j);
 
 class JsonPathReader {
  public:

@@ -9,6 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include "core/errors.hpp"
+#include "core/json_util.hpp"
+#include "core/utf8.hpp"
 
 namespace growbench {
 
@@ -196,6 +198,10 @@ void Params::check_and_store(std::size_t i, ParamValue v, std::string_view shown
       check_range(x.z);
       break;
     }
+    case ParamType::String:
+      // Values are written to records and journals, which are JSON: text that is not UTF-8 cannot be.
+      if (!is_valid_utf8(std::get<std::string>(v))) bad("is not valid UTF-8 text");
+      break;
     case ParamType::Choice:
       if (std::find(s.choices.begin(), s.choices.end(), std::get<std::string>(v)) == s.choices.end()) {
         const std::string near = closest_match(std::get<std::string>(v), s.choices);
@@ -238,6 +244,10 @@ void Params::apply_preset() {
 }
 
 namespace {
+// The largest whole number an integer parameter takes from a real number's text or JSON (2^53: every
+// integer up to it is exact in a double).
+constexpr double kMaxExactInteger = 9007199254740992.0;
+
 bool parse_double(std::string_view t, double& out) {
   while (!t.empty() && t.front() == ' ') t.remove_prefix(1);
   while (!t.empty() && t.back() == ' ') t.remove_suffix(1);
@@ -251,8 +261,8 @@ void Params::set(std::string_view key, std::string_view text) {
   const std::size_t i = index_of(key);
   const ParamSpec& s = specs_[i];
   auto bad = [&]() {
-    throw InputError(
-        fmt::format("parameter '{}' of {}: cannot read '{}'; expected {}", s.name, owner_, text, s.allowed()));
+    throw InputError(fmt::format("parameter '{}' of {}: cannot read '{}'; expected {}", s.name, owner_,
+                                 utf8_excerpt(text, kJsonExcerptBytes), s.allowed()));
   };
   switch (s.type) {
     case ParamType::Int: {
@@ -260,16 +270,16 @@ void Params::set(std::string_view key, std::string_view text) {
       const auto r = std::from_chars(text.data(), text.data() + text.size(), v);
       if (r.ec != std::errc{} || r.ptr != text.data() + text.size()) {
         double d = 0;  // accept "1e6" and "3.0" when they are whole numbers
-        if (!parse_double(text, d) || d != std::floor(d) || std::abs(d) > 9.0e15) bad();
+        if (!parse_double(text, d) || d != std::floor(d) || std::abs(d) > kMaxExactInteger) bad();
         v = static_cast<std::int64_t>(d);
       }
-      check_and_store(i, v, text);
+      check_and_store(i, v, utf8_excerpt(text, kJsonExcerptBytes));
       break;
     }
     case ParamType::Real: {
       double v = 0;
       if (!parse_double(text, v)) bad();
-      check_and_store(i, v, text);
+      check_and_store(i, v, utf8_excerpt(text, kJsonExcerptBytes));
       break;
     }
     case ParamType::Bool: {
@@ -287,7 +297,7 @@ void Params::set(std::string_view key, std::string_view text) {
     }
     case ParamType::String:
     case ParamType::Choice:
-      check_and_store(i, std::string(text), text);
+      check_and_store(i, std::string(text), utf8_excerpt(text, kJsonExcerptBytes));
       break;
     case ParamType::Vec3: {
       glm::dvec3 v{0.0};
@@ -298,7 +308,7 @@ void Params::set(std::string_view key, std::string_view text) {
         if (!parse_double(rest.substr(0, comma), v[c])) bad();
         if (c < 2) rest.remove_prefix(comma + 1);
       }
-      check_and_store(i, v, text);
+      check_and_store(i, v, utf8_excerpt(text, kJsonExcerptBytes));
       break;
     }
   }
@@ -307,20 +317,29 @@ void Params::set(std::string_view key, std::string_view text) {
 void Params::set_json(std::string_view key, const nlohmann::json& j) {
   const std::size_t i = index_of(key);
   const ParamSpec& s = specs_[i];
-  const std::string shown = j.dump();
+  const std::string shown = json_excerpt(j);
   auto bad = [&]() {
     throw InputError(fmt::format("parameter '{}' of {}: value {} has the wrong type; expected {}", s.name, owner_,
                                  shown, s.allowed()));
   };
   switch (s.type) {
-    case ParamType::Int:
+    case ParamType::Int: {
+      const bool too_big =
+          j.is_number_unsigned() &&
+          j.get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max());
+      const bool whole = j.is_number_float() && j.get<double>() == std::floor(j.get<double>());
+      // A real number is taken when whole and exact in a double (as set() reads "1e6"); beyond, a cast is undefined.
+      if (too_big || (whole && std::abs(j.get<double>()) > kMaxExactInteger))
+        throw InputError(fmt::format("parameter '{}' of {}: value {} is out of range; expected {}", s.name, owner_,
+                                     shown, s.allowed()));
       if (j.is_number_integer())
         check_and_store(i, j.get<std::int64_t>(), shown);
-      else if (j.is_number_float() && j.get<double>() == std::floor(j.get<double>()))
+      else if (whole)
         check_and_store(i, static_cast<std::int64_t>(j.get<double>()), shown);
       else
         bad();
       break;
+    }
     case ParamType::Real:
       if (!j.is_number()) bad();
       check_and_store(i, j.get<double>(), shown);

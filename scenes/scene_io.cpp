@@ -2,7 +2,6 @@
 // and OBJ meshes as scenes (mesh:PATH, or mesh:NAME for a mesh the repository carries).
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <sstream>
 
@@ -13,6 +12,7 @@
 #include "core/data_path.hpp"
 #include "core/json_util.hpp"
 #include "scenes/geometry.hpp"
+#include "scenes/obj_check.hpp"
 #include "scenes/scene_library.hpp"
 
 namespace growbench {
@@ -48,6 +48,7 @@ std::string mesh_path(const std::string& ref) {
 
 TriangleMesh load_obj(const std::string& path) {
   if (!fs::exists(path)) throw InputError(fmt::format("{}: no such file", path));
+  check_obj_text(path, read_text_file(path));
   tinyobj::ObjReaderConfig cfg;
   cfg.triangulate = true;
   cfg.vertex_color = false;
@@ -212,10 +213,27 @@ Scene mesh_scene(const std::string& path, const Params& p) {
   return s;
 }
 
+// The scene files whose bases are being read, outermost first, each as given and as its canonical path:
+// a base that is one of them is a cycle. Bases nest at most kMaxBaseDepth files deep.
+struct BaseLink {
+  std::string shown, canonical;
+};
+using BaseChain = std::vector<BaseLink>;
+constexpr std::size_t kMaxBaseDepth = 16;
+
+// An error in the chain of bases as a whole: each file of the chain would otherwise prefix it again.
+class BaseChainError : public InputError {
+ public:
+  using InputError::InputError;
+};
+
+Scene load_scene_in(const std::string& spec, const std::vector<std::string>& assignments, const BaseChain& chain);
+
 // A small reader that remembers the JSON path, so every error says where it is.
 class JsonScene : public JsonPathReader {
  public:
-  JsonScene(std::string file, fs::path dir) : JsonPathReader(std::move(file)), dir_(std::move(dir)) {}
+  JsonScene(std::string file, fs::path dir, const BaseChain& chain)
+      : JsonPathReader(std::move(file)), dir_(std::move(dir)), chain_(chain) {}
   const json& need(const json& j, const std::string& path, const char* key) const {
     if (!j.contains(key)) fail(path, fmt::format("missing required key '{}'", key));
     return j.at(key);
@@ -369,8 +387,12 @@ class JsonScene : public JsonPathReader {
       std::string base = string(j["base"], "/base");
       if (base.rfind("mesh:", 0) == 0 && !is_mesh_name(base.substr(5)))
         base = "mesh:" + resolve(base.substr(5), "/base");
+      else if (base.ends_with(".json"))
+        base = resolve(base, "/base");
       try {
-        s = load_scene(base, params);
+        s = load_scene_in(base, params, chain_);
+      } catch (const BaseChainError&) {
+        throw;
       } catch (const InputError& e) {
         fail("/base", e.what());
       }
@@ -456,19 +478,31 @@ class JsonScene : public JsonPathReader {
 
  private:
   fs::path dir_;
+  const BaseChain& chain_;
 };
 
-Scene json_scene(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(fmt::format("{}: cannot open scene file", path));
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const json j = parse_json_file_text(path, text);
-  return JsonScene(path, fs::path(path).parent_path()).scene(j);
+// `chain`: the files whose bases led here (empty for a scene named on the command line).
+Scene json_scene(const std::string& path, const BaseChain& chain) {
+  std::error_code ec;
+  const fs::path canonical = fs::weakly_canonical(path, ec);
+  BaseChain longer = chain;
+  longer.push_back({path, ec ? path : canonical.string()});
+  auto names = [&] {
+    std::vector<std::string> shown;
+    for (const auto& l : longer) shown.push_back(l.shown);
+    return fmt::format("{}", fmt::join(shown, " -> "));
+  };
+  for (const auto& l : chain)
+    if (l.canonical == longer.back().canonical)
+      throw BaseChainError(fmt::format("{}: at /base: the scene bases form a cycle: {}", chain.back().shown, names()));
+  if (longer.size() > kMaxBaseDepth)
+    throw BaseChainError(fmt::format("{}: at /base: scene bases nest more than {} files deep: {}", chain.back().shown,
+                                     kMaxBaseDepth, names()));
+  const json j = parse_json_file_text(path, read_text_file(path));
+  return JsonScene(path, fs::path(path).parent_path(), longer).scene(j);
 }
 
-}  // namespace
-
-Scene load_scene(const std::string& spec, const std::vector<std::string>& assignments) {
+Scene load_scene_in(const std::string& spec, const std::vector<std::string>& assignments, const BaseChain& chain) {
   Scene s;
   if (spec.rfind("mesh:", 0) == 0) {
     const std::string path = mesh_path(spec.substr(5));
@@ -479,7 +513,7 @@ Scene load_scene(const std::string& spec, const std::vector<std::string>& assign
     if (!assignments.empty())
       throw InputError(
           fmt::format("scene '{}': scene parameters go in the file's 'base_params', not on the command line", spec));
-    s = json_scene(spec);
+    s = json_scene(spec, chain);
   } else {
     const auto& list = standard_scenes();
     const auto it = std::find_if(list.begin(), list.end(), [&](const StandardScene& st) { return st.name == spec; });
@@ -497,6 +531,12 @@ Scene load_scene(const std::string& spec, const std::vector<std::string>& assign
   }
   s.source = spec;
   return s;
+}
+
+}  // namespace
+
+Scene load_scene(const std::string& spec, const std::vector<std::string>& assignments) {
+  return load_scene_in(spec, assignments, {});
 }
 
 }  // namespace growbench

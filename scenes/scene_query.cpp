@@ -10,6 +10,7 @@
 #include <tbb/task_arena.h>
 
 #include "core/kdtree.hpp"
+#include "core/memory.hpp"
 #include "core/random.hpp"
 #include "scenes/geometry.hpp"
 #include "scenes/host_queries.hpp"
@@ -48,6 +49,29 @@ void embree_error(void*, RTCError code, const char* str) {
   fmt::print(stderr, "Embree error {}: {}\n", static_cast<int>(code), str ? str : "");
 }
 
+// Embree's error `e` (rtcGetDeviceError) as an exception: out of memory is OutOfMemoryError, as every
+// library's is; anything else is a bug here.
+[[noreturn]] void throw_embree(RTCError e, const char* what) {
+  if (e == RTC_ERROR_OUT_OF_MEMORY) throw OutOfMemoryError(fmt::format("Embree: out of memory {}", what));
+  throw std::runtime_error(fmt::format("Embree: {} failed (error {})", what, static_cast<int>(e)));
+}
+// `what` is a C string: this runs in phases whose allocations are counted.
+void check_embree(RTCDevice device, const char* what) {
+  if (const RTCError e = rtcGetDeviceError(device); e != RTC_ERROR_NONE) throw_embree(e, what);
+}
+// A new buffer of `g`. Embree returns null when it cannot make one; `g` is then released.
+template <class T>
+T* new_buffer(RTCDevice device, RTCGeometry g, RTCBufferType type, RTCFormat format, std::size_t stride,
+              std::size_t count) {
+  void* p = rtcSetNewGeometryBuffer(g, type, 0, format, stride, count);
+  if (!p) {
+    rtcReleaseGeometry(g);
+    const RTCError e = rtcGetDeviceError(device);
+    throw_embree(e == RTC_ERROR_NONE ? RTC_ERROR_UNKNOWN : e, "allocating a geometry buffer");
+  }
+  return static_cast<T*>(p);
+}
+
 // One Embree scene over a list of meshes (geometry ID = index in the list).
 struct BvhScene {
   RTCScene scene = nullptr;
@@ -55,23 +79,31 @@ struct BvhScene {
 
   BvhScene(RTCDevice device, std::vector<const TriangleMesh*> ms) : meshes(std::move(ms)) {
     scene = rtcNewScene(device);
+    if (!scene) throw_embree(rtcGetDeviceError(device), "making a scene");
+    try {
+      build(device);
+    } catch (...) {
+      rtcReleaseScene(scene);
+      throw;
+    }
+  }
+  void build(RTCDevice device) {
     rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
     for (std::size_t i = 0; i < meshes.size(); ++i) {
       const TriangleMesh& m = *meshes[i];
       RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-      auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                             3 * sizeof(float), m.vertices.size()));
+      auto* vb =
+          new_buffer<float>(device, g, RTC_BUFFER_TYPE_VERTEX, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m.vertices.size());
       std::copy_n(&m.vertices[0].x, 3 * m.vertices.size(), vb);
-      auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                3 * sizeof(unsigned), m.triangles.size()));
+      auto* ib = new_buffer<unsigned>(device, g, RTC_BUFFER_TYPE_INDEX, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
+                                      m.triangles.size());
       std::copy_n(&m.triangles[0].x, 3 * m.triangles.size(), ib);
       rtcCommitGeometry(g);
       rtcAttachGeometryByID(scene, g, static_cast<unsigned>(i));
       rtcReleaseGeometry(g);
     }
     rtcCommitScene(scene);
-    if (const RTCError e = rtcGetDeviceError(device); e != RTC_ERROR_NONE)
-      throw std::runtime_error(fmt::format("Embree: building the BVH failed (error {})", static_cast<int>(e)));
+    check_embree(device, "building the BVH");
   }
   ~BvhScene() {
     if (scene) rtcReleaseScene(scene);
@@ -286,9 +318,7 @@ struct SceneQuery::Embree {
   std::vector<std::pair<const Shape*, std::unique_ptr<BvhScene>>> shapes;  // mesh envelopes/zones
   Embree() {
     device = rtcNewDevice("threads=0");
-    if (!device)
-      throw std::runtime_error(
-          fmt::format("Embree: cannot create a device (error {})", static_cast<int>(rtcGetDeviceError(nullptr))));
+    if (!device) throw_embree(rtcGetDeviceError(nullptr), "creating a device");
     rtcSetDeviceErrorFunction(device, embree_error, nullptr);
   }
   ~Embree() {
@@ -353,10 +383,35 @@ SceneQuery::SceneQuery(const Scene& scene, SceneQueryOptions options)
   if (!(voxel_size_ > 0.0f) || !std::isfinite(voxel_size_))
     throw InputError(fmt::format("scene '{}': cannot size the distance field (degenerate bounds)", scene.name));
   if (options.build_sdf) {
+    check_sdf_size(sdf_meshes, b, options.voxel_size > 0.0f);
     t0 = std::chrono::steady_clock::now();
     sdf_ = std::make_unique<SdfGrid>(sdf_meshes, solid_, voxel_size_, options.band_voxels);
     sdf_seconds_ = seconds_since(t0);
   }
+}
+
+void SceneQuery::check_sdf_size(const std::vector<const TriangleMesh*>& meshes, const Aabb& bounds, bool given) const {
+  const std::string what =
+      given ? fmt::format("--voxel-size {}", voxel_size_)
+            : fmt::format("the automatic voxel size {} m (the meshes' bounding-box diagonal / 256)", voxel_size_);
+  if (voxel_size_ < SdfGrid::min_voxel_size())
+    throw InputError(fmt::format("scene '{}': {} is below {:.3g} m, the smallest voxel OpenVDB represents{}",
+                                 scene_.name, what, SdfGrid::min_voxel_size(),
+                                 given ? "" : "; the scene is too small: scale it up, or give --voxel-size"));
+  const glm::vec3 far = glm::max(glm::abs(bounds.min), glm::abs(bounds.max));
+  const float reach = std::max({far.x, far.y, far.z});
+  if (reach / voxel_size_ > SdfGrid::max_voxel_reach())
+    throw InputError(
+        fmt::format("scene '{}': {}: the meshes reach {} m from the origin, more voxels than OpenVDB's "
+                    "coordinates address; expected a larger voxel size",
+                    scene_.name, what, reach));
+  const double need = SdfGrid::estimate_peak_bytes(meshes, voxel_size_, options_.band_voxels);
+  if (const auto headroom = memory_headroom(); headroom && need > static_cast<double>(*headroom))
+    throw OutOfMemoryError(
+        fmt::format("scene '{}': the distance field at {} would need about {}, more than the {} "
+                    "this process may still take; a larger --voxel-size needs less (a quarter "
+                    "for twice the size)",
+                    scene_.name, what, format_bytes(need), format_bytes(static_cast<double>(*headroom))));
 }
 
 SceneQuery::~SceneQuery() = default;
@@ -417,6 +472,7 @@ BoxIndex::BoxIndex(void* device, std::vector<Aabb> boxes) : boxes_(std::move(box
   // Empty boxes stay out of the BVH (Embree skips primitives with invalid bounds), so ids keep their
   // meaning without ever being visited.
   impl_->scene = rtcNewScene(dev);
+  if (!impl_->scene) throw_embree(rtcGetDeviceError(dev), "making a scene");
   rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
   RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_USER);
   rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(boxes_.size()));
@@ -428,8 +484,7 @@ BoxIndex::BoxIndex(void* device, std::vector<Aabb> boxes) : boxes_(std::move(box
   rtcAttachGeometryByID(impl_->scene, g, 0);
   rtcReleaseGeometry(g);
   rtcCommitScene(impl_->scene);
-  if (const RTCError e = rtcGetDeviceError(dev); e != RTC_ERROR_NONE)
-    throw std::runtime_error(fmt::format("Embree: building a box index failed (error {})", static_cast<int>(e)));
+  check_embree(dev, "building a box index");
 }
 
 BoxIndex::~BoxIndex() = default;
@@ -473,13 +528,13 @@ Occluder::Occluder(void* device, std::vector<Capsule> capsules, std::vector<Tria
     : impl_(std::make_unique<Impl>()) {
   auto* dev = static_cast<RTCDevice>(device);
   impl_->scene = rtcNewScene(dev);
+  if (!impl_->scene) throw_embree(rtcGetDeviceError(dev), "making a scene");
   rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
   if (!capsules.empty()) {
     RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE);
-    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
-                                                           4 * sizeof(float), 2 * capsules.size()));
-    auto* ib = static_cast<unsigned*>(
-        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT, sizeof(unsigned), capsules.size()));
+    auto* vb =
+        new_buffer<float>(dev, g, RTC_BUFFER_TYPE_VERTEX, RTC_FORMAT_FLOAT4, 4 * sizeof(float), 2 * capsules.size());
+    auto* ib = new_buffer<unsigned>(dev, g, RTC_BUFFER_TYPE_INDEX, RTC_FORMAT_UINT, sizeof(unsigned), capsules.size());
     for (std::size_t i = 0; i < capsules.size(); ++i) {
       const Capsule& c = capsules[i];
       const float v[8] = {c.a.x, c.a.y, c.a.z, c.ra, c.b.x, c.b.y, c.b.z, c.rb};
@@ -492,10 +547,10 @@ Occluder::Occluder(void* device, std::vector<Capsule> capsules, std::vector<Tria
   }
   if (!triangles.empty()) {
     RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                           3 * sizeof(float), 3 * triangles.size()));
-    auto* ib = static_cast<unsigned*>(
-        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), triangles.size()));
+    auto* vb =
+        new_buffer<float>(dev, g, RTC_BUFFER_TYPE_VERTEX, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * triangles.size());
+    auto* ib =
+        new_buffer<unsigned>(dev, g, RTC_BUFFER_TYPE_INDEX, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), triangles.size());
     owners_.reserve(triangles.size());
     for (std::size_t i = 0; i < triangles.size(); ++i) {
       for (int k = 0; k < 3; ++k) {
@@ -513,9 +568,7 @@ Occluder::Occluder(void* device, std::vector<Capsule> capsules, std::vector<Tria
   // (the metrics) must allocate the same way every time.
   tbb::task_arena one(1);
   one.execute([&] { rtcCommitScene(impl_->scene); });
-  if (const RTCError e = rtcGetDeviceError(dev); e != RTC_ERROR_NONE)
-    throw std::runtime_error(
-        fmt::format("Embree: building the plant's occluder failed (error {})", static_cast<int>(e)));
+  check_embree(dev, "building the plant's occluder");
 }
 
 Occluder::~Occluder() = default;

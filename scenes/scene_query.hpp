@@ -201,6 +201,9 @@ class SceneQuery {
   [[nodiscard]] const std::vector<bool>& mesh_solid() const { return solid_; }
 
  private:
+  // Refuses a distance field OpenVDB cannot represent (InputError) or that would need more memory than
+  // the process may take (OutOfMemoryError), before building it. `given`: the voxel size is the user's.
+  void check_sdf_size(const std::vector<const TriangleMesh*>& meshes, const Aabb& bounds, bool given) const;
   struct Embree;
   struct VertexIndex;
   struct Solid;

@@ -1,7 +1,10 @@
 #include "scenes/sdf.hpp"
 
+#include <cmath>
+#include <limits>
 #include <mutex>
 
+#include <fmt/format.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Composite.h>
 #include <openvdb/tools/Interpolation.h>
@@ -13,11 +16,51 @@ struct SdfGrid::Impl {
   openvdb::FloatGrid::Ptr grid;
 };
 
+namespace {
+// Peak bytes per narrow-band voxel while meshToLevelSet builds, and active voxels per voxel-sized square
+// of surface per voxel of band half-width, both measured (see estimate_peak_bytes).
+constexpr double kPeakBytesPerVoxel = 26.0;
+constexpr double kVoxelsPerFace = 1.7;
+}  // namespace
+
+double SdfGrid::min_voxel_size() {
+  // ScaleMap refuses |sx * sy * sz| < 3 * Tolerance<double>; a little above its cube root, to be safe.
+  return 1.01 * std::cbrt(3.0 * openvdb::math::Tolerance<double>::value());
+}
+
+double SdfGrid::max_voxel_reach() {
+  return 0.25 * static_cast<double>(std::numeric_limits<openvdb::Int32>::max());
+}
+
+double SdfGrid::estimate_peak_bytes(const std::vector<const TriangleMesh*>& meshes, float voxel_size,
+                                    float band_voxels) {
+  double area = 0.0;
+  for (const auto* m : meshes) area += m->area();
+  const double faces = area / (static_cast<double>(voxel_size) * voxel_size);
+  return kPeakBytesPerVoxel * kVoxelsPerFace * faces * band_voxels;
+}
+
 SdfGrid::SdfGrid(const std::vector<const TriangleMesh*>& meshes, const std::vector<bool>& solid, float voxel_size,
                  float band_voxels)
     : impl_(std::make_unique<Impl>()) {
   static std::once_flag init;
   std::call_once(init, [] { openvdb::initialize(); });
+  try {
+    build(meshes, solid, voxel_size, band_voxels);
+  } catch (const OutOfMemoryError&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    throw OutOfMemoryError(
+        fmt::format("out of memory building the distance field at voxel size {} m (OpenVDB); a "
+                    "larger --voxel-size needs less",
+                    voxel_size));
+  } catch (const openvdb::Exception& e) {
+    throw InputError(fmt::format("voxel size {} m: OpenVDB cannot build the distance field: {}", voxel_size, e.what()));
+  }
+}
+
+void SdfGrid::build(const std::vector<const TriangleMesh*>& meshes, const std::vector<bool>& solid, float voxel_size,
+                    float band_voxels) {
   const auto xform = openvdb::math::Transform::createLinearTransform(voxel_size);
   background_ = voxel_size * band_voxels;
   for (std::size_t i = 0; i < meshes.size(); ++i) {

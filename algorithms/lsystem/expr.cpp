@@ -4,15 +4,26 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include <fmt/format.h>
+
+#include "core/errors.hpp"
+#include "core/utf8.hpp"
 
 namespace growbench::lsys {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr int kMaxStack = 64;
+
+// A value for a message: "nan" whatever its sign bit (sqrt(-1) gives -nan), else the shortest %g.
+std::string shown(double v) {
+  return std::isnan(v) ? "nan" : fmt::format("{:g}", v);
+}
+// Nesting the recursive-descent parser follows, bounded so that no input runs it off the stack.
+constexpr int kMaxDepth = 200;
 
 struct Function {
   const char* name;
@@ -82,7 +93,7 @@ class Parser {
       if (pos_ >= s_.size()) fail("expected an expression");
       parse_or();
       skip();
-      if (pos_ < s_.size()) fail(fmt::format("unexpected '{}' after the expression", s_[pos_]));
+      if (pos_ < s_.size()) fail(fmt::format("unexpected '{}' after the expression", utf8_char_at(s_, pos_)));
       return true;
     } catch (const ExprError& e) {
       error = e;
@@ -197,7 +208,9 @@ class Parser {
     }
   }
   void parse_unary() {
-    if (++depth_ > 200) fail("expression nested too deeply");
+    if (++depth_ > kMaxDepth)
+      fail(fmt::format("expression nested more than {} deep (parentheses, unary operators, powers and calls)",
+                       kMaxDepth));
     if (accept("-")) {
       parse_unary();
       emit(Op::Neg);
@@ -237,10 +250,16 @@ class Parser {
         ++pos_;
       }
       double v = 0.0;
-      const auto [end, ec] = std::from_chars(s_.data() + start, s_.data() + pos_, v);
-      if (ec != std::errc() || end != s_.data() + pos_) {
+      const std::string_view number = s_.substr(start, pos_ - start);
+      const auto [end, ec] = std::from_chars(number.data(), number.data() + number.size(), v);
+      if (ec == std::errc::result_out_of_range) {
         pos_ = start;
-        fail(fmt::format("malformed number '{}'", s_.substr(start, pos_ - start)));
+        fail(fmt::format("number '{}' is out of range; expected a magnitude from {:g} to {:g}, or 0", number,
+                         std::numeric_limits<double>::min(), std::numeric_limits<double>::max()));
+      }
+      if (ec != std::errc() || end != number.data() + number.size()) {
+        pos_ = start;
+        fail(fmt::format("malformed number '{}'", number));
       }
       emit(Op::Const, 0, v);
       return;
@@ -270,7 +289,7 @@ class Parser {
       load(name, start);
       return;
     }
-    fail(fmt::format("expected a number, a variable, a function call or '(', found '{}'", ch));
+    fail(fmt::format("expected a number, a variable, a function call or '(', found '{}'", utf8_char_at(s_, pos_)));
   }
   void load(std::string_view name, std::size_t at) {
     if (scope_.formals) {
@@ -346,148 +365,225 @@ bool ExprCompiler::compile(std::string_view text, const ExprScope& scope, Expr& 
       double rand(double) const override { return 0.0; }
       double chan(double) const override { return 0.0; }
     } host;
-    const double v = out.eval(nullptr, host);
+    const double v = out.run(nullptr, host);
+    if (!std::isfinite(v)) {
+      error = {0, fmt::format("the expression is always {}, from {}", shown(v), out.diagnose(nullptr, host))};
+      return false;
+    }
     out.code_.assign(1, Instr{Op::Const, 0, v});
   }
   return true;
 }
 
+void Expr::set_origin(std::string origin, bool module_parameter) {
+  origin_ = std::move(origin);
+  module_parameter_ = module_parameter;
+}
+
 double Expr::eval(const double* env, const ExprHost& host) const {
+  const double v = run(env, host);
+  if (!std::isfinite(v) || (module_parameter_ && std::abs(v) > kMaxModuleParameter)) [[unlikely]]
+    fail_eval(env, host, v);
+  return v;
+}
+
+void Expr::fail_eval(const double* env, const ExprHost& host, double value) const {
+  const std::string cause =
+      std::isfinite(value)
+          ? fmt::format("beyond the largest module parameter, {:g} (a 32-bit float)", kMaxModuleParameter)
+          : fmt::format("from {}", diagnose(env, host));
+  throw InputError(
+      fmt::format("{} gave {}, {}", origin_.empty() ? fmt::format("'{}'", text_) : origin_, shown(value), cause));
+}
+
+namespace {
+
+// One instruction on the stack st (sp values). Inlined into both loops below: the evaluation's, and the
+// diagnosis's, which checks every step.
+[[gnu::always_inline]] inline void exec(const Instr& in, double* st, int& sp, const double* env, const ExprHost& host) {
+  switch (in.op) {
+    case Op::Const:
+      st[sp++] = in.value;
+      break;
+    case Op::Load:
+      st[sp++] = env[in.slot];
+      break;
+    case Op::Add:
+      --sp;
+      st[sp - 1] += st[sp];
+      break;
+    case Op::Sub:
+      --sp;
+      st[sp - 1] -= st[sp];
+      break;
+    case Op::Mul:
+      --sp;
+      st[sp - 1] *= st[sp];
+      break;
+    case Op::Div:
+      --sp;
+      st[sp - 1] /= st[sp];
+      break;
+    case Op::Mod:
+      --sp;
+      st[sp - 1] = std::fmod(st[sp - 1], st[sp]);
+      break;
+    case Op::Pow:
+      --sp;
+      st[sp - 1] = std::pow(st[sp - 1], st[sp]);
+      break;
+    case Op::Neg:
+      st[sp - 1] = -st[sp - 1];
+      break;
+    case Op::Not:
+      st[sp - 1] = st[sp - 1] == 0.0 ? 1.0 : 0.0;
+      break;
+    case Op::Lt:
+      --sp;
+      st[sp - 1] = st[sp - 1] < st[sp] ? 1.0 : 0.0;
+      break;
+    case Op::Le:
+      --sp;
+      st[sp - 1] = st[sp - 1] <= st[sp] ? 1.0 : 0.0;
+      break;
+    case Op::Gt:
+      --sp;
+      st[sp - 1] = st[sp - 1] > st[sp] ? 1.0 : 0.0;
+      break;
+    case Op::Ge:
+      --sp;
+      st[sp - 1] = st[sp - 1] >= st[sp] ? 1.0 : 0.0;
+      break;
+    case Op::Eq:
+      --sp;
+      st[sp - 1] = st[sp - 1] == st[sp] ? 1.0 : 0.0;
+      break;
+    case Op::Ne:
+      --sp;
+      st[sp - 1] = st[sp - 1] != st[sp] ? 1.0 : 0.0;
+      break;
+    case Op::And:
+      --sp;
+      st[sp - 1] = (st[sp - 1] != 0.0 && st[sp] != 0.0) ? 1.0 : 0.0;
+      break;
+    case Op::Or:
+      --sp;
+      st[sp - 1] = (st[sp - 1] != 0.0 || st[sp] != 0.0) ? 1.0 : 0.0;
+      break;
+    case Op::Sin:
+      st[sp - 1] = std::sin(st[sp - 1] * kDeg);
+      break;
+    case Op::Cos:
+      st[sp - 1] = std::cos(st[sp - 1] * kDeg);
+      break;
+    case Op::Tan:
+      st[sp - 1] = std::tan(st[sp - 1] * kDeg);
+      break;
+    case Op::Asin:
+      st[sp - 1] = std::asin(std::clamp(st[sp - 1], -1.0, 1.0)) / kDeg;
+      break;
+    case Op::Acos:
+      st[sp - 1] = std::acos(std::clamp(st[sp - 1], -1.0, 1.0)) / kDeg;
+      break;
+    case Op::Atan:
+      st[sp - 1] = std::atan(st[sp - 1]) / kDeg;
+      break;
+    case Op::Atan2:
+      --sp;
+      st[sp - 1] = std::atan2(st[sp - 1], st[sp]) / kDeg;
+      break;
+    case Op::Sqrt:
+      st[sp - 1] = std::sqrt(st[sp - 1]);
+      break;
+    case Op::Abs:
+      st[sp - 1] = std::fabs(st[sp - 1]);
+      break;
+    case Op::Floor:
+      st[sp - 1] = std::floor(st[sp - 1]);
+      break;
+    case Op::Ceil:
+      st[sp - 1] = std::ceil(st[sp - 1]);
+      break;
+    case Op::Min:
+      --sp;
+      st[sp - 1] = std::min(st[sp - 1], st[sp]);
+      break;
+    case Op::Max:
+      --sp;
+      st[sp - 1] = std::max(st[sp - 1], st[sp]);
+      break;
+    case Op::Clamp:
+      sp -= 2;
+      st[sp - 1] = std::clamp(st[sp - 1], std::min(st[sp], st[sp + 1]), std::max(st[sp], st[sp + 1]));
+      break;
+    case Op::Rand:
+      st[sp - 1] = host.rand(st[sp - 1]);
+      break;
+    case Op::Chan:
+      st[sp - 1] = host.chan(st[sp - 1]);
+      break;
+    case Op::In:
+      sp -= 2;
+      st[sp - 1] = host.in(st[sp - 1], st[sp], st[sp + 1]);
+      break;
+    case Op::Pic:
+      sp -= 2;
+      st[sp - 1] = host.pic(st[sp - 1], st[sp], st[sp + 1]);
+      break;
+  }
+}
+
+std::string describe(Op op, const double* args, int n) {
+  auto finite_args = [&] {
+    for (int k = 0; k < n; ++k)
+      if (!std::isfinite(args[k])) return false;
+    return true;
+  };
+  if (!finite_args()) return "a value that was not finite";
+  switch (op) {
+    case Op::Div:
+      return args[1] == 0.0 ? "a division by zero" : "an overflow in '/'";
+    case Op::Mod:
+      return "a remainder (%) of a division by zero";
+    case Op::Mul:
+      return "an overflow in '*'";
+    case Op::Add:
+    case Op::Sub:
+      return "an overflow in '+' or '-'";
+    case Op::Pow:
+      return args[0] < 0.0 ? "a negative number to a fractional power (^ or pow)" : "an overflow in '^' or pow()";
+    case Op::Sqrt:
+      return "the square root of a negative number";
+    case Op::Tan:
+      return "tan() at an odd multiple of 90 degrees";
+    case Op::Load:
+      return "a variable that was not finite";
+    default:
+      return "a function's result that was not finite";
+  }
+}
+
+}  // namespace
+
+double Expr::run(const double* env, const ExprHost& host) const {
+  double st[kMaxStack];
+  int sp = 0;
+  for (const Instr& in : code_) exec(in, st, sp, env, host);
+  return st[0];
+}
+
+std::string Expr::diagnose(const double* env, const ExprHost& host) const {
   double st[kMaxStack];
   int sp = 0;
   for (const Instr& in : code_) {
-    switch (in.op) {
-      case Op::Const:
-        st[sp++] = in.value;
-        break;
-      case Op::Load:
-        st[sp++] = env[in.slot];
-        break;
-      case Op::Add:
-        --sp;
-        st[sp - 1] += st[sp];
-        break;
-      case Op::Sub:
-        --sp;
-        st[sp - 1] -= st[sp];
-        break;
-      case Op::Mul:
-        --sp;
-        st[sp - 1] *= st[sp];
-        break;
-      case Op::Div:
-        --sp;
-        st[sp - 1] /= st[sp];
-        break;
-      case Op::Mod:
-        --sp;
-        st[sp - 1] = std::fmod(st[sp - 1], st[sp]);
-        break;
-      case Op::Pow:
-        --sp;
-        st[sp - 1] = std::pow(st[sp - 1], st[sp]);
-        break;
-      case Op::Neg:
-        st[sp - 1] = -st[sp - 1];
-        break;
-      case Op::Not:
-        st[sp - 1] = st[sp - 1] == 0.0 ? 1.0 : 0.0;
-        break;
-      case Op::Lt:
-        --sp;
-        st[sp - 1] = st[sp - 1] < st[sp] ? 1.0 : 0.0;
-        break;
-      case Op::Le:
-        --sp;
-        st[sp - 1] = st[sp - 1] <= st[sp] ? 1.0 : 0.0;
-        break;
-      case Op::Gt:
-        --sp;
-        st[sp - 1] = st[sp - 1] > st[sp] ? 1.0 : 0.0;
-        break;
-      case Op::Ge:
-        --sp;
-        st[sp - 1] = st[sp - 1] >= st[sp] ? 1.0 : 0.0;
-        break;
-      case Op::Eq:
-        --sp;
-        st[sp - 1] = st[sp - 1] == st[sp] ? 1.0 : 0.0;
-        break;
-      case Op::Ne:
-        --sp;
-        st[sp - 1] = st[sp - 1] != st[sp] ? 1.0 : 0.0;
-        break;
-      case Op::And:
-        --sp;
-        st[sp - 1] = (st[sp - 1] != 0.0 && st[sp] != 0.0) ? 1.0 : 0.0;
-        break;
-      case Op::Or:
-        --sp;
-        st[sp - 1] = (st[sp - 1] != 0.0 || st[sp] != 0.0) ? 1.0 : 0.0;
-        break;
-      case Op::Sin:
-        st[sp - 1] = std::sin(st[sp - 1] * kDeg);
-        break;
-      case Op::Cos:
-        st[sp - 1] = std::cos(st[sp - 1] * kDeg);
-        break;
-      case Op::Tan:
-        st[sp - 1] = std::tan(st[sp - 1] * kDeg);
-        break;
-      case Op::Asin:
-        st[sp - 1] = std::asin(std::clamp(st[sp - 1], -1.0, 1.0)) / kDeg;
-        break;
-      case Op::Acos:
-        st[sp - 1] = std::acos(std::clamp(st[sp - 1], -1.0, 1.0)) / kDeg;
-        break;
-      case Op::Atan:
-        st[sp - 1] = std::atan(st[sp - 1]) / kDeg;
-        break;
-      case Op::Atan2:
-        --sp;
-        st[sp - 1] = std::atan2(st[sp - 1], st[sp]) / kDeg;
-        break;
-      case Op::Sqrt:
-        st[sp - 1] = std::sqrt(st[sp - 1]);
-        break;
-      case Op::Abs:
-        st[sp - 1] = std::fabs(st[sp - 1]);
-        break;
-      case Op::Floor:
-        st[sp - 1] = std::floor(st[sp - 1]);
-        break;
-      case Op::Ceil:
-        st[sp - 1] = std::ceil(st[sp - 1]);
-        break;
-      case Op::Min:
-        --sp;
-        st[sp - 1] = std::min(st[sp - 1], st[sp]);
-        break;
-      case Op::Max:
-        --sp;
-        st[sp - 1] = std::max(st[sp - 1], st[sp]);
-        break;
-      case Op::Clamp:
-        sp -= 2;
-        st[sp - 1] = std::clamp(st[sp - 1], std::min(st[sp], st[sp + 1]), std::max(st[sp], st[sp + 1]));
-        break;
-      case Op::Rand:
-        st[sp - 1] = host.rand(st[sp - 1]);
-        break;
-      case Op::Chan:
-        st[sp - 1] = host.chan(st[sp - 1]);
-        break;
-      case Op::In:
-        sp -= 2;
-        st[sp - 1] = host.in(st[sp - 1], st[sp], st[sp + 1]);
-        break;
-      case Op::Pic:
-        sp -= 2;
-        st[sp - 1] = host.pic(st[sp - 1], st[sp], st[sp + 1]);
-        break;
-    }
+    // The operands, as they were before the instruction consumed them.
+    const int n = std::max(0, 1 - stack_effect(in.op));
+    double args[3] = {0.0, 0.0, 0.0};
+    for (int k = 0; k < std::min(n, 3); ++k) args[k] = st[sp - n + k];
+    exec(in, st, sp, env, host);
+    if (!std::isfinite(st[sp - 1])) return describe(in.op, args, n);
   }
-  return st[0];
+  return "an operation";
 }
 
 }  // namespace growbench::lsys

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -111,7 +112,13 @@ struct ExprUse {
 class Expr {
  public:
   Expr() = default;
+  // The value. A value that is not finite (a division by zero, an overflow), or beyond a 32-bit float
+  // for an expression whose value becomes a module's parameter, is an InputError naming the origin and
+  // the operation that made it (see set_origin).
   [[nodiscard]] double eval(const double* env, const ExprHost& host) const;
+  // What eval's errors name: "FILE:LINE:COL: in rule '...': the condition 'x/y'". `module_parameter`:
+  // the value is stored as a module's parameter, a 32-bit float.
+  void set_origin(std::string origin, bool module_parameter);
   [[nodiscard]] bool empty() const { return code_.empty(); }
   [[nodiscard]] bool constant() const { return code_.size() == 1 && code_[0].op == Op::Const; }
   [[nodiscard]] double constant_value() const { return code_[0].value; }
@@ -120,10 +127,19 @@ class Expr {
 
  private:
   friend class ExprCompiler;
+  [[nodiscard]] double run(const double* env, const ExprHost& host) const;
+  // Which operation first made a value that is not finite, for messages ("a division by zero").
+  [[nodiscard]] std::string diagnose(const double* env, const ExprHost& host) const;
+  [[noreturn]] void fail_eval(const double* env, const ExprHost& host, double value) const;
   std::vector<Instr> code_;
   ExprUse use_;
   std::string text_;
+  std::string origin_;
+  bool module_parameter_ = false;
 };
+
+// The largest magnitude a module's parameter holds: the parameters are 32-bit floats.
+inline constexpr double kMaxModuleParameter = std::numeric_limits<float>::max();
 
 // A compile error: `offset` is the byte offset into the expression text where the problem is.
 struct ExprError {

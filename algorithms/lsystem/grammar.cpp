@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -11,6 +13,7 @@
 #include "algorithms/lsystem/lstring.hpp"
 #include "core/errors.hpp"
 #include "core/params.hpp"
+#include "core/utf8.hpp"
 
 namespace growbench::lsys {
 
@@ -20,6 +23,12 @@ bool is_symbol_char(char c) {
 
 namespace {
 
+// The most of a rule or an expression a message quotes.
+constexpr std::size_t kQuoted = 80;
+
+// What a character that is not a symbol is told.
+constexpr const char* kSymbolsAre = "symbols are printable ASCII characters other than ( ) , : = < >";
+
 // A view of part of one line that knows its columns, for messages.
 struct Span {
   std::string_view text;
@@ -28,7 +37,10 @@ struct Span {
 
 class LineParser {
  public:
-  LineParser(std::string where, Grammar& g) : where_(std::move(where)), g_(g) {}
+  // `where`: "SOURCE:LINE"; `context`: what the line is, for the errors of its expressions at derivation
+  // ("rule 'A(x) = B(x/2)'", "the premise").
+  LineParser(std::string where, std::string context, Grammar& g)
+      : where_(std::move(where)), context_(std::move(context)), g_(g) {}
 
   [[noreturn]] void fail(std::size_t column, const std::string& what) const {
     throw InputError(fmt::format("{}:{}: {}", where_, column, what));
@@ -73,7 +85,8 @@ class LineParser {
         ++k;
         continue;
       }
-      if (!is_symbol_char(c)) fail(s.column + k, fmt::format("expected a symbol, found '{}'", c));
+      if (!is_symbol_char(c))
+        fail(s.column + k, fmt::format("expected a symbol, found '{}' ({})", utf8_char_at(s.text, k), kSymbolsAre));
       if ((c == '[' || c == ']') && !allow_brackets)
         fail(s.column + k, "a predecessor or left context cannot contain '[' or ']'");
       Pattern p;
@@ -111,13 +124,19 @@ class LineParser {
     return out;
   }
 
-  Expr expression(Span s, const ExprScope& scope, const char* what) const {
+  // `module_parameter`: the value becomes a module's parameter (see Expr::set_origin).
+  Expr expression(Span s, const ExprScope& scope, const char* what, bool module_parameter = false) const {
     const Span t = trim(s);
     if (t.text.empty()) fail(s.column, fmt::format("expected {}", what));
     Expr e;
     ExprError err;
     if (!ExprCompiler::compile(t.text, scope, e, err))
       fail(t.column + err.offset, fmt::format("in {}: {}", what, err.message));
+    if (module_parameter && e.constant() && std::abs(e.constant_value()) > kMaxModuleParameter)
+      fail(t.column, fmt::format("{} {:g} is out of range; a module's parameter is a 32-bit float, at most {:g}", what,
+                                 e.constant_value(), kMaxModuleParameter));
+    e.set_origin(fmt::format("{}:{}: in {}: {} '{}'", where_, t.column, context_, what, utf8_excerpt(t.text, kQuoted)),
+                 module_parameter);
     return e;
   }
 
@@ -131,7 +150,8 @@ class LineParser {
         ++k;
         continue;
       }
-      if (!is_symbol_char(c)) fail(s.column + k, fmt::format("expected a symbol, found '{}'", c));
+      if (!is_symbol_char(c))
+        fail(s.column + k, fmt::format("expected a symbol, found '{}' ({})", utf8_char_at(s.text, k), kSymbolsAre));
       OutModule m;
       m.symbol = c;
       ++k;
@@ -172,7 +192,7 @@ class LineParser {
             ExprCompiler::compile(std::to_string(it - g_.strings.begin()), scope, e, err);
             m.args.push_back(std::move(e));
           } else {
-            m.args.push_back(expression(arg, scope, "a parameter expression"));
+            m.args.push_back(expression(arg, scope, "the parameter expression", true));
           }
           start = commas[a] + 1;
         }
@@ -188,6 +208,7 @@ class LineParser {
   Rule rule(Span line) {
     Rule r;
     r.text = std::string(trim(line).text);
+    context_ = fmt::format("rule '{}'", utf8_excerpt(r.text, kQuoted));
     // the separator: the first top-level "->", else the last lone top-level "="
     std::size_t sep = std::string_view::npos, sep_len = 1;
     const auto arrows = top_level(
@@ -295,6 +316,7 @@ class LineParser {
 
  private:
   std::string where_;
+  std::string context_;
   Grammar& g_;
 };
 
@@ -319,12 +341,18 @@ bool blank_or_comment(std::string_view l) {
   return k == l.size() || l[k] == '#';
 }
 
+// The file's text without the UTF-8 byte order mark some editors put first (columns count from after it).
 std::string read_text(const std::string& path, const char* what) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw InputError(fmt::format("cannot read {} '{}': it is a directory", what, path));
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(fmt::format("cannot read {} '{}'", what, path));
   std::ostringstream ss;
   ss << in.rdbuf();
-  return ss.str();
+  std::string text = ss.str();
+  if (text.starts_with(kUtf8Bom)) text.erase(0, kUtf8Bom.size());
+  return text;
 }
 
 }  // namespace
@@ -333,17 +361,19 @@ Grammar parse_grammar(const GrammarText& premise, const std::vector<GrammarText>
                       const std::vector<std::string>& user_variables, const std::string& ignore) {
   Grammar g;
   g.user_variables = user_variables;
-  for (char c : ignore) {
+  for (std::size_t k = 0; k < ignore.size(); ++k) {
+    const char c = ignore[k];
     if (std::isspace(static_cast<unsigned char>(c))) continue;
-    if (!is_symbol_char(c)) throw InputError(fmt::format("context_ignore: '{}' is not a symbol", c));
+    if (!is_symbol_char(c))
+      throw InputError(fmt::format("context_ignore: '{}' is not a symbol ({})", utf8_char_at(ignore, k), kSymbolsAre));
     g.ignore.set(static_cast<unsigned char>(c));
   }
   for (const auto& src : rules) {
     const auto lines = split_lines(src.text);
     for (std::size_t k = 0; k < lines.size(); ++k) {
       if (blank_or_comment(lines[k])) continue;
-      LineParser p(fmt::format("{}:{}", src.source, src.first_line + k), g);
-      Rule r = p.rule({lines[k], 1});
+      LineParser p(fmt::format("{}:{}", src.source, src.first_line + k), "a rule", g);
+      Rule r = p.rule({lines[k], k == 0 ? src.first_column : 1});
       r.where = fmt::format("{}:{}", src.source, src.first_line + k);
       if (g.rules.size() >= 65535) throw InputError(fmt::format("{}: too many rules", r.where));
       g.rules_for[static_cast<unsigned char>(r.pred.symbol)].push_back(static_cast<std::uint16_t>(g.rules.size()));
@@ -357,9 +387,9 @@ Grammar parse_grammar(const GrammarText& premise, const std::vector<GrammarText>
   {
     const auto lines = split_lines(premise.text);
     for (std::size_t k = 0; k < lines.size(); ++k) {
-      LineParser p(fmt::format("{}:{}", premise.source, premise.first_line + k), g);
+      LineParser p(fmt::format("{}:{}", premise.source, premise.first_line + k), "the premise", g);
       const ExprScope scope{nullptr, &g.user_variables};
-      auto mods = p.modules({lines[k], 1}, scope);
+      auto mods = p.modules({lines[k], k == 0 ? premise.first_column : 1}, scope);
       for (auto& m : mods) {
         for (const auto& a : m.args) {
           g.uses_turtle |= a.use().turtle;
@@ -401,8 +431,8 @@ GrammarFile read_grammar_file(const std::string& path, const std::vector<std::st
                                        near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near),
                                        fmt::join(known_settings, ", ")));
         }
-        std::string value(LineParser::trim({l.substr(c + 1), c + 2}).text);
-        f.settings.push_back({key, value, k + 1});
+        const Span value = LineParser::trim({l.substr(c + 1), c + 2});
+        f.settings.push_back({key, std::string(value.text), k + 1, value.column});
       }
     }
     if (!is_setting && !blank_or_comment(l)) rules.append(l);
@@ -414,6 +444,10 @@ GrammarFile read_grammar_file(const std::string& path, const std::vector<std::st
 
 GrammarText read_rules_file(const std::string& path) {
   return {path, read_text(path, "rules file"), 1};
+}
+
+GrammarText GrammarFile::setting_text(const Setting& setting) const {
+  return {path, setting.value, setting.line, setting.column};
 }
 
 std::vector<std::pair<std::string, double>> parse_variables(const std::string& source, const std::string& text) {
@@ -436,8 +470,10 @@ std::vector<std::pair<std::string, double>> parse_variables(const std::string& s
             "{}: '{}' is a reserved variable (a g i t x y z A L T U V W); choose another letter", source, name));
       double v = 0.0;
       const auto [p, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
-      if (ec != std::errc() || p != value.data() + value.size() || value.empty())
-        throw InputError(fmt::format("{}: variable '{}': expected a number, found '{}'", source, name, value));
+      if (ec == std::errc::result_out_of_range)
+        throw InputError(fmt::format("{}: variable '{}': the number '{}' is out of range", source, name, value));
+      if (ec != std::errc() || p != value.data() + value.size() || value.empty() || !std::isfinite(v))
+        throw InputError(fmt::format("{}: variable '{}': expected a finite number, found '{}'", source, name, value));
       for (const auto& [n, _] : out)
         if (n == name) throw InputError(fmt::format("{}: variable '{}' is given twice", source, name));
       out.emplace_back(name, v);

@@ -59,7 +59,8 @@ struct Rule {
 struct GrammarText {
   std::string source;
   std::string text;
-  std::size_t first_line = 1;  // line number of the text's first line in `source`
+  std::size_t first_line = 1;    // line number of the text's first line in `source`
+  std::size_t first_column = 1;  // column of the text's first character on that line
 };
 
 struct Grammar {
@@ -88,11 +89,16 @@ struct GrammarFile {
   struct Setting {
     std::string key, value;
     std::size_t line;
+    std::size_t column;  // of the value's first character
   };
   std::string path;
   std::vector<Setting> settings;
   GrammarText rules;  // the rule lines (others blanked so line numbers stay true)
+  // A setting's value as grammar text that knows its place in the file (for the premise: errors then
+  // name PATH:LINE:COLUMN).
+  [[nodiscard]] GrammarText setting_text(const Setting& setting) const;
 };
+// A UTF-8 byte order mark at the top of the file is skipped.
 GrammarFile read_grammar_file(const std::string& path, const std::vector<std::string>& known_settings);
 // A rules file as Houdini's "Read Rules From File" reads it: one rule per line, '#' comments.
 GrammarText read_rules_file(const std::string& path);

@@ -15,6 +15,7 @@
 #include "algorithms/plugins/plugin_algorithm.hpp"
 #include "core/errors.hpp"
 #include "core/file_hash.hpp"
+#include "core/utf8.hpp"
 #include "growbench/plugin.h"
 
 namespace growbench {
@@ -33,24 +34,36 @@ std::deque<Loaded>& loaded() {
   return list;
 }
 
-bool valid_name(const char* s) {
-  if (!s || !*s) return false;
+// Why `s` cannot be a name ([a-z0-9_]+), or "" when it can.
+std::string name_problem(const char* s) {
+  if (!s) return "its name is NULL";
+  if (!*s) return "its name is empty";
   for (const char* c = s; *c; ++c)
-    if (!((*c >= 'a' && *c <= 'z') || (*c >= '0' && *c <= '9') || *c == '_')) return false;
-  return true;
+    if (!((*c >= 'a' && *c <= 'z') || (*c >= '0' && *c <= '9') || *c == '_'))
+      return fmt::format("its name '{}' has '{}'; expected a-z, 0-9 and _ only", escape_utf8(s),
+                         utf8_char_at(s, static_cast<std::size_t>(c - s)));
+  return {};
 }
 
 std::string text_or_empty(const char* s) {
   return s ? s : "";
 }
 
+// `s` (which may be NULL), when it is UTF-8; std::invalid_argument naming `what` otherwise. What a table
+// says is printed and written to records, which are JSON.
+std::string utf8_text(const char* s, const std::string& what) {
+  std::string t = text_or_empty(s);
+  if (!is_valid_utf8(t)) throw std::invalid_argument(fmt::format("{} '{}' is not valid UTF-8", what, escape_utf8(t)));
+  return t;
+}
+
 // One row of the plugin's table as a ParamSpec; throws std::invalid_argument saying what is wrong.
 ParamSpec read_row(const growbench_param& r) {
-  if (!valid_name(r.name)) throw std::invalid_argument("its name must be non-empty and of a-z, 0-9 and _");
+  if (const std::string why = name_problem(r.name); !why.empty()) throw std::invalid_argument(why);
   ParamSpec s;
   s.name = r.name;
-  s.unit = text_or_empty(r.unit);
-  s.doc = text_or_empty(r.doc);
+  s.unit = utf8_text(r.unit, "its unit");
+  s.doc = utf8_text(r.doc, "its doc");
   const bool ranged = r.type == GROWBENCH_PARAM_INT || r.type == GROWBENCH_PARAM_REAL || r.type == GROWBENCH_PARAM_VEC3;
   if (ranged) {
     if (std::isnan(r.min) || std::isnan(r.max) || r.min > r.max)
@@ -81,7 +94,7 @@ ParamSpec read_row(const growbench_param& r) {
       break;
     case GROWBENCH_PARAM_STRING:
       s.type = ParamType::String;
-      s.default_value = text_or_empty(r.default_value.text);
+      s.default_value = utf8_text(r.default_value.text, "its default");
       break;
     case GROWBENCH_PARAM_VEC3:
       s.type = ParamType::Vec3;
@@ -93,13 +106,17 @@ ParamSpec read_row(const growbench_param& r) {
       if (r.choice_count == 0 || !r.choices) throw std::invalid_argument("a choice without choices");
       std::set<std::string> seen;
       for (std::uint32_t k = 0; k < r.choice_count; ++k) {
-        if (!r.choices[k] || !*r.choices[k]) throw std::invalid_argument(fmt::format("choice {} is empty", k));
+        if (!r.choices[k]) throw std::invalid_argument(fmt::format("choice {} is NULL", k));
+        if (!*r.choices[k]) throw std::invalid_argument(fmt::format("choice {} is empty", k));
+        (void)utf8_text(r.choices[k], fmt::format("choice {}", k));
         if (!seen.insert(r.choices[k]).second)
           throw std::invalid_argument(fmt::format("choice '{}' is listed twice", r.choices[k]));
         s.choices.emplace_back(r.choices[k]);
       }
-      const std::string d = text_or_empty(r.default_value.text);
-      if (!seen.count(d)) throw std::invalid_argument(fmt::format("its default '{}' is not one of its choices", d));
+      if (!r.default_value.text) throw std::invalid_argument("its default is NULL; expected one of its choices");
+      const std::string d = r.default_value.text;
+      if (!seen.count(d))
+        throw std::invalid_argument(fmt::format("its default '{}' is not one of its choices", escape_utf8(d)));
       s.default_value = d;
       break;
     }
@@ -113,14 +130,15 @@ ParamSpec read_row(const growbench_param& r) {
 // built before them still loads (and the host reads no member beyond its struct_size).
 constexpr std::size_t kTableSizeV1 = offsetof(growbench_plugin, destroy) + sizeof(growbench_plugin::destroy);
 
-// The plugin's descriptive members as an AlgorithmInfo; InputError naming the file for what is malformed.
-AlgorithmInfo read_table(const std::string& path, const growbench_plugin& t) {
+}  // namespace
+
+AlgorithmInfo read_plugin_table(const std::string& path, const growbench_plugin& t) {
   auto bad = [&](const std::string& what) {
     return InputError(fmt::format("{}: malformed plugin table: {}", path, what));
   };
   if (t.struct_size < kTableSizeV1)
     throw bad(fmt::format("struct_size {} is smaller than ABI {}'s {}", t.struct_size, t.abi_version, kTableSizeV1));
-  if (!valid_name(t.name)) throw bad("its name must be non-empty and of a-z, 0-9 and _");
+  if (const std::string why = name_problem(t.name); !why.empty()) throw bad(why);
   if (!t.create || !t.start || !t.step || !t.finish || !t.plant || !t.destroy)
     throw bad("create, start, step, finish, plant and destroy must all be set");
   if (t.param_count > 0 && !t.params) throw bad(fmt::format("param_count is {} but params is NULL", t.param_count));
@@ -128,21 +146,27 @@ AlgorithmInfo read_table(const std::string& path, const growbench_plugin& t) {
     throw bad(fmt::format("test_param_count is {} but test_params is NULL", t.test_param_count));
   AlgorithmInfo info;
   info.name = t.name;
-  info.summary = text_or_empty(t.summary);
+  try {
+    info.summary = utf8_text(t.summary, "its summary");
+    (void)utf8_text(t.version, "its version");
+  } catch (const std::invalid_argument& e) {
+    throw bad(e.what());
+  }
   std::set<std::string> names;
   for (std::uint32_t i = 0; i < t.param_count; ++i) {
     const growbench_param& r = t.params[i];
     try {
       info.params.push_back(read_row(r));
     } catch (const std::invalid_argument& e) {
-      throw bad(fmt::format("parameter {} ('{}'): {}", i, text_or_empty(r.name), e.what()));
+      throw bad(fmt::format("parameter {} ('{}'): {}", i, escape_utf8(text_or_empty(r.name)), e.what()));
     }
     if (!names.insert(info.params.back().name).second)
       throw bad(fmt::format("parameter {} ('{}') is declared twice", i, info.params.back().name));
   }
   Params check(fmt::format("plugin '{}'", info.name), info.params);
   for (std::uint32_t i = 0; i < t.test_param_count; ++i) {
-    const std::string a = text_or_empty(t.test_params[i]);
+    if (!t.test_params[i]) throw bad(fmt::format("test_params[{}] is NULL; expected key=value", i));
+    const std::string a = t.test_params[i];
     try {
       check.set_assignment(a);
     } catch (const InputError& e) {
@@ -152,6 +176,8 @@ AlgorithmInfo read_table(const std::string& path, const growbench_plugin& t) {
   }
   return info;
 }
+
+namespace {
 
 const growbench_plugin* open_plugin(const std::string& path) {
   std::error_code ec;
@@ -198,7 +224,7 @@ const AlgorithmEntry& load_plugin(const std::string& given) {
   for (const auto& l : loaded())
     if (l.path == path) return l.entry;
   const growbench_plugin* t = open_plugin(path);
-  AlgorithmInfo info = read_table(path, *t);
+  AlgorithmInfo info = read_plugin_table(path, *t);
   check_name_free(path, info.name);
   auto origin = std::make_shared<PluginOrigin>(
       PluginOrigin{info.name, path, file_hash(path), t->abi_version, text_or_empty(t->version)});

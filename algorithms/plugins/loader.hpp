@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "algorithms/algorithm.hpp"
+#include "growbench/plugin.h"
 
 namespace growbench {
 
@@ -16,6 +17,10 @@ namespace growbench {
 // has no growbench_plugin_entry, speaks another ABI version, takes a name already taken, or has a
 // malformed table.
 const AlgorithmEntry& load_plugin(const std::string& path);
+// The checks load_plugin makes of a plugin's table, on their own (for tests and fuzzing): its name,
+// functions, parameter rows (names, types, ranges, finite defaults in range, choices, UTF-8 text, no
+// duplicates) and test parameters. InputError "PATH: malformed plugin table: ..." naming the row.
+AlgorithmInfo read_plugin_table(const std::string& path, const growbench_plugin& table);
 // Loads `paths` in order, then every *.so in the directories GROWBENCH_PLUGIN_PATH names (separated
 // by ':', each directory's files in name order).
 void load_plugins(const std::vector<std::string>& paths);

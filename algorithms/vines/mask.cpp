@@ -1,7 +1,10 @@
 #include "algorithms/vines/mask.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <filesystem>
+#include <fstream>
+#include <string_view>
 #include <memory>
 
 #include <fmt/format.h>
@@ -11,20 +14,64 @@
 
 namespace growbench::vines {
 
+namespace {
+
+constexpr int kMaxSide = 16384;  // a map is looked up per attractor candidate and never needs more
+
+// stb_image's terse reason for a PNG it cannot decode, in words.
+std::string decode_failure(const char* reason) {
+  const std::string r = reason ? reason : "";
+  if (r == "outofdata" || r == "no IEND" || r == "no IDAT" || r == "not enough pixels")
+    return fmt::format("the file ends before its image data does: truncated? (stb_image: {})", r);
+  if (r.starts_with("bad") || r == "zlib corrupt" || r == "read past buffer" || r == "output buffer limit" ||
+      r == "too many codes")
+    return fmt::format("its compressed image data is corrupt (stb_image: {})", r);
+  return fmt::format("stb_image: {}", r.empty() ? "unknown failure" : r);
+}
+
+// Width and height as the PNG's header (IHDR, bytes 16 to 23, big-endian) gives them, when it has one.
+bool header_size(const std::string& bytes, std::uint32_t& w, std::uint32_t& h) {
+  if (bytes.size() < 24 || bytes.compare(12, 4, "IHDR") != 0) return false;
+  auto be32 = [&](std::size_t at) {
+    std::uint32_t v = 0;
+    for (std::size_t k = 0; k < 4; ++k) v = (v << 8) | static_cast<unsigned char>(bytes[at + k]);
+    return v;
+  };
+  w = be32(16);
+  h = be32(20);
+  return true;
+}
+
+}  // namespace
+
 Mask Mask::read(const std::string& path, const std::string& key) {
   if (!std::filesystem::exists(path))
     throw InputError(fmt::format("{}={}: no such file (expected a PNG inclusion/exclusion map)", key, path));
   if (!std::filesystem::is_regular_file(path))
     throw InputError(fmt::format("{}={}: not a file (expected a PNG inclusion/exclusion map)", key, path));
-  int w = 0, h = 0, channels = 0;
-  // Refuse absurd sizes before decoding: a map is looked up per attractor candidate, never needs more.
-  if (stbi_info(path.c_str(), &w, &h, &channels) == 0)
-    throw InputError(fmt::format("{}={}: not a readable image ({}); expected a PNG", key, path, stbi_failure_reason()));
-  if (w <= 0 || h <= 0 || w > 16384 || h > 16384)
+  std::string head(24, '\0');
+  {
+    std::ifstream in(path, std::ios::binary);
+    in.read(head.data(), static_cast<std::streamsize>(head.size()));
+    head.resize(static_cast<std::size_t>(in.gcount()));
+  }
+  constexpr std::string_view kPngSignature = "\x89PNG\r\n\x1a\n";
+  if (!head.starts_with(kPngSignature))
+    throw InputError(fmt::format(
+        "{}={}: not a readable image: it is not a PNG (its first bytes are not the PNG signature)", key, path));
+  // Refuse absurd sizes before decoding, from the header itself: stb_image refuses them too, but says only
+  // that it does not know the file's type.
+  std::uint32_t hw = 0, hh = 0;
+  if (header_size(head, hw, hh) && (hw == 0 || hh == 0 || hw > kMaxSide || hh > kMaxSide))
     throw InputError(
-        fmt::format("{}={}: the image is {} x {} pixels; expected 1 to 16384 on each side", key, path, w, h));
+        fmt::format("{}={}: the image is {} x {} pixels; expected 1 to {} on each side", key, path, hw, hh, kMaxSide));
+  int w = 0, h = 0, channels = 0;
+  if (stbi_info(path.c_str(), &w, &h, &channels) == 0)
+    throw InputError(fmt::format("{}={}: not a readable image: {}", key, path, decode_failure(stbi_failure_reason())));
   std::unique_ptr<stbi_uc, void (*)(void*)> px(stbi_load(path.c_str(), &w, &h, &channels, 4), &stbi_image_free);
-  if (!px) throw InputError(fmt::format("{}={}: cannot decode the image ({})", key, path, stbi_failure_reason()));
+  if (!px)
+    throw InputError(
+        fmt::format("{}={}: cannot decode the image: {}", key, path, decode_failure(stbi_failure_reason())));
   Mask m;
   m.width_ = w;
   m.height_ = h;

@@ -14,9 +14,9 @@ namespace growbench::vines {
 
 class Mask {
  public:
-  // Reads PATH; `key` names the parameter in errors. InputError for a file that is missing, not an image,
-  // or empty. Red: R at least 128 and at least twice G and B; green: the same with G; a pixel with alpha
-  // below 128 is neither.
+  // Reads PATH; `key` names the parameter in errors. InputError for a file that is missing, not a PNG,
+  // truncated or corrupt, or 0 or more than 16384 pixels on a side. Red: R at least 128 and at least twice G and B;
+  // green: the same with G; a pixel with alpha below 128 is neither.
   static Mask read(const std::string& path, const std::string& key);
 
   [[nodiscard]] int width() const { return width_; }

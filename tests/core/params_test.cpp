@@ -125,5 +125,28 @@ TEST(Params, Json) {
   EXPECT_EQ(j["mode"], "open");
 }
 
+// A JSON integer beyond int64 wrapped (18446744073709551615 read as -1), and a whole real beyond it was
+// cast with undefined behaviour.
+TEST(Params, JsonIntegersOutOfRangeAreRefused) {
+  Params p("suite entry", {param::integer("count", 10)});
+  EXPECT_EQ(error_of([&] { p.set_json("count", nlohmann::json::parse("18446744073709551615")); }),
+            "parameter 'count' of suite entry: value 18446744073709551615 is out of range; expected an integer");
+  EXPECT_EQ(error_of([&] { p.set_json("count", nlohmann::json(1e300)); }),
+            "parameter 'count' of suite entry: value 1e+300 is out of range; expected an integer");
+  p.set_json("count", nlohmann::json(1e6));
+  EXPECT_EQ(p.integer("count"), 1000000);
+  EXPECT_EQ(error_of([&] { p.set("count", "1e300"); }),
+            "parameter 'count' of suite entry: cannot read '1e300'; expected an integer");
+}
+
+// A text value goes into records and journals, which are JSON: bytes that are not UTF-8 cannot.
+TEST(Params, TextMustBeValidUtf8) {
+  Params p("algorithm 'x'", specs());
+  EXPECT_EQ(error_of([&] { p.set("file", "a\xC3.png"); }),
+            "parameter 'file' of algorithm 'x': value 'a\\xc3.png' is not valid UTF-8 text; expected a string");
+  p.set("file", "caf\xC3\xA9.png");
+  EXPECT_EQ(p.text("file"), "caf\xC3\xA9.png");
+}
+
 }  // namespace
 }  // namespace growbench

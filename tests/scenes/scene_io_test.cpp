@@ -1,3 +1,4 @@
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "scenes/scene_library.hpp"
@@ -174,6 +175,67 @@ TEST(JsonScene, ErrorsNameFileAndJsonPath) {
     EXPECT_NE(e.find(c.expect), std::string::npos) << "got: " << e << "\nwanted: " << c.expect;
     EXPECT_NE(e.find("s.json"), std::string::npos) << e;
   }
+}
+
+// A base that leads back to its own file recursed until the stack ran out (SIGSEGV).
+TEST(JsonScene, BasesThatFormACycleAreNamed) {
+  const auto dir = test::temp_dir("jsoncycle");
+  const std::string self = test::write_text(dir / "self.json", R"({"schema_version": 1, "base": "self.json"})");
+  EXPECT_EQ(error_of([&] { load_scene(self); }),
+            fmt::format("{0}: at /base: the scene bases form a cycle: {0} -> {0}", self));
+  const std::string a = test::write_text(dir / "a.json", R"({"schema_version": 1, "base": "b.json"})");
+  const std::string b = test::write_text(dir / "b.json", R"({"schema_version": 1, "base": "a.json"})");
+  EXPECT_EQ(error_of([&] { load_scene(a); }),
+            fmt::format("{1}: at /base: the scene bases form a cycle: {0} -> {1} -> {0}", a, b));
+}
+
+TEST(JsonScene, BasesNestAtMostSixteenFilesDeep) {
+  const auto dir = test::temp_dir("jsondeep");
+  // base0.json has a real base; each next file is based on the one before.
+  test::write_text(dir / "base0.json", R"({"schema_version": 1, "base": "wall"})");
+  for (int k = 1; k <= 16; ++k)
+    test::write_text(dir / fmt::format("base{}.json", k),
+                     fmt::format(R"({{"schema_version": 1, "base": "base{}.json"}})", k - 1));
+  EXPECT_EQ(load_scene((dir / "base15.json").string()).meshes.size(), load_scene("wall").meshes.size());
+  const std::string e = error_of([&] { load_scene((dir / "base16.json").string()); });
+  EXPECT_EQ(e.rfind((dir / "base1.json").string() + ": at /base: scene bases nest more than 16 files deep: ", 0), 0u)
+      << e;
+}
+
+// tinyobjloader reads what it cannot parse as 0 and indices with atoi, silently.
+TEST(MeshScene, ObjNumbersAreCheckedWithTheirLine) {
+  const auto dir = test::temp_dir("objcheck");
+  struct Case {
+    const char* text;
+    const char* expect;
+  } cases[] = {
+      {"v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n", ":3: vertex (v x y z): 'nan' is not a finite number"},
+      {"v 0 0 0\nv 1 0 0\nv inf 1 0\nf 1 2 3\n", ":3: vertex (v x y z): 'inf' is not a finite number"},
+      {"v 0 0 0\nv 1 0 0\nv 1e400 1 0\nf 1 2 3\n", ":3: vertex (v x y z): '1e400' is out of the range of a number"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1\nf 1 2 3\n", ":3: vertex (v x y z) has 2 numbers; expected at least 3"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 x\nf 1 2 3\n", ":3: vertex (v x y z): 'x' is not a number"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999\n",
+       ":4: face: vertex index 99999999999999999999 is out of range; 3 vertices are defined before this line "
+       "(expected 1 to 3 or -1 to -3)"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n", ":4: face: vertex index -4 is out of range"},
+      {"v 0 0 0\nv 1 0 0\nf 1 2 3\nv 0 1 0\n", ":3: face: vertex index 3 is out of range; 2 vertices are"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n", ":4: face: vertex index 0 is out of range"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3/x\n", ":4: face: texture coordinate index 'x' is not an integer"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3//1\n", ":4: face: normal index 1 is out of range; 0 normals are"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n", ":4: face has 2 corners; expected at least 3"},
+      {"v 0 0 0\r\nv 1 0 0\rv 0 1 nan\n", ":3: vertex (v x y z): 'nan'"},
+  };
+  for (const auto& c : cases) {
+    const std::string f = test::write_text(dir / "m.obj", c.text);
+    const std::string e = error_of([&] { (void)load_obj(f); });
+    EXPECT_EQ(e.rfind(f + c.expect, 0), 0u) << "got: " << e << "\nwanted: " << f << c.expect;
+  }
+  // What the checks must not refuse: comments, relative indices, slashes, polygons, w and colours.
+  const std::string ok = test::write_text(dir / "ok.obj",
+                                          "# a quad\nv 0 0 0 1\nv 1 0 0 # end\nv 1 1 0 0.5 0.5 0.5\nv 0 1 0\n"
+                                          "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\nf 1/1/1 2/2/1 -2/-2/-1 -1/-1/1\n");
+  EXPECT_EQ(load_obj(ok).triangles.size(), 2u);
+  for (const auto& name : bundled_meshes()) EXPECT_NO_THROW((void)load_obj(mesh_path(name))) << name;
 }
 
 }  // namespace

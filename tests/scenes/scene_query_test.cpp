@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <tbb/parallel_for.h>
 
+#include "core/errors.hpp"
 #include "core/random.hpp"
 #include "scenes/geometry.hpp"
 #include "scenes/scene_library.hpp"
@@ -447,6 +448,41 @@ TEST(SceneQuery, SurfaceSamplesAreAreaWeightedAndOnClimbableMeshes) {
   }
   const double expected = front / total;
   EXPECT_NEAR(front_hits / double(n), expected, 5 * std::sqrt(expected * (1 - expected) / n));
+}
+
+// OpenVDB threw "ArithmeticError: Non-zero scale values required", which named no parameter.
+TEST(SceneQuery, AVoxelSizeOpenVdbCannotRepresentIsAnInputError) {
+  const Scene s = load_scene("wall");
+  SceneQueryOptions o;
+  o.voxel_size = 1e-5f;
+  EXPECT_EQ(test::error_of([&] { SceneQuery q(s, o); }),
+            "scene 'wall': --voxel-size 1e-05 is below 1.46e-05 m, the smallest voxel OpenVDB represents");
+  Scene tiny = test::scene_with(geom::make_box("speck", glm::vec3(0.0f), glm::vec3(1e-3f)));
+  const std::string e = test::error_of([&] { SceneQuery q(tiny); });
+  EXPECT_EQ(e.rfind("scene 'test': the automatic voxel size 6.7", 0), 0u) << e;
+  EXPECT_NE(e.find("is below 1.46e-05 m, the smallest voxel OpenVDB represents; the scene is too small: scale it up, "
+                   "or give --voxel-size"),
+            std::string::npos)
+      << e;
+}
+
+// A voxel size that needs more memory than there is ran into OpenVDB and ended in SIGABRT under a limit.
+// The field at 0.1 mm on the wall needs terabytes: refused before anything is allocated.
+TEST(SceneQuery, ADistanceFieldTooLargeForMemoryIsRefusedBeforeItIsBuilt) {
+  const Scene s = load_scene("wall");
+  SceneQueryOptions o;
+  o.voxel_size = 1e-4f;
+  try {
+    SceneQuery q(s, o);
+    ADD_FAILURE() << "built a field at 0.1 mm";
+  } catch (const OutOfMemoryError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind("scene 'wall': the distance field at --voxel-size 0.0001 would need about ", 0), 0u) << m;
+    EXPECT_NE(m.find("TiB, more than the "), std::string::npos) << m;
+    EXPECT_NE(m.find(" this process may still take; a larger --voxel-size needs less (a quarter for twice the size)"),
+              std::string::npos)
+        << m;
+  }
 }
 
 }  // namespace
