@@ -272,8 +272,12 @@ Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* quer
   }
   if (user_names.size() > static_cast<std::size_t>(lsys::kMaxSlots - lsys::kUserVar0))
     throw InputError("variables: too many user variables");
-  const std::string premise_source = file && !p.was_set("premise") ? file->path + " (premise)" : "parameter 'premise'";
-  s.grammar = lsys::parse_grammar({premise_source, p.text("premise"), 1}, rules, user_names, p.text("context_ignore"));
+  // A premise from the file is parsed where the file has it, so that its errors name FILE:LINE:COLUMN.
+  lsys::GrammarText premise{"parameter 'premise'", p.text("premise"), 1};
+  if (file && !given.was_set("premise"))
+    for (const auto& st : file->settings)
+      if (st.key == "premise") premise = file->setting_text(st);
+  s.grammar = lsys::parse_grammar(premise, rules, user_names, p.text("context_ignore"));
 
   s.host = std::make_unique<Host>();
   s.host->seed_ = seed;

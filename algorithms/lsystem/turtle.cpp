@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
+#include <fmt/format.h>
 #include <glm/gtc/quaternion.hpp>
 
+#include "core/errors.hpp"
 #include "core/random.hpp"
 #include "scenes/scene_query.hpp"
 
@@ -13,6 +16,12 @@ namespace growbench::lsys {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
+
+// Whether a position survives the cast to the plant's floats (finite, within float range).
+bool fits_float(const glm::dvec3& p) {
+  constexpr double kMax = std::numeric_limits<float>::max();
+  return std::abs(p.x) <= kMax && std::abs(p.y) <= kMax && std::abs(p.z) <= kMax;
+}
 
 struct State {
   glm::dvec3 pos{0.0}, H{0.0, 1.0, 0.0}, L{-1.0, 0.0, 0.0}, U{0.0, 0.0, 1.0};
@@ -103,6 +112,11 @@ class Interpreter {
           if (draw && t.node == kNoParent) t.node = add_node(t.pos, width, kNoParent, t, {});
           const glm::dvec3 before = t.pos;
           t.pos += t.H * len;
+          if (!fits_float(t.pos))
+            throw InputError(fmt::format("L-system: module {} ('{}', step {:g}) moved the turtle to ({:g}, {:g}, {:g}), "
+                                         "beyond the range of a 32-bit float; expected steps that keep the plant "
+                                         "within +-{:g}",
+                                         m, c, len, t.pos.x, t.pos.y, t.pos.z, std::numeric_limits<float>::max()));
           if (s_.wrap) snap(t);
           if (c == 'F' || c == 'H' || c == 'G') t.arc += glm::length(t.pos - before);
           if (draw)
