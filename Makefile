@@ -9,7 +9,7 @@ JOBS ?= $(shell nproc)
 # Repetitions per cell in `make demo` (a number, or "suite" for the standard suite's own).
 DEMO_REPETITIONS ?= 1
 
-.PHONY: all deps configure build cli test demo demo-full bench plugin-bench gate baseline readme-params plugin-sdk format clean
+.PHONY: all deps configure build cli test demo demo-full bench plugin-bench gate baseline readme-params plugin-sdk fuzz sanitize format clean
 
 all: build
 
@@ -69,6 +69,20 @@ plugin-bench: build
 	$(GROWBENCH) suite bench/suites/plugin-boundary.json --plugin $(BUILD)/plugins/spacecol_plugin.so \
 	  --out out/plugin-boundary -q
 	$(GROWBENCH) summary out/plugin-boundary/results.json
+
+# The libFuzzer targets (fuzz/README.md), built with clang in build/fuzz, each run for FUZZ_SECONDS on its
+# seed corpus; fails on any finding (CI runs it).
+FUZZ_SECONDS ?= 60
+fuzz: deps
+	cmake --preset fuzz
+	cmake --build build/fuzz -j $(JOBS) --target fuzz
+	bash scripts/fuzz --build build/fuzz --seconds $(FUZZ_SECONDS)
+
+# The test suite under ASan and UBSan, then the parallel algorithm tests under TSan (scripts/sanitize; CI
+# runs both).
+sanitize: deps
+	JOBS=$(JOBS) bash scripts/sanitize asan
+	JOBS=$(JOBS) bash scripts/sanitize tsan
 
 # Reformat every C and C++ file with the committed .clang-format (CI checks it: scripts/check-format).
 format:
