@@ -92,6 +92,8 @@ class CheckingDomParser : public nlohmann::detail::json_sax_dom_parser<nlohmann:
       error_ = error_.substr(p);
     else if (const auto q = error_.find("] "); error_.rfind("[json.exception.", 0) == 0 && q != std::string::npos)
       error_ = error_.substr(q + 2);  // "number overflow parsing '1e400'"
+    if (std::is_same_v<Exception, nlohmann::json::out_of_range>)
+      error_ += "; expected a number within a double's range";
     return false;
   }
 

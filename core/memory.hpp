@@ -8,6 +8,20 @@
 
 namespace growbench {
 
+// AddressSanitizer reserves terabytes of shadow address space at start-up, so under it an address-space
+// limit (RLIMIT_AS) kills the process before it runs: sanitizer builds run trials without one.
+#if defined(__SANITIZE_ADDRESS__)
+inline constexpr bool kAddressSpaceLimitWorks = false;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+inline constexpr bool kAddressSpaceLimitWorks = false;
+#else
+inline constexpr bool kAddressSpaceLimitWorks = true;
+#endif
+#else
+inline constexpr bool kAddressSpaceLimitWorks = true;
+#endif
+
 // The least of what is known: the address-space limit (ulimit -v) less the address space the process
 // has mapped, the cgroup's memory.max less its memory.current, and the kernel's MemAvailable. nullopt
 // when none of them is known.

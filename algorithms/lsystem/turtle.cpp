@@ -113,10 +113,11 @@ class Interpreter {
           const glm::dvec3 before = t.pos;
           t.pos += t.H * len;
           if (!fits_float(t.pos))
-            throw InputError(fmt::format("L-system: module {} ('{}', step {:g}) moved the turtle to ({:g}, {:g}, {:g}), "
-                                         "beyond the range of a 32-bit float; expected steps that keep the plant "
-                                         "within +-{:g}",
-                                         m, c, len, t.pos.x, t.pos.y, t.pos.z, std::numeric_limits<float>::max()));
+            throw InputError(
+                fmt::format("L-system: module {} ('{}', step {:g}) moved the turtle to ({:g}, {:g}, {:g}), "
+                            "beyond the range of a 32-bit float; expected steps that keep the plant "
+                            "within +-{:g}",
+                            m, c, len, t.pos.x, t.pos.y, t.pos.z, std::numeric_limits<float>::max()));
           if (s_.wrap) snap(t);
           if (c == 'F' || c == 'H' || c == 'G') t.arc += glm::length(t.pos - before);
           if (draw)

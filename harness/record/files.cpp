@@ -135,8 +135,8 @@ std::string read_input_file(const std::string& path) {
 }
 
 nlohmann::json parse_input_json(const std::string& path, const std::string& text) {
-  // Syntax errors are InputErrors already. What else the parser throws is nlohmann's number overflow
-  // (406), which gives no position but quotes the number.
+  // Syntax and range errors come as InputErrors with file:line:column; anything else nlohmann might throw
+  // still names the file.
   auto message = [](const nlohmann::json::exception& e) {
     const std::string msg = e.what();
     const auto p = msg.find("] ");
@@ -144,8 +144,6 @@ nlohmann::json parse_input_json(const std::string& path, const std::string& text
   };
   try {
     return parse_json_file_text(path, text);
-  } catch (const nlohmann::json::out_of_range& e) {
-    throw InputError(fmt::format("{}: invalid JSON: {}; expected a number within a double's range", path, message(e)));
   } catch (const nlohmann::json::exception& e) {
     throw InputError(fmt::format("{}: invalid JSON: {}", path, message(e)));
   }

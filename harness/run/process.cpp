@@ -29,6 +29,8 @@
 
 #include <fmt/format.h>
 
+#include "core/memory.hpp"
+
 namespace growbench {
 
 namespace {
@@ -93,7 +95,7 @@ void enter_job(const std::string& log_path, const ChildLimits& limits) {
       close(fd);
     }
   }
-  if (limits.address_space_bytes > 0) {
+  if (limits.address_space_bytes > 0 && kAddressSpaceLimitWorks) {
     rlimit rl{limits.address_space_bytes, limits.address_space_bytes};
     setrlimit(RLIMIT_AS, &rl);
   }

@@ -191,8 +191,8 @@ TEST(ExitStatus, CompareOnAFileItCannotReadIsTwoNeverARegression) {
       {d + "/kind5.json",
        d + "/kind5.json: not a growbench results or baseline file (kind 5, expected 'growbench-results' or "
            "'growbench-baseline')"},
-      {d + "/overflow.json",
-       d + "/overflow.json: invalid JSON: number overflow parsing '1e400'; expected a number within a double's range"},
+      {d + "/overflow.json", d + "/overflow.json:1:62: invalid JSON: number overflow parsing '1e400'; expected a "
+                                 "number within a double's range"},
       {d + "/idnum.json", d + "/idnum.json: at trials[0].id: expected a string, got number"},
       {d + "/adir", d + "/adir: is a directory, expected a file"},
   };

@@ -172,9 +172,8 @@ TEST(Record, InputFilesThatCannotBeReadNameTheFileAndWhy) {
   EXPECT_EQ(error(d + "/adir"), d + "/adir: is a directory, expected a file");
   EXPECT_EQ(error("/dev/zero"), "/dev/zero: is a device, expected a file");
   EXPECT_EQ(error(d + "/missing.json"), d + "/missing.json: cannot open: No such file or directory");
-  EXPECT_EQ(
-      error(d + "/overflow.json"),
-      d + "/overflow.json: invalid JSON: number overflow parsing '1e400'; expected a number within a double's range");
+  EXPECT_EQ(error(d + "/overflow.json"), d + "/overflow.json:1:62: invalid JSON: number overflow parsing '1e400'; "
+                                             "expected a number within a double's range");
   EXPECT_EQ(error(d + "/kind5.json"),
             d + "/kind5.json: not a growbench results file (kind 5, expected 'growbench-results')");
   // The version is checked before the fields: a newer file's new field is not called a mistake.
