@@ -70,13 +70,13 @@ plugin-bench: build
 	  --out out/plugin-boundary -q
 	$(GROWBENCH) summary out/plugin-boundary/results.json
 
-# The libFuzzer targets (fuzz/README.md), built with clang in build/fuzz, each run for FUZZ_SECONDS on its
-# seed corpus; fails on any finding (CI runs it).
+# The libFuzzer targets (fuzz/README.md), built by the asan preset (clang) in build/asan, JOBS at a time,
+# each for FUZZ_SECONDS on its seed corpus; fails on any finding (CI runs it).
 FUZZ_SECONDS ?= 60
 fuzz: deps
-	cmake --preset fuzz
-	cmake --build build/fuzz -j $(JOBS) --target fuzz
-	bash scripts/fuzz --build build/fuzz --seconds $(FUZZ_SECONDS)
+	cmake --preset asan
+	cmake --build build/asan -j $(JOBS) --target fuzz
+	bash scripts/fuzz --build build/asan --seconds $(FUZZ_SECONDS) --jobs $(JOBS)
 
 # The test suite under ASan and UBSan, then the parallel algorithm tests under TSan (scripts/sanitize; CI
 # runs both).

@@ -21,10 +21,20 @@ std::string read_text_file(const std::string& path) {
   if (std::filesystem::is_directory(path, ec)) throw InputError(fmt::format("{}: is a directory, not a file", path));
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(fmt::format("{}: cannot open", path));
-  std::stringstream ss;
-  ss << in.rdbuf();
+  // One allocation of the file's size, not a stream's doublings: meshes run to many megabytes.
+  std::string text;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (!ec && size > 0) {
+    text.resize(size);
+    in.read(text.data(), static_cast<std::streamsize>(size));
+    text.resize(static_cast<std::size_t>(in.gcount()));
+  } else {  // not a regular file (a pipe): as the stream gives it
+    std::stringstream ss;
+    ss << in.rdbuf();
+    text = ss.str();
+  }
   if (in.bad()) throw InputError(fmt::format("{}: cannot read", path));
-  return ss.str();
+  return text;
 }
 
 std::pair<std::size_t, std::size_t> line_column(const std::string& text, std::size_t byte) {

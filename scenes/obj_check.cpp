@@ -32,12 +32,13 @@ class ObjLineChecker {
       if (!t.empty() && t.front() == '+') t.remove_prefix(1);
       double v = 0.0;
       const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+      if (ec == std::errc() && end == t.data() + t.size() && !t.empty() && std::isfinite(v)) continue;
       const std::string shown = utf8_excerpt(tokens[k], 40);
       if (ec == std::errc::result_out_of_range)
         fail(fmt::format("{}: '{}' is out of the range of a number", what, shown));
       if (ec != std::errc() || end != t.data() + t.size() || t.empty())
         fail(fmt::format("{}: '{}' is not a number", what, shown));
-      if (!std::isfinite(v)) fail(fmt::format("{}: '{}' is not a finite number", what, shown));
+      fail(fmt::format("{}: '{}' is not a finite number", what, shown));
     }
   }
 
@@ -49,16 +50,15 @@ class ObjLineChecker {
   };
   void index(std::string_view t, std::size_t count, Element e) const {
     const char* element = e.one;
-    const std::string shown = utf8_excerpt(t, 40);
     if (t.empty()) fail(fmt::format("face: expected a {} index, found nothing", element));
     std::int64_t i = 0;
     const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), i);
-    if (ec == std::errc() && end == t.data() + t.size() && i != 0) {
-      const auto n = static_cast<std::int64_t>(count);
-      if ((i > 0 && i <= n) || (i < 0 && -i <= n)) return;
-    } else if (ec != std::errc::result_out_of_range && (ec != std::errc() || end != t.data() + t.size())) {
+    const bool integer = ec == std::errc() && end == t.data() + t.size() && i != 0;
+    const auto n = static_cast<std::int64_t>(count);
+    if (integer && ((i > 0 && i <= n) || (i < 0 && -i <= n))) return;
+    const std::string shown = utf8_excerpt(t, 40);
+    if (ec != std::errc::result_out_of_range && (ec != std::errc() || end != t.data() + t.size()))
       fail(fmt::format("face: {} index '{}' is not an integer", element, shown));
-    }
     fail(fmt::format("face: {} index {} is out of range; {} {} {} defined before this line{}", element, shown, count,
                      count == 1 ? e.one : e.many, count == 1 ? "is" : "are",
                      count == 0 ? "" : fmt::format(" (expected 1 to {} or -1 to -{})", count, count)));
@@ -87,9 +87,9 @@ class ObjLineChecker {
 };
 
 // The line's words, up to a '#' that starts one (a comment) or a NUL (where tinyobjloader's C string ends).
-std::vector<std::string_view> tokens_of(std::string_view line) {
+void tokens_of(std::string_view line, std::vector<std::string_view>& out) {
   line = line.substr(0, line.find('\0'));
-  std::vector<std::string_view> out;
+  out.clear();
   std::size_t k = 0;
   while (k < line.size()) {
     while (k < line.size() && (line[k] == ' ' || line[k] == '\t')) ++k;
@@ -99,20 +99,20 @@ std::vector<std::string_view> tokens_of(std::string_view line) {
     if (line[start] == '#') break;
     out.push_back(line.substr(start, k - start));
   }
-  return out;
 }
 
 }  // namespace
 
 void check_obj_text(const std::string& path, std::string_view text) {
   std::size_t nv = 0, nt = 0, nn = 0, line = 0;
+  std::vector<std::string_view> tokens;  // one line's, reused: a mesh has millions of lines
   for (std::size_t start = 0; start < text.size();) {
     // A line ends at "\n", "\r\n" or a lone "\r", as tinyobjloader's reader has it.
     const std::size_t end = std::min(text.find_first_of("\r\n", start), text.size());
     const std::string_view l = text.substr(start, end - start);
     start = end + (text.compare(end, 2, "\r\n") == 0 ? 2 : 1);
     ++line;
-    const auto tokens = tokens_of(l);
+    tokens_of(l, tokens);
     if (tokens.empty()) continue;
     const ObjLineChecker check(path, line);
     if (tokens[0] == "v") {

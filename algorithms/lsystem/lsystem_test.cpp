@@ -278,16 +278,8 @@ TEST(LSystemErrors, RunawayGrowthStopsWithAClearError) {
 
 // ---------- the turtle ----------
 
-class LSystemTurtle : public ::testing::Test {
+class LSystemTurtle : public test::OnEnvelope {
  protected:
-  static void SetUpTestSuite() {
-    scene_ = new Scene(load_scene("envelope"));
-    query_ = new SceneQuery(*scene_);
-  }
-  static void TearDownTestSuite() {
-    delete query_;
-    delete scene_;
-  }
   static Plant grow(const std::string& premise, const std::string& rules, double generations,
                     std::vector<std::string> extra = {}, int threads = 0) {
     std::vector<std::string> sets = {
@@ -296,11 +288,7 @@ class LSystemTurtle : public ::testing::Test {
     sets.insert(sets.end(), extra.begin(), extra.end());
     return test::grow("lsystem", *scene_, *query_, sets, threads);
   }
-  static Scene* scene_;
-  static SceneQuery* query_;
 };
-Scene* LSystemTurtle::scene_ = nullptr;
-SceneQuery* LSystemTurtle::query_ = nullptr;
 
 TEST_F(LSystemTurtle, KochIslandClosesWithExactLengthsAndRightAngles) {
   const Plant p = grow("F-F-F-F", "F = F-F+F+FF-F-F+F", 2, {"angle=90"});

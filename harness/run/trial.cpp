@@ -181,7 +181,10 @@ struct CurveSampler {
 
 void inject_fault(const std::string& fault) {
   if (fault.empty()) return;
-  if (fault == "crash") std::raise(SIGSEGV);
+  if (fault == "crash") {
+    std::signal(SIGSEGV, SIG_DFL);  // a plain crash, past any handler a sanitizer installed
+    std::raise(SIGSEGV);
+  }
   if (fault == "hang")
     for (;;) std::this_thread::sleep_for(std::chrono::seconds(1));
   if (fault == "oom") {

@@ -4,12 +4,29 @@
 #include <string>
 #include <vector>
 
+#include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
 #include "algorithms/algorithm.hpp"
+#include "scenes/scene_library.hpp"
 #include "scenes/scene_query.hpp"
 
 namespace growbench::test {
+
+// A test suite whose tests grow on the envelope scene, loaded and queried once for all of them.
+class OnEnvelope : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    scene_ = new Scene(load_scene("envelope"));
+    query_ = new SceneQuery(*scene_);
+  }
+  static void TearDownTestSuite() {
+    delete query_;
+    delete scene_;
+  }
+  static inline Scene* scene_ = nullptr;
+  static inline SceneQuery* query_ = nullptr;
+};
 
 // Grows a plant with one algorithm to completion (or max_steps) with a given thread count.
 inline Plant grow(const std::string& algorithm, const Scene& scene, const SceneQuery& query,

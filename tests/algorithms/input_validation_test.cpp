@@ -18,6 +18,8 @@
 #include "algorithms/plugins/loader.hpp"
 #include "algorithms/vines/mask.hpp"
 #include "core/errors.hpp"
+#include "grow_util.hpp"
+#include "scenes/scene_library.hpp"
 #include "test_util.hpp"
 
 namespace growbench {
@@ -118,6 +120,18 @@ TEST(GrammarInput, ADivisionByZeroDuringDerivationNamesTheRule) {
   EXPECT_EQ(error_of([&] { (void)derive("A(1)", "A(x) : x/(x-x) = B", 1); }),
             "parameter 'rules':1:8: in rule 'A(x) : x/(x-x) = B': the condition 'x/(x-x)' gave inf, from a division "
             "by zero");
+}
+
+// Steps that are each within float range can still carry the turtle beyond it; that ended in "invalid
+// plant: node 2 has a non-finite position", naming no module.
+TEST(GrammarInput, AStepThatLeavesFloatRangeNamesItsModule) {
+  const Scene scene = load_scene("envelope");
+  const SceneQuery query(scene);
+  EXPECT_EQ(error_of([&] {
+              (void)test::grow("lsystem", scene, query, {"premise=F(3e38)F(3e38)", "rules=", "surface=free"});
+            }),
+            "L-system: module 1 ('F', step 3e+38) moved the turtle to (0, 6e+38, 0), beyond the range of a 32-bit "
+            "float; expected steps that keep the plant within +-3.40282e+38");
 }
 
 TEST(GrammarInput, VariablesMustBeFinite) {

@@ -137,27 +137,15 @@ Ply read_ply(const std::filesystem::path& path) {
 // ---------- helpers ----------
 
 // The L-system grown from `premise` (no rules) at the origin, one unit per F, width 0.1.
-class PlantAttributes : public ::testing::Test {
+class PlantAttributes : public test::OnEnvelope {
  protected:
-  static void SetUpTestSuite() {
-    scene_ = new Scene(load_scene("envelope"));
-    query_ = new SceneQuery(*scene_);
-  }
-  static void TearDownTestSuite() {
-    delete query_;
-    delete scene_;
-  }
   static Plant grow(const std::string& premise, std::vector<std::string> extra = {}) {
     std::vector<std::string> sets = {"premise=" + premise, "rules=",      "generations=0",
                                      "start=origin",       "step_size=1", "thickness=0.1"};
     sets.insert(sets.end(), extra.begin(), extra.end());
     return test::grow("lsystem", *scene_, *query_, sets);
   }
-  static Scene* scene_;
-  static SceneQuery* query_;
 };
-Scene* PlantAttributes::scene_ = nullptr;
-SceneQuery* PlantAttributes::query_ = nullptr;
 
 std::string text_of(const std::filesystem::path& p) {
   std::ifstream in(p, std::ios::binary);
