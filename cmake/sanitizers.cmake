@@ -20,7 +20,16 @@ if(GROWBENCH_ASAN)
     add_compile_options(-fsanitize-ignorelist=${CMAKE_CURRENT_LIST_DIR}/sanitizer-ignorelist.txt)
   endif()
 endif()
+# TSan sees only the synchronization of instrumented code, and TBB's (spawn, steal, join) is in libtbb:
+# preset tsan links the libtbb that scripts/tsan-tbb builds with TSan (its directory goes in the rpath,
+# and OpenVDB and Embree, which need the same libtbb.so.12, get the one already loaded). g++, not clang:
+# g++'s TSan runtime is a shared library, linked by that libtbb and by our plugins (which refuse undefined
+# symbols) as well as by the executables; clang links its runtime into executables only, and its shared
+# runtime (-shared-libsan) crashes at start with Debian's clang 14.
 if(GROWBENCH_TSAN)
+  if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "GNU" OR NOT EXISTS "${TBB_DIR}/../../../growbench-stamp")
+    message(FATAL_ERROR "GROWBENCH_TSAN needs g++ and the TBB of scripts/tsan-tbb: scripts/sanitize tsan")
+  endif()
   add_compile_options(-fsanitize=thread)
   add_link_options(-fsanitize=thread)
 endif()
