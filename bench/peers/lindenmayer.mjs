@@ -42,7 +42,9 @@ function build(spec) {
 const spec = JSON.parse(readFileSync(process.argv[2], 'utf8'));
 const lsys = build(spec);
 const t0 = process.hrtime.bigint();
+const cpu0 = process.cpuUsage();
 lsys.iterate(spec.iterations);
+const cpu = process.cpuUsage(cpu0);
 const seconds = Number(process.hrtime.bigint() - t0) / 1e9;
 const symbols = lsys.getString();
 const version = JSON.parse(readFileSync(new URL('./node_modules/lindenmayer/package.json', import.meta.url))).version;
@@ -51,6 +53,7 @@ console.log(JSON.stringify({
   version,
   node: process.version,
   seconds,
+  cpu_seconds: (cpu.user + cpu.system) / 1e6,  // beside the wall time: a shared machine's load shows in the gap
   modules: lsys.axiom.length,
   sha256: createHash('sha256').update(symbols).digest('hex'),
 }));

@@ -53,7 +53,7 @@ ExitStatus derive(const LsystemArgs& a) {
     if (a.limit && d.modules > a.limit) fmt::print(" ... ({} more modules)", d.modules - a.limit);
     fmt::print("\n");
   }
-  fmt::print(stderr, "generation {}: {} modules, {} parameters, {:.1f} MiB, derived in {:.3f} s\n", d.generations,
+  fmt::print(stderr, "generation {}: {} modules, {} parameters, {:.1f} MiB, derived in {:.6f} s\n", d.generations,
              d.modules, d.params, d.bytes / (1024.0 * 1024.0), secs);
   for (const auto& [c, n] : d.counts) fmt::print(stderr, "  {}  {}\n", c, n);
   return kExitOk;
