@@ -73,6 +73,14 @@ class Report(unittest.TestCase):
             "ivy on a cube", "Blender 3.4.1", "3.00 s", "75.0 ms (1 thr.)", "40.0x [30.0, 45.5]", ">= 50x not met",
             "60,860 nodes", "65,911 nodes", "ok: node counts within 10%"]])
 
+    def test_whole_operator_row(self):
+        doc = json.loads(json.dumps(DOC))
+        doc["cases"][0]["whole"] = {"what": "whole vs growth + meshing", "peer_s": [9.0, 8.0, 10.0],
+                                    "growbench_s": [1.0, 1.0, 1.0], "ratio": 9.0, "ratio_low": 8.0, "ratio_high": 10.0}
+        rows = report.peers_rows(doc)
+        self.assertEqual(rows[1], ["ivy on a cube: whole vs growth + meshing", "Blender 3.4.1", "9.00 s",
+                                   "1.00 s (1 thr.)", "9.0x [8.0, 10.0]", "-", "", "", ""])
+
     def test_page_alone(self):
         with tempfile.TemporaryDirectory() as d:
             path = os.path.join(d, "peers.json")
