@@ -653,8 +653,8 @@ def write_html(path, doc, results_path, rows, figs, grids, failed, caption, metr
 
 # ---------------------------------------------------------------- versus peers (peers.json of `make peers`)
 
-PEERS_HEAD = ["work", "peer", "peer median", "growbench median", "ratio [interval]", "target", "peer count",
-              "growbench count", "check"]
+PEERS_HEAD = ["work", "peer", "peer median", "growbench median", "ratio [interval]", "target", "CPU-time ratio",
+              "peer count", "growbench count", "check"]
 
 
 def load_peers(path):
@@ -676,13 +676,14 @@ def peers_rows(doc):
                      fmt_seconds(c["growbench_median_s"]) + (f" ({threads} thr.)" if threads else ""),
                      f"{c['ratio']:.1f}x [{c['ratio_low']:.1f}, {c['ratio_high']:.1f}]",
                      f">= {c['target']:g}x" + (" met" if c["ratio"] >= c["target"] else " not met"),
+                     f"{c['cpu_ratio']:.1f}x" if c.get("cpu_ratio") else "-",
                      f"{c['peer_count']:,} {c['count_unit']}", f"{c['growbench_count']:,} {c['count_unit']}",
                      ("ok: " if c["check"]["ok"] else "FAILED: ") + c["check"]["what"]])
         if "whole" in c:  # what a user waits for, beside the growth-to-growth ratio
             w = c["whole"]
             rows.append([c["title"] + ": " + w["what"], c["peer"], fmt_seconds(median(w["peer_s"])),
                          fmt_seconds(median(w["growbench_s"])) + (f" ({threads} thr.)" if threads else ""),
-                         f"{w['ratio']:.1f}x [{w['ratio_low']:.1f}, {w['ratio_high']:.1f}]", "-", "", "", ""])
+                         f"{w['ratio']:.1f}x [{w['ratio_low']:.1f}, {w['ratio_high']:.1f}]", "-", "-", "", "", ""])
     return rows
 
 
@@ -742,7 +743,8 @@ def peers_html(doc, path, out, formats):
     parts += ["<tr>" + "".join(f"<td>{e(x)}</td>" for x in r) + "</tr>" for r in rows]
     parts.append("</table>")
     parts.append(f"<p class='note'>Ratio: the peer's median time over growbench's; interval: "
-                 f"{e(doc['interval']['method'])} ({doc['interval']['level']:.0%}). Also as "
+                 f"{e(doc['interval']['method'])} ({doc['interval']['level']:.0%}). CPU-time ratio: the same with "
+                 f"CPU seconds (growbench's summed over its threads), which a loaded machine disturbs less. Also as "
                  f"<a href='peers-table.md'>Markdown</a>.</p>")
     parts.append("<figure><img src='fig-peers.png' alt='fig-peers'><figcaption>Peer time over growbench time per "
                  "case, with its interval; red: the case's target. <a href='fig-peers.pdf'>PDF</a></figcaption></figure>")

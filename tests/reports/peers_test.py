@@ -63,7 +63,7 @@ DOC = {"schema": "growbench-peers/1", "started": "2026-01-01T00:00:00+00:00", "r
        "machine": {"cpu": "test cpu", "cores": 2}, "growbench": {"version": "abc1234"},
        "cases": [{"name": "ivy-cube", "kind": "ivy", "title": "ivy on a cube", "target": 50, "peer": "Blender 3.4.1",
                   "growbench_threads": 1, "peer_median_s": 3.0, "growbench_median_s": 0.075, "ratio": 40.0,
-                  "ratio_low": 30.0, "ratio_high": 45.5, "peer_count": 60860, "growbench_count": 65911,
+                  "ratio_low": 30.0, "ratio_high": 45.5, "cpu_ratio": 20.0, "peer_count": 60860, "growbench_count": 65911,
                   "count_unit": "nodes", "load_1min": [1.5, 2.5], "check": {"ok": True, "what": "node counts within 10%"}}]}
 
 
@@ -71,7 +71,7 @@ class Report(unittest.TestCase):
     def test_rows(self):
         self.assertEqual(report.peers_rows(DOC), [[
             "ivy on a cube", "Blender 3.4.1", "3.00 s", "75.0 ms (1 thr.)", "40.0x [30.0, 45.5]", ">= 50x not met",
-            "60,860 nodes", "65,911 nodes", "ok: node counts within 10%"]])
+            "20.0x", "60,860 nodes", "65,911 nodes", "ok: node counts within 10%"]])
 
     def test_whole_operator_row(self):
         doc = json.loads(json.dumps(DOC))
@@ -79,7 +79,7 @@ class Report(unittest.TestCase):
                                     "growbench_s": [1.0, 1.0, 1.0], "ratio": 9.0, "ratio_low": 8.0, "ratio_high": 10.0}
         rows = report.peers_rows(doc)
         self.assertEqual(rows[1], ["ivy on a cube: whole vs growth + meshing", "Blender 3.4.1", "9.00 s",
-                                   "1.00 s (1 thr.)", "9.0x [8.0, 10.0]", "-", "", "", ""])
+                                   "1.00 s (1 thr.)", "9.0x [8.0, 10.0]", "-", "-", "", "", ""])
 
     def test_page_alone(self):
         with tempfile.TemporaryDirectory() as d:
