@@ -738,7 +738,8 @@ def peers_html(doc, path, out, formats):
              f"{e(doc.get('started', '?'))}): each peer and growbench on the same input, alternating, "
              f"{doc['repetitions']} repetitions each, each timed inside its own process. Machine: {e(m.get('cpu', '?'))}, "
              f"{m.get('cores', '?')} cores; 1-minute load during the runs {min(loads, default=0):.1f} to "
-             f"{max(loads, default=0):.1f}.</p>",
+             f"{max(loads, default=0):.1f}. lindenmayer is timed after {doc.get('lindenmayer_warmup', 0)} untimed "
+             f"derivation(s) in its own process (V8 warmed up).</p>",
              "<table><tr>" + "".join(f"<th>{e(h)}</th>" for h in PEERS_HEAD) + "</tr>"]
     parts += ["<tr>" + "".join(f"<td>{e(x)}</td>" for x in r) + "</tr>" for r in rows]
     parts.append("</table>")

@@ -9,6 +9,7 @@
 //                function production a lindenmayer user writes by hand: ({part}) => { const [l, w] =
 //                part.params; return [{symbol: 'F', params: [l]}, ...]; }
 //   iterations   rewrites
+//   warmup       untimed derivations first, each on a fresh LSystem (scripts/peers sets it from cases.json)
 // The time covers iterate() alone, inside this process, like growbench's "derived in". The check fields
 // are the module count and the SHA-256 of the symbols without parameters (getString()), which
 // scripts/peers compares with growbench's string.
@@ -40,6 +41,7 @@ function build(spec) {
 }
 
 const spec = JSON.parse(readFileSync(process.argv[2], 'utf8'));
+for (let i = 0; i < (spec.warmup || 0); ++i) build(spec).iterate(spec.iterations);
 const lsys = build(spec);
 const t0 = process.hrtime.bigint();
 const cpu0 = process.cpuUsage();
