@@ -525,8 +525,9 @@ std::string resolve_grammar_path(const std::string& name) {
 }
 
 DerivedString derive_lsystem(const Params& params, std::uint64_t seed, const Scene* scene, const SceneQuery* query,
-                             std::size_t print_limit) {
+                             std::optional<std::size_t> print_limit) {
   Setup setup = make_setup(params, seed, query);
+  const auto t0 = std::chrono::steady_clock::now();
   lsys::Deriver deriver(setup.grammar, setup.derive);
   lsys::LString cur, next;
   std::vector<lsys::TurtleVars> states;
@@ -548,7 +549,8 @@ DerivedString derive_lsystem(const Params& params, std::uint64_t seed, const Sce
     std::swap(cur, next);
   }
   DerivedString out;
-  out.text = lsys::to_text(cur, setup.grammar.strings, print_limit);
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (print_limit) out.text = lsys::to_text(cur, setup.grammar.strings, *print_limit);
   out.modules = cur.size();
   out.params = cur.params.size();
   out.bytes = cur.bytes();
