@@ -1,8 +1,6 @@
 // growbench lsystem: derive an L-system's string without drawing it.
-#include <chrono>
 #include <cstdint>
 #include <cstdio>
-#include <ctime>
 #include <memory>
 #include <optional>
 #include <string>
@@ -46,18 +44,15 @@ ExitStatus derive(const LsystemArgs& a) {
     scene = load_scene(a.scene);
     query = std::make_unique<SceneQuery>(*scene);
   }
-  const auto t0 = std::chrono::steady_clock::now();
-  const std::clock_t c0 = std::clock();  // CPU time of all threads: on a loaded machine wall time also holds waiting
-  const DerivedString d = derive_lsystem(params, a.seed, scene ? &*scene : nullptr, query.get(), a.limit);
-  const double cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
-  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const DerivedString d = derive_lsystem(params, a.seed, scene ? &*scene : nullptr, query.get(),
+                                         a.print ? std::optional(a.limit) : std::nullopt);
   if (a.print) {
     fmt::print("{}", d.text);
     if (a.limit && d.modules > a.limit) fmt::print(" ... ({} more modules)", d.modules - a.limit);
     fmt::print("\n");
   }
   fmt::print(stderr, "generation {}: {} modules, {} parameters, {:.1f} MiB, derived in {:.6f} s ({:.6f} s CPU)\n",
-             d.generations, d.modules, d.params, d.bytes / (1024.0 * 1024.0), secs, cpu);
+             d.generations, d.modules, d.params, d.bytes / (1024.0 * 1024.0), d.seconds, d.cpu_seconds);
   for (const auto& [c, n] : d.counts) fmt::print(stderr, "  {}  {}\n", c, n);
   return kExitOk;
 }
