@@ -9,7 +9,7 @@ JOBS ?= $(shell nproc)
 # Repetitions per cell in `make demo` (a number, or "suite" for the standard suite's own).
 DEMO_REPETITIONS ?= 1
 
-.PHONY: all deps configure build cli test demo demo-full bench plugin-bench gate baseline readme-params plugin-sdk fuzz sanitize format clean
+.PHONY: all deps configure build cli test demo demo-full peers bench plugin-bench gate baseline readme-params plugin-sdk fuzz sanitize format clean
 
 all: build
 
@@ -34,6 +34,19 @@ demo: cli
 
 demo-full: cli
 	bash scripts/demo $(GROWBENCH) out/demo-full suite
+
+# growbench against its peers (bench/peers/README.md): npm lindenmayer (pinned by bench/peers/package-lock.json),
+# Blender's IvyGen add-on (Debian's blender, scripts/peers-packages) and a nanoflann reference, each on the same
+# input as growbench, alternating, PEERS_REPETITIONS times; writes out/peers/peers.json and its report page
+# out/peers/report/index.html. Not part of `make test`: Blender is a large install.
+PEERS_REPETITIONS ?= 5
+peers: cli
+	bash scripts/install-deps --peers
+	cd bench/peers && npm ci --no-audit --no-fund
+	cmake --build $(BUILD) -j $(JOBS) --target spacecol_reference
+	/usr/bin/python3 scripts/peers --growbench $(GROWBENCH) --reference $(BUILD)/bench/peers/spacecol_reference \
+	  --repetitions $(PEERS_REPETITIONS) --out out/peers
+	/usr/bin/python3 reports/report.py --peers out/peers/peers.json --out out/peers/report
 
 # The deterministic regression gate (CI runs it after the tests): the quick suite once, single-threaded,
 # under callgrind, compared with the committed baseline. Instruction counts depend on the compiler flags:

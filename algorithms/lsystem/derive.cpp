@@ -1,7 +1,11 @@
 #include "algorithms/lsystem/derive.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstring>
+#include <new>
+
+#include <sys/mman.h>
 
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
@@ -26,6 +30,29 @@ std::size_t block_count(std::size_t n) {
 }
 
 }  // namespace
+
+namespace detail {
+
+void* allocate_buffer(std::size_t bytes) {
+  constexpr std::size_t kHugePage = std::size_t{2} << 20;
+  if (bytes < kHugePage) {
+    if (void* p = std::malloc(std::max<std::size_t>(bytes, 1))) return p;
+    throw std::bad_alloc();
+  }
+  const std::size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+  void* p = std::aligned_alloc(kHugePage, rounded);
+  if (!p) throw std::bad_alloc();
+#ifdef MADV_HUGEPAGE
+  (void)madvise(p, rounded, MADV_HUGEPAGE);  // advice only: without huge pages the memory works the same
+#endif
+  return p;
+}
+
+void FreeBuffer::operator()(void* p) const {
+  std::free(p);
+}
+
+}  // namespace detail
 
 std::string to_text(const LString& s, const std::vector<std::string>& strings, std::size_t limit) {
   std::string out;
@@ -64,15 +91,21 @@ Deriver::Deriver(const Grammar& grammar, DeriveSettings settings) : g_(grammar),
     const auto& list = g_.rules_for[c];
     if (list.empty()) continue;
     const Rule& r = g_.rules[list[0]];
-    const bool simple = list.size() == 1 && !r.has_context && r.condition.empty() && r.probability.empty() &&
-                        r.static_successor && !r.pred.has_parens && !g_.uses_age;
-    kind_[c] = simple ? 1 : 2;
-    any_general_ |= !simple;
-    if (simple) {
-      static_symbols_[c] = static_cast<std::uint32_t>(r.static_symbols.size());
-      static_params_[c] = static_cast<std::uint32_t>(r.static_params.size());
-    }
+    const bool unconditional =
+        list.size() == 1 && !r.has_context && r.condition.empty() && r.probability.empty() && !g_.uses_age;
+    const bool simple = unconditional && r.static_successor && !r.pred.has_parens;
+    kind_[c] = simple ? 1 : unconditional && r.pred.has_parens ? 3 : 2;
+    any_general_ |= kind_[c] == 2;
+    static_symbols_[c] = static_cast<std::uint32_t>(r.successor.size());
+    static_params_[c] = r.out_params;
+    formals_[c] = static_cast<std::uint8_t>(r.pred.formals.size());
+    lone_context_[c] = list.size() == 1 && r.has_context;
   }
+  out_words_.resize(g_.rules.size());
+  for (std::size_t ri = 0; ri < g_.rules.size(); ++ri)
+    for (const auto& mod : g_.rules[ri].successor)
+      out_words_[ri].push_back(
+          static_cast<std::uint16_t>(encode(mod.symbol, static_cast<int>(mod.args.size())) | kNewFlag));
 }
 
 void Deriver::premise(LString& out) const {
@@ -240,6 +273,22 @@ bool Deriver::bind(const Rule& r, const LString& in, std::size_t m, std::size_t 
   return true;
 }
 
+// Most modules fail a context on their nearest neighbour. When that neighbour is neither a bracket nor
+// ignored, bind's walk would stop at it and compare it with the pattern's symbol, so comparing it here
+// decides the same without binding anything.
+bool Deriver::neighbours_allow(const Rule& r, const LString& in, std::size_t m) const {
+  const auto decides = [&](char c) { return c != '[' && c != ']' && !g_.ignore.test(static_cast<unsigned char>(c)); };
+  if (!r.left.empty() && m > 0) {
+    const char c = symbol_of(in.symbols[m - 1]);
+    if (decides(c) && c != r.left.back().symbol) return false;
+  }
+  if (!r.right.empty() && r.right.front().symbol != ']' && m + 1 < in.size()) {
+    const char c = symbol_of(in.symbols[m + 1]);
+    if (decides(c) && c != r.right.front().symbol) return false;
+  }
+  return true;
+}
+
 int Deriver::choose(const LString& in, std::size_t m, std::size_t poff, double* env, int generation) const {
   const std::uint16_t w = in.symbols[m];
   const auto& list = g_.rules_for[static_cast<unsigned char>(symbol_of(w))];
@@ -250,6 +299,7 @@ int Deriver::choose(const LString& in, std::size_t m, std::size_t poff, double* 
   int fallback = -1;
   for (const std::uint16_t ri : list) {
     const Rule& r = g_.rules[ri];
+    if (r.has_context && !neighbours_allow(r, in, m)) continue;
     if (!bind(r, in, m, poff, env)) continue;
     if (!r.condition.empty() && r.condition.eval(env, *s_.host) == 0.0) continue;
     if (r.probability.empty()) {
@@ -341,7 +391,22 @@ void Deriver::rewrite(const LString& in, LString& out, int generation, const std
           osyms += static_symbols_[c];
           opars += static_params_[c];
           break;
+        case 3:
+          if (k == formals_[c]) {
+            osyms += static_symbols_[c];
+            opars += static_params_[c];
+          } else {
+            osyms += 1;
+            opars += static_cast<std::size_t>(k);
+          }
+          break;
         default: {
+          if (lone_context_[c] && !neighbours_allow(g_.rules[g_.rules_for[c][0]], in, m)) {
+            choice_[m] = kCopy;
+            osyms += 1;
+            opars += static_cast<std::size_t>(k);
+            break;
+          }
           set_module_env(env, m);
           const int r = choose(in, m, poff, env, generation);
           choice_[m] = r < 0 ? kCopy : static_cast<std::uint16_t>(r);
@@ -397,9 +462,9 @@ void Deriver::rewrite(const LString& in, LString& out, int generation, const std
         *oa++ = age == 0xffff ? age : static_cast<std::uint16_t>(age + 1);
       }
     };
-    auto put_static = [&](const Rule& r) {
-      const std::size_t ns = r.static_symbols.size();
-      for (std::size_t q = 0; q < ns; ++q) os[q] = static_cast<std::uint16_t>(r.static_symbols[q] | kNewFlag);
+    auto put_static = [&](const Rule& r, const std::vector<std::uint16_t>& words) {
+      const std::size_t ns = words.size();
+      std::memcpy(os, words.data(), ns * sizeof(std::uint16_t));
       os += ns;
       if (!r.static_params.empty()) {
         std::memcpy(op, r.static_params.data(), r.static_params.size() * sizeof(float));
@@ -410,6 +475,21 @@ void Deriver::rewrite(const LString& in, LString& out, int generation, const std
         oa += ns;
       }
     };
+    auto apply = [&](std::size_t m, std::uint16_t ri) {
+      const Rule& r = g_.rules[ri];
+      if (r.static_successor) {
+        put_static(r, out_words_[ri]);
+        return;
+      }
+      set_module_env(env, m);
+      bind(r, in, m, poff, env);
+      const std::uint16_t* words = out_words_[ri].data();
+      for (const auto& mod : r.successor) {
+        *os++ = *words++;
+        for (const auto& a : mod.args) *op++ = static_cast<float>(a.eval(env, *s_.host));
+        if (oa) *oa++ = 0;
+      }
+    };
     for (std::size_t m = b * kBlock; m < end; ++m) {
       const std::uint16_t w = sym[m];
       const unsigned c = w & kSymbolMask;
@@ -418,27 +498,23 @@ void Deriver::rewrite(const LString& in, LString& out, int generation, const std
         case 0:
           copy_module(m, w, k);
           break;
-        case 1:
-          put_static(g_.rules[g_.rules_for[c][0]]);
+        case 1: {
+          const std::uint16_t ri = g_.rules_for[c][0];
+          put_static(g_.rules[ri], out_words_[ri]);
+          break;
+        }
+        case 3:
+          if (k == formals_[c])
+            apply(m, g_.rules_for[c][0]);
+          else
+            copy_module(m, w, k);
           break;
         default: {
           const std::uint16_t ri = choice_[m];
-          if (ri == kCopy) {
+          if (ri == kCopy)
             copy_module(m, w, k);
-            break;
-          }
-          const Rule& r = g_.rules[ri];
-          if (r.static_successor) {
-            put_static(r);
-            break;
-          }
-          set_module_env(env, m);
-          bind(r, in, m, poff, env);
-          for (const auto& mod : r.successor) {
-            *os++ = static_cast<std::uint16_t>(encode(mod.symbol, static_cast<int>(mod.args.size())) | kNewFlag);
-            for (const auto& a : mod.args) *op++ = static_cast<float>(a.eval(env, *s_.host));
-            if (oa) *oa++ = 0;
-          }
+          else
+            apply(m, ri);
         }
       }
       poff += static_cast<std::size_t>(k);

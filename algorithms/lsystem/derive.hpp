@@ -69,12 +69,18 @@ class Deriver {
   struct Block;
   int choose(const LString& in, std::size_t m, std::size_t poff, double* env, int generation) const;
   bool bind(const Rule& r, const LString& in, std::size_t m, std::size_t poff, double* env) const;
+  [[nodiscard]] bool neighbours_allow(const Rule& r, const LString& in, std::size_t m) const;
 
   const Grammar& g_;
   DeriveSettings s_;
-  std::uint8_t kind_[128] = {};  // 0 copy, 1 one static rule without conditions, 2 general
-  bool any_general_ = false;     // some symbol is kind 2: rule choices are stored per module
-  std::uint32_t static_symbols_[128] = {}, static_params_[128] = {};  // output size of a kind-1 symbol
+  // 0 copy; 1 one static rule without conditions; 2 general; 3 one rule without conditions whose pattern
+  // names its parameters: it applies exactly to the modules with that many, so nothing is chosen.
+  std::uint8_t kind_[128] = {};
+  bool any_general_ = false;  // some symbol is kind 2: rule choices are stored per module
+  std::uint32_t static_symbols_[128] = {}, static_params_[128] = {};  // output size of a kind-1 or 3 symbol
+  std::uint8_t formals_[128] = {};                                    // parameters a kind-3 symbol needs
+  bool lone_context_[128] = {};  // a kind-2 symbol whose one rule has a context (checked before choosing)
+  std::vector<std::vector<std::uint16_t>> out_words_;  // per rule: its successor's encoded words, flagged new
   std::vector<std::uint16_t> choice_;
   std::vector<std::size_t> block_in_params_, block_out_syms_, block_out_params_;
 };

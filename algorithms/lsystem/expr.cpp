@@ -372,6 +372,7 @@ bool ExprCompiler::compile(std::string_view text, const ExprScope& scope, Expr& 
     }
     out.code_.assign(1, Instr{Op::Const, 0, v});
   }
+  out.classify();
   return true;
 }
 
@@ -380,11 +381,27 @@ void Expr::set_origin(std::string origin, bool module_parameter) {
   module_parameter_ = module_parameter;
 }
 
-double Expr::eval(const double* env, const ExprHost& host) const {
-  const double v = run(env, host);
-  if (!std::isfinite(v) || (module_parameter_ && std::abs(v) > kMaxModuleParameter)) [[unlikely]]
-    fail_eval(env, host, v);
-  return v;
+void Expr::classify() {
+  shape_ = Shape::General;
+  const auto arithmetic = [](Op op) { return op == Op::Add || op == Op::Sub || op == Op::Mul || op == Op::Div; };
+  if (code_.size() == 1 && code_[0].op == Op::Const) {
+    shape_ = Shape::Constant;
+    shape_value_ = code_[0].value;
+  } else if (code_.size() == 1 && code_[0].op == Op::Load) {
+    shape_ = Shape::Variable;
+    shape_slot_ = code_[0].slot;
+  } else if (code_.size() == 3 && arithmetic(code_[2].op)) {
+    shape_op_ = code_[2].op;
+    if (code_[0].op == Op::Load && code_[1].op == Op::Const) {
+      shape_ = Shape::VariableOpConstant;
+      shape_slot_ = code_[0].slot;
+      shape_value_ = code_[1].value;
+    } else if (code_[0].op == Op::Const && code_[1].op == Op::Load) {
+      shape_ = Shape::ConstantOpVariable;
+      shape_slot_ = code_[1].slot;
+      shape_value_ = code_[0].value;
+    }
+  }
 }
 
 void Expr::fail_eval(const double* env, const ExprHost& host, double value) const {

@@ -15,6 +15,7 @@
 // are in degrees (the reference's convention).
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -109,13 +110,21 @@ struct ExprUse {
   bool age = false;           // g
 };
 
+// The largest magnitude a module's parameter holds: the parameters are 32-bit floats.
+inline constexpr double kMaxModuleParameter = std::numeric_limits<float>::max();
+
 class Expr {
  public:
   Expr() = default;
   // The value. A value that is not finite (a division by zero, an overflow), or beyond a 32-bit float
   // for an expression whose value becomes a module's parameter, is an InputError naming the origin and
   // the operation that made it (see set_origin).
-  [[nodiscard]] double eval(const double* env, const ExprHost& host) const;
+  [[nodiscard]] double eval(const double* env, const ExprHost& host) const {
+    const double v = value(env, host);
+    if (!std::isfinite(v) || (module_parameter_ && std::abs(v) > kMaxModuleParameter)) [[unlikely]]
+      fail_eval(env, host, v);
+    return v;
+  }
   // What eval's errors name: "FILE:LINE:COL: in rule '...': the condition 'x/y'". `module_parameter`:
   // the value is stored as a module's parameter, a 32-bit float.
   void set_origin(std::string origin, bool module_parameter);
@@ -127,6 +136,37 @@ class Expr {
 
  private:
   friend class ExprCompiler;
+  // Most arguments in practice are a constant, a variable, or a variable and a constant under one
+  // arithmetic operation (l*0.9, i+1). Those shapes skip the stack machine; the operation and its
+  // operand order are the bytecode's, so the value is the same to the bit.
+  enum class Shape : std::uint8_t { General, Constant, Variable, VariableOpConstant, ConstantOpVariable };
+  [[nodiscard]] double value(const double* env, const ExprHost& host) const {
+    switch (shape_) {
+      case Shape::Constant:
+        return shape_value_;
+      case Shape::Variable:
+        return env[shape_slot_];
+      case Shape::VariableOpConstant:
+        return arith(shape_op_, env[shape_slot_], shape_value_);
+      case Shape::ConstantOpVariable:
+        return arith(shape_op_, shape_value_, env[shape_slot_]);
+      default:
+        return run(env, host);
+    }
+  }
+  static double arith(Op op, double a, double b) {
+    switch (op) {
+      case Op::Add:
+        return a + b;
+      case Op::Sub:
+        return a - b;
+      case Op::Mul:
+        return a * b;
+      default:
+        return a / b;
+    }
+  }
+  void classify();
   [[nodiscard]] double run(const double* env, const ExprHost& host) const;
   // Which operation first made a value that is not finite, for messages ("a division by zero").
   [[nodiscard]] std::string diagnose(const double* env, const ExprHost& host) const;
@@ -136,10 +176,11 @@ class Expr {
   std::string text_;
   std::string origin_;
   bool module_parameter_ = false;
+  Shape shape_ = Shape::General;
+  Op shape_op_ = Op::Add;
+  std::uint8_t shape_slot_ = 0;
+  double shape_value_ = 0.0;
 };
-
-// The largest magnitude a module's parameter holds: the parameters are 32-bit floats.
-inline constexpr double kMaxModuleParameter = std::numeric_limits<float>::max();
 
 // A compile error: `offset` is the byte offset into the expression text where the problem is.
 struct ExprError {

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace growbench::lsys {
@@ -31,10 +32,23 @@ constexpr bool is_new(std::uint16_t w) {
   return (w & kNewFlag) != 0;
 }
 
+namespace detail {
+// Memory for a Buffer. A generation writes its whole output into fresh memory, so the first touch of
+// every page (a page fault, and the kernel zeroing the page) is a large share of a plain rewrite.
+// Blocks of a huge page or more are aligned to it and marked for transparent huge pages, which take
+// one fault per huge page instead of one per base page.
+void* allocate_buffer(std::size_t bytes);
+struct FreeBuffer {
+  void operator()(void* p) const;
+};
+}  // namespace detail
+
 // A growable array of trivially copyable values that does not zero what it allocates (the writers
 // fill every element), so a generation's output costs one pass of writes, not two.
 template <class T>
 class Buffer {
+  static_assert(std::is_trivially_copyable_v<T>);
+
  public:
   [[nodiscard]] std::size_t size() const { return size_; }
   [[nodiscard]] std::size_t capacity() const { return capacity_; }
@@ -46,7 +60,7 @@ class Buffer {
   void resize_discard(std::size_t n) {
     if (n > capacity_) {
       data_.reset();
-      data_.reset(new T[n]);
+      data_.reset(static_cast<T*>(detail::allocate_buffer(n * sizeof(T))));
       capacity_ = n;
     }
     size_ = n;
@@ -62,7 +76,7 @@ class Buffer {
   [[nodiscard]] std::size_t bytes() const { return capacity_ * sizeof(T); }
 
  private:
-  std::unique_ptr<T[]> data_;
+  std::unique_ptr<T[], detail::FreeBuffer> data_;
   std::size_t size_ = 0;
   std::size_t capacity_ = 0;
 };

@@ -16,6 +16,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <optional>
 
@@ -525,8 +526,10 @@ std::string resolve_grammar_path(const std::string& name) {
 }
 
 DerivedString derive_lsystem(const Params& params, std::uint64_t seed, const Scene* scene, const SceneQuery* query,
-                             std::size_t print_limit) {
+                             std::optional<std::size_t> print_limit) {
   Setup setup = make_setup(params, seed, query);
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::clock_t c0 = std::clock();
   lsys::Deriver deriver(setup.grammar, setup.derive);
   lsys::LString cur, next;
   std::vector<lsys::TurtleVars> states;
@@ -548,7 +551,9 @@ DerivedString derive_lsystem(const Params& params, std::uint64_t seed, const Sce
     std::swap(cur, next);
   }
   DerivedString out;
-  out.text = lsys::to_text(cur, setup.grammar.strings, print_limit);
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  out.cpu_seconds = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
+  if (print_limit) out.text = lsys::to_text(cur, setup.grammar.strings, *print_limit);
   out.modules = cur.size();
   out.params = cur.params.size();
   out.bytes = cur.bytes();

@@ -3,6 +3,8 @@
 // (>= 20 M/s), and memory per plain symbol (<= 8 bytes). Each benchmark times one generation (or one
 // interpretation) of about 5-25 million symbols; the generations before it are derived outside the
 // timed region. Rates count output symbols.
+#include <string>
+
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 
@@ -88,6 +90,44 @@ BENCHMARK(BM_LsysParametricRewrite)
     ->UseRealTime()
     ->Repetitions(3)
     ->ReportAggregatesOnly(true);
+
+// The peer workloads (bench/peers/cases.json), each derived whole from its premise, as `make
+// peers` times them against npm lindenmayer. Arg: threads. Rates count the last generation's modules.
+void derive_whole(benchmark::State& state, const std::string& premise, const std::string& rules, int generations) {
+  tbb::global_control gc(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(state.range(0)));
+  static const NoHost host;
+  const Grammar g = grammar(premise, rules);
+  Deriver d(g, settings(host));
+  LString a, b;
+  for (auto _ : state) {
+    d.premise(a);
+    for (int k = 1; k <= generations; ++k) {
+      d.rewrite(a, b, k, {});
+      std::swap(a, b);
+    }
+    benchmark::DoNotOptimize(a.symbols.data());
+  }
+  state.counters["modules"] = static_cast<double>(a.size());
+  state.counters["modules_per_s"] =
+      benchmark::Counter(static_cast<double>(a.size()), benchmark::Counter::kIsIterationInvariantRate);
+}
+
+void BM_LsysPeerBracketedPlant(benchmark::State& state) {  // n=9: 4.88 M modules
+  derive_whole(state, "F", "F = F[+F]F[-F]F", 9);
+}
+void BM_LsysPeerMonopodialTree(benchmark::State& state) {  // ABOP fig. 2.6, n=18: 1.84 M modules
+  derive_whole(state, "A(1,10)",
+               "A(l,w) = !(w)F(l)[&(45)B(l*0.6,w*0.707)]/(137.5)A(l*0.9,w*0.707)\n"
+               "B(l,w) = !(w)F(l)[-(45)$C(l*0.6,w*0.707)]C(l*0.9,w*0.707)\n"
+               "C(l,w) = !(w)F(l)[+(45)$B(l*0.6,w*0.707)]B(l*0.9,w*0.707)",
+               18);
+}
+void BM_LsysPeerContextSignal(benchmark::State& state) {  // b + 350,000 a, 8 steps
+  derive_whole(state, "b" + std::string(350000, 'a'), "b < a = b\nb = a", 8);
+}
+BENCHMARK(BM_LsysPeerBracketedPlant)->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_LsysPeerMonopodialTree)->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_LsysPeerContextSignal)->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // The plain plant at generation 9: 4.9 M symbols, 2 M nodes. Arg 0: a fresh Plant per interpretation
 // (cold: the node array's pages are touched for the first time); arg 1: the Plant is cleared and

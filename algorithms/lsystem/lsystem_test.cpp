@@ -150,6 +150,36 @@ TEST(LSystemDerivation, Parametric) {  // ABOP 1.10, fig. 1.31
   EXPECT_EQ(derive("B(2)A(4,4)", rules, 5), "CB(0)B(8)A(1.14286,0)");
 }
 
+TEST(LSystemDerivation, OneParametricRuleAppliesOnlyToItsParameterCount) {
+  // A symbol with one rule and no condition is rewritten without choosing: the pattern's count decides.
+  EXPECT_EQ(derive("A(1)A(1,2)A", "A(x) = B(x+1)A(x*2)", 1), "B(2)A(2)A(1,2)A");
+  EXPECT_EQ(derive("A(1)A(1,2)A", "A(x) = B(x+1)A(x*2)", 2), "B(2)B(3)A(4)A(1,2)A");
+  EXPECT_EQ(derive("A(1)A", "A(x) = F[+]A(x)", 2), "F[+]F[+]A(1)A");  // a successor of constants
+}
+
+// The peer workloads (bench/peers/cases.json), smaller: each spans several rewrite blocks.
+TEST(LSystemDerivation, PeerWorkloadsAreExactAndIdenticalOnOneAndTwoThreads) {
+  const std::string abop =
+      "A(l,w) = !(w)F(l)[&(45)B(l*0.6,w*0.707)]/(137.5)A(l*0.9,w*0.707)\n"
+      "B(l,w) = !(w)F(l)[-(45)$C(l*0.6,w*0.707)]C(l*0.9,w*0.707)\n"
+      "C(l,w) = !(w)F(l)[+(45)$B(l*0.6,w*0.707)]B(l*0.9,w*0.707)";
+  const std::string signal = "b" + std::string(100000, 'a');
+  const std::vector<Params> cases = {lsys_params("F", "F=F[+F]F[-F]F", 7), lsys_params("A(1,10)", abop, 14),
+                                     lsys_params(signal, "b < a = b\nb = a", 8)};
+  std::vector<DerivedString> one, two;
+  for (const std::size_t threads : {1, 2}) {
+    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, threads);
+    for (const auto& p : cases) (threads == 1 ? one : two).push_back(derive_lsystem(p, 1, nullptr, nullptr, 0));
+  }
+  for (std::size_t k = 0; k < cases.size(); ++k) EXPECT_EQ(one[k].text, two[k].text) << k;
+  EXPECT_EQ(one[0].modules, 1u + 10u * (78125u - 1u) / 4u);  // 5^7 F, each adding 10 symbols
+  EXPECT_EQ(one[1].modules, 7u * 16384u - 6u);               // 7 * 2^n - 6
+  EXPECT_EQ(one[1].params, 81931u);
+  EXPECT_EQ(one[1].text.substr(0, 41), "!(10)F(1)[&(45)!(7.07)F(0.6)[-(45)$C(0.36");
+  EXPECT_EQ(one[2].text.substr(0, 10), "aaaaaaaaba");  // the signal moves one module per step
+  EXPECT_EQ(counts(one[2])['b'], 1u);
+}
+
 TEST(LSystemDerivation, HoudiniReferenceExamples) {
   // "A(i):i<5 = A(i+1) A(i+1) will double each A a maximum of five times"
   const auto d = derive_lsystem(lsys_params("A(0)", "A(i):i<5 = A(i+1) A(i+1)", 8), 1, nullptr, nullptr, 0);
@@ -531,6 +561,58 @@ TEST(LSystemExpr, CompilesOnceAndFoldsConstants) {
   EXPECT_EQ(e.constant_value(), -4.0);
   EXPECT_FALSE(lsys::ExprCompiler::compile("x +", {&formals, nullptr}, e, err));
   EXPECT_EQ(err.offset, 3u);
+}
+
+TEST(LSystemExpr, ShortShapesGiveTheStackMachinesBitsAndErrors) {
+  // x*0.6 runs without the stack machine, x*0.6*1 with it: the same product to the bit.
+  std::vector<std::string> formals = {"x"};
+  struct H final : lsys::ExprHost {
+    double in(double, double, double) const override { return 0; }
+    double pic(double, double, double) const override { return 0; }
+    double rand(double) const override { return 0; }
+    double chan(double) const override { return 0; }
+  } host;
+  const auto compiled = [&](const std::string& text) {
+    lsys::Expr e;
+    lsys::ExprError err;
+    EXPECT_TRUE(lsys::ExprCompiler::compile(text, {&formals, nullptr}, e, err)) << text;
+    return e;
+  };
+  double env[lsys::kMaxSlots] = {};
+  for (const double x : {0.1, -3.7, 1e-300, 123456.789}) {
+    env[0] = x;
+    for (const char* op : {"*", "/", "+", "-"}) {
+      const std::string o(op);
+      EXPECT_EQ(compiled("x" + o + "0.6").eval(env, host), compiled("x" + o + "0.6*1").eval(env, host)) << op << x;
+      EXPECT_EQ(compiled("0.6" + o + "x").eval(env, host), compiled("(0.6" + o + "x)*1").eval(env, host)) << op << x;
+    }
+    EXPECT_EQ(compiled("x").eval(env, host), x);
+  }
+  env[0] = 2.0;
+  EXPECT_EQ(compiled("x - 0.5").eval(env, host), 1.5);
+  EXPECT_EQ(compiled("3 / x").eval(env, host), 1.5);
+  try {
+    (void)compiled("1 / (x - 2)").eval(env, host);  // the general path, for comparison
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("a division by zero"), std::string::npos) << e.what();
+  }
+  env[0] = 0.0;
+  try {
+    (void)compiled("1 / x").eval(env, host);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "'1 / x' gave inf, from a division by zero");
+  }
+  env[0] = 1e300;
+  lsys::Expr big = compiled("x * 10");
+  big.set_origin("the argument", true);
+  try {
+    (void)big.eval(env, host);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("beyond the largest module parameter"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
