@@ -175,7 +175,7 @@ TEST(LSystemDerivation, PeerWorkloadsAreExactAndIdenticalOnOneAndTwoThreads) {
   EXPECT_EQ(one[0].modules, 1u + 10u * (78125u - 1u) / 4u);  // 5^7 F, each adding 10 symbols
   EXPECT_EQ(one[1].modules, 7u * 16384u - 6u);               // 7 * 2^n - 6
   EXPECT_EQ(one[1].params, 81931u);
-  EXPECT_EQ(one[1].text.substr(0, 41), "!(10)F(1)[&(45)!(7.07)F(0.6)[-(45)$C(0.36");
+  EXPECT_EQ(one[1].text.substr(0, 41), "!(10)F(1)[&(45)!(7.07)F(0.6)[-(45)$!(4.99");
   EXPECT_EQ(one[2].text.substr(0, 10), "aaaaaaaaba");  // the signal moves one module per step
   EXPECT_EQ(counts(one[2])['b'], 1u);
 }

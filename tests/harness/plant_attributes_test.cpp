@@ -335,7 +335,8 @@ TEST_F(PlantAttributes, OrganColoursBecomeVertexColoursInGltfAndPly) {
   EXPECT_EQ(petal_in_gltf, petal_vertices);
 
   write_ply((dir / "p.ply").string(), m);
-  const PlyElement& vertex = read_ply(dir / "p.ply").element("vertex");
+  const Ply ply = read_ply(dir / "p.ply");  // kept: the element below refers into it
+  const PlyElement& vertex = ply.element("vertex");
   auto srgb_byte = [](float linear) {
     const double s = linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
     return std::round(255.0 * s);
