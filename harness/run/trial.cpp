@@ -593,9 +593,12 @@ TrialRecord run_trial_record(const TrialSpec& spec, const std::function<void(con
     // Indented for people reading `growbench run` output; compact when a suite parent parses it.
     write_file_atomic(path, json_text(to_json(rec), spec.skip_teardown ? -1 : 2));
   }
-  // Deliberately never freed: the process exits next and the kernel reclaims it all at once.
-  if (spec.skip_teardown) [[maybe_unused]]
-    auto* kept = new TrialState{std::move(st)};
+  // Deliberately never freed: the process exits next and the kernel reclaims it all at once. Held by a
+  // static, so that a leak checker sees it still reachable at exit.
+  if (spec.skip_teardown) {
+    [[maybe_unused]] static TrialState* kept = nullptr;
+    kept = new TrialState{std::move(st)};
+  }
   return rec;
 }
 
