@@ -464,8 +464,7 @@ void Deriver::rewrite(const LString& in, LString& out, int generation, const std
     };
     auto put_static = [&](const Rule& r, const std::vector<std::uint16_t>& words) {
       const std::size_t ns = words.size();
-      std::memcpy(os, words.data(), ns * sizeof(std::uint16_t));
-      os += ns;
+      os = std::copy(words.begin(), words.end(), os);  // an empty successor has no data() to memcpy from
       if (!r.static_params.empty()) {
         std::memcpy(op, r.static_params.data(), r.static_params.size() * sizeof(float));
         op += r.static_params.size();

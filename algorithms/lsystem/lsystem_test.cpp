@@ -150,6 +150,12 @@ TEST(LSystemDerivation, Parametric) {  // ABOP 1.10, fig. 1.31
   EXPECT_EQ(derive("B(2)A(4,4)", rules, 5), "CB(0)B(8)A(1.14286,0)");
 }
 
+TEST(LSystemDerivation, AnEmptySuccessorErasesItsModule) {  // a fuzzer's find: nothing to copy is no copy
+  EXPECT_EQ(derive("AB", "A =\nB = AB", 1), "AB");
+  EXPECT_EQ(derive("AB", "A =\nB = AB", 3), "AB");
+  EXPECT_EQ(derive("A[A]B", "A =", 1), "[]B");
+}
+
 TEST(LSystemDerivation, OneParametricRuleAppliesOnlyToItsParameterCount) {
   // A symbol with one rule and no condition is rewritten without choosing: the pattern's count decides.
   EXPECT_EQ(derive("A(1)A(1,2)A", "A(x) = B(x+1)A(x*2)", 1), "B(2)A(2)A(1,2)A");
