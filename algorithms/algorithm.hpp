@@ -53,6 +53,10 @@ class GrowthAlgorithm {
   void set_deadline(std::chrono::steady_clock::time_point t) { deadline_ = t; }
   [[nodiscard]] bool cancelled() const { return deadline_ && std::chrono::steady_clock::now() > *deadline_; }
   [[nodiscard]] virtual const AlgorithmInfo& describe() const = 0;
+  // Reads the input files `params` name (spacecol's points file), once, before start(). The harness
+  // calls it in the scene_load phase: reading input is not growth. An algorithm that skips it (a
+  // plugin) reads them in start(). Throws InputError for a file that cannot be read.
+  virtual void load_inputs(const Params& /*params*/) {}
   // Prepares a run. `params` were validated against describe().params. The scene and query outlive
   // the algorithm. Throws InputError for combinations of parameters and scene that cannot work.
   virtual void start(const Scene& scene, const SceneQuery& query, const Params& params, std::uint64_t seed) = 0;

@@ -1,13 +1,13 @@
 // Runions space colonization: open venation (Runions et al. 2005, trees 2007) and closed venation
 // (relative neighbourhood, 2005), in a volume, on surfaces, or held on them (the Hyphae variant).
 //
-// Cost model. Attraction points sit in two nanoflann kd-trees (far and near points), rebuilt only when
-// dead points crowd them (compact_active). Each point keeps its nearest node within the influence
-// radius; nodes are only ever added, so after a step only the points
-// within the influence radius of the *new* nodes can change their nearest node or die. One radius
-// query per new node (in parallel) does all the updating; there is never a rebuild plus re-query of
-// every point per step. Points that have a node in range form the `active` list, the only points a
-// step looks at.
+// Cost model. Attraction points sit in a few nanoflann kd-trees, one per tier of distance to their
+// nearest node, rebuilt only when stale points crowd one (compact_active). Each point keeps its
+// nearest node within the influence radius; nodes are only ever added, so after a step only the
+// points within the influence radius of the *new* nodes can change their nearest node or die. One
+// radius query per new node and tier (in parallel) does all the updating; there is never a rebuild plus
+// re-query of every point per step. Points that have a node in range form the `active` list, the only
+// points a step looks at.
 //
 // Determinism. Parallel work writes to per-item slots; everything that depends on order (merging
 // query results, accumulating directions, appending nodes) runs in a fixed order (node index, then
@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <memory>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -124,6 +125,15 @@ using spacecol::Points;
 using spacecol::Surface;
 constexpr std::int32_t kNone = -1;
 constexpr float kStallFraction = 0.05f;  // a child closer than this * step to a sibling means a stalled node
+// Point tiers (associate()): each tier's upper bound is this times the one below it. Thinner tiers
+// cost more queries per node (one tree descent each), thicker ones more points per query that the
+// filter then rejects (their nearest node is already nearer than the new one).
+constexpr float kTierRatio = 1.5f;
+constexpr std::size_t kMaxTiers = 16;
+constexpr std::size_t kRebuildSlack = 1024;  // stale points a tier may hold beyond half before a rebuild
+// Points per kd-tree leaf. Larger than nanoflann's usual 10-16: a radius query here covers many
+// leaves, and scanning a leaf's points costs less than descending to more, smaller leaves.
+constexpr std::size_t kLeafSize = 32;
 
 // The pulls of the attraction points on one node, accumulated in a fixed order.
 struct Pull {
@@ -137,6 +147,15 @@ struct Pull {
 class SpaceColonization final : public PortableGrowthAlgorithm {
  public:
   const AlgorithmInfo& describe() const override { return kInfo; }
+
+  // The points file is read here, in the harness's scene_load phase; start_with() reads it itself when
+  // this was not called (the plugin build, tests that call start() directly).
+  void load_inputs(const Params& p) override {
+    if (p.text("points") != "file") return;
+    loaded_path_ = p.text("points_file");
+    loaded_pts_ = read_points_file(loaded_path_);
+    loaded_ = true;
+  }
 
   void start_with(const Scene& scene, const HostQueries& query, const Params& p, std::uint64_t seed) override {
     scene_ = &scene;
@@ -156,10 +175,8 @@ class SpaceColonization final : public PortableGrowthAlgorithm {
     closest_.assign(pts_.size(), kNone);
     closest_d2_.assign(pts_.size(), 0.0f);
     alive_.assign(pts_.size(), 1);
-    where_.assign(pts_.size(), kFar);
-    // tau: the near/far split. Small enough that near searches are cheap, large enough that most
-    // covered points qualify (every live point is at least the kill distance from its nearest node).
-    tau_ = std::min(cfg_.influence, std::max(2.0f * cfg_.kill, cfg_.kill + 2.0f * cfg_.step));
+    where_.assign(pts_.size(), 0);
+    make_tiers();
     build_trees();
     alive_count_ = pts_.size();
     if (cfg_.closed)
@@ -269,8 +286,11 @@ class SpaceColonization final : public PortableGrowthAlgorithm {
             return s.position + off * s.normal;
           },
           "on the surfaces");
+    } else if (loaded_ && loaded_path_ == points_file) {
+      pts_ = std::move(loaded_pts_);
+      loaded_ = false;
     } else {
-      read_points_file(points_file);
+      pts_ = read_points_file(points_file);
     }
     morton_order();
   }
@@ -304,10 +324,11 @@ class SpaceColonization final : public PortableGrowthAlgorithm {
     pts_.swap(sorted);
   }
 
-  void read_points_file(const std::string& path) {
+  static std::vector<glm::vec3> read_points_file(const std::string& path) {
     if (path.empty()) throw InputError("algorithm 'spacecol': points=file needs points_file=PATH");
     std::ifstream in(path);
     if (!in) throw InputError(fmt::format("{}: cannot open attraction point file", path));
+    std::vector<glm::vec3> pts;
     std::string line;
     for (int ln = 1; std::getline(in, line); ++ln) {
       std::replace(line.begin(), line.end(), ',', ' ');
@@ -320,9 +341,10 @@ class SpaceColonization final : public PortableGrowthAlgorithm {
       if (!(ls >> v.x >> v.y >> v.z) || (ls >> extra) || !std::isfinite(v.x) || !std::isfinite(v.y) ||
           !std::isfinite(v.z))
         throw InputError(fmt::format("{}:{}: expected three finite numbers 'x y z'", path, ln));
-      pts_.push_back(v);
+      pts.push_back(v);
     }
-    if (pts_.empty()) throw InputError(fmt::format("{}: no attraction points in the file", path));
+    if (pts.empty()) throw InputError(fmt::format("{}: no attraction points in the file", path));
+    return pts;
   }
 
   // ---------- nodes ----------
@@ -604,9 +626,29 @@ class SpaceColonization final : public PortableGrowthAlgorithm {
     if (alive_[s]) {
       alive_[s] = 0;
       --alive_count_;
-      if (where_[s] == kFar) ++far_stale_;
-      if (where_[s] == kNear) ++near_dead_;
+      make_stale(s);
     }
+  }
+
+  // Marks a point its tier's tree need not hold any more (dead, or nearer than the tier's range).
+  void make_stale(std::uint32_t s) {
+    if (where_[s] & kStale) return;
+    ++tiers_[where_[s]]->stale;
+    where_[s] |= kStale;
+  }
+
+  // The tiers' bounds: the first at tau, small enough that searches of the nearest points are cheap,
+  // large enough that most covered points fall below it (every live point is at least the kill
+  // distance from its nearest node); then a geometric series up to the influence radius.
+  void make_tiers() {
+    const float tau = std::min(cfg_.influence, std::max(2.0f * cfg_.kill, cfg_.kill + 2.0f * cfg_.step));
+    tiers_.clear();
+    float lo = 0.0f;
+    for (float hi = tau; hi < cfg_.influence && tiers_.size() + 2 < kMaxTiers; hi *= kTierRatio) {
+      tiers_.push_back(std::make_unique<Tier>(lo, hi));
+      lo = hi;
+    }
+    tiers_.push_back(std::make_unique<Tier>(lo, cfg_.influence));  // also every point with no node in range
   }
 
   // Updates nearest nodes, activations and kills for points near the given (new) nodes.
@@ -614,27 +656,26 @@ class SpaceColonization final : public PortableGrowthAlgorithm {
     if (cfg_.closed)
       node_tree_->addPoints(static_cast<std::uint32_t>(node_pos_.size() - nodes.size()),
                             static_cast<std::uint32_t>(node_pos_.size() - 1));
-    const float r2 = cfg_.influence * cfg_.influence, k2 = cfg_.kill * cfg_.kill;
+    const float k2 = cfg_.kill * cfg_.kill;
     std::vector<std::vector<std::pair<std::uint32_t, float>>> found(nodes.size());
     // Only points the new node is nearer to than their current nearest can change (every live point is
     // farther than the kill distance from its nearest node, so this also keeps every point to kill).
-    // Far points are searched within the influence radius, near points (a node within tau) only within
-    // tau: their nearest node can only get nearer. The parallel part only reads; all writes happen in
-    // the merge below, in point-index order per node, so the result does not depend on the trees.
-    const float t2 = tau_ * tau_;
+    // A tier's points are searched only within its upper bound: their nearest node can only get
+    // nearer. The parallel part only reads; all writes happen in the merge below, in point-index order
+    // per node, so the result does not depend on the trees.
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nodes.size(), 16), [&](const auto& r) {
       std::vector<std::pair<std::uint32_t, float>> part;
       for (std::size_t k = r.begin(); k < r.end(); ++k) {
         const glm::vec3& q = node_pos_[static_cast<std::size_t>(nodes[k])];
         auto& out = found[k];
         out.clear();
-        for (int t = 0; t < 2; ++t) {
-          const auto& ids = t == 0 ? far_ids_ : near_ids_;
-          auto rs = collect_within(t == 0 ? r2 : t2, part, [&](std::uint32_t j, float d2) {
+        for (const auto& tier : tiers_) {
+          const auto& ids = tier->ids;
+          auto rs = collect_within(tier->hi * tier->hi, part, [&](std::uint32_t j, float d2) {
             const std::uint32_t i = ids[j];
             return alive_[i] != 0 && (closest_[i] == kNone || d2 < closest_d2_[i]);
           });
-          (t == 0 ? far_tree_ : near_tree_)->findNeighbors(rs, &q.x, nanoflann::SearchParams(32, 0.0f, false));
+          tier->tree->findNeighbors(rs, &q.x, nanoflann::SearchParams(32, 0.0f, false));
           for (const auto& [j, d2] : part) out.emplace_back(ids[j], d2);
         }
         std::sort(out.begin(), out.end());
@@ -658,10 +699,8 @@ class SpaceColonization final : public PortableGrowthAlgorithm {
         } else {
           continue;
         }
-        if (where_[s] == kFar && d2 < tau_ * tau_) {  // now near, but still searched in the far tree
-          where_[s] = kFarStale;
-          ++far_stale_;
-        }
+        // Below its tier now, but still searched in that tier's tree.
+        if (const float lo = tiers_[where_[s] & ~kStale]->lo; d2 < lo * lo) make_stale(s);
       }
     }
   }
@@ -669,30 +708,35 @@ class SpaceColonization final : public PortableGrowthAlgorithm {
   void compact_active() {
     active_.erase(std::remove_if(active_.begin(), active_.end(), [this](std::uint32_t s) { return !alive_[s]; }),
                   active_.end());
-    // Dead points, and near points still in the far tree, cost time in every radius query: rebuild the
-    // trees when they make up half of the far tree, or dead points half of the near tree (amortised
-    // O(n log n) over the whole run).
-    if (alive_count_ > 0 && (2 * far_stale_ > far_ids_.size() || 2 * near_dead_ > near_ids_.size() + 1024))
-      build_trees();
+    // Stale points (dead, or below their tier) cost time in every radius query: rebuild the trees when
+    // they make up half of any tier (amortised O(n log n) over the whole run).
+    if (alive_count_ == 0) return;
+    for (const auto& t : tiers_)
+      if (2 * t->stale > t->ids.size() + kRebuildSlack) return build_trees();
   }
 
   void build_trees() {
-    far_ids_.clear();
-    far_pts_.clear();
-    near_ids_.clear();
-    near_pts_.clear();
-    const float t2 = tau_ * tau_;
+    for (auto& t : tiers_) {
+      t->ids.clear();
+      t->pts.clear();
+      t->stale = 0;
+    }
     for (std::uint32_t i = 0; i < pts_.size(); ++i) {
       if (!alive_[i]) continue;
-      const bool near = closest_[i] != kNone && closest_d2_[i] < t2;
-      where_[i] = near ? kNear : kFar;
-      (near ? near_ids_ : far_ids_).push_back(i);
-      (near ? near_pts_ : far_pts_).push_back(pts_[i]);
+      std::uint8_t k = 0;
+      if (closest_[i] == kNone)
+        k = static_cast<std::uint8_t>(tiers_.size() - 1);
+      else
+        while (std::size_t{k} + 1 < tiers_.size() && closest_d2_[i] >= tiers_[k]->hi * tiers_[k]->hi) ++k;
+      where_[i] = k;
+      tiers_[k]->ids.push_back(i);
+      tiers_[k]->pts.push_back(pts_[i]);
     }
-    far_stale_ = near_dead_ = 0;
     ++tree_builds_;
-    far_tree_ = std::make_unique<PointTree>(3, far_cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-    near_tree_ = std::make_unique<PointTree>(3, near_cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    tbb::parallel_for(std::size_t{0}, tiers_.size(), [&](std::size_t k) {
+      tiers_[k]->tree =
+          std::make_unique<PointTree>(3, tiers_[k]->cloud, nanoflann::KDTreeSingleIndexAdaptorParams(kLeafSize));
+    });
   }
 
   // ---------- leaves ----------
@@ -736,16 +780,26 @@ class SpaceColonization final : public PortableGrowthAlgorithm {
   bool ever_influenced_ = false;
 
   std::vector<glm::vec3> pts_;
-  // Live points split at the last rebuild into far (no node within tau) and near ones, each in its own
-  // kd-tree; the ids map tree indices back to point indices.
-  enum Where : std::uint8_t { kFar, kNear, kFarStale };
-  std::vector<std::uint8_t> where_;
-  std::vector<glm::vec3> far_pts_, near_pts_;
-  std::vector<std::uint32_t> far_ids_, near_ids_;
-  Cloud far_cloud_{&far_pts_}, near_cloud_{&near_pts_};  // nanoflann keeps references to these adaptors
-  std::unique_ptr<PointTree> far_tree_, near_tree_;
-  std::size_t far_stale_ = 0, near_dead_ = 0, tree_builds_ = 0;
-  float tau_ = 0;
+  // The points file as load_inputs() read it, until start_with() takes it.
+  bool loaded_ = false;
+  std::string loaded_path_;
+  std::vector<glm::vec3> loaded_pts_;
+  // Live points split at the last rebuild by the distance to their nearest node into tiers [lo, hi),
+  // each in its own kd-tree searched within hi; the last tier also holds the points no node reaches.
+  // The ids map tree indices back to point indices.
+  struct Tier {
+    Tier(float l, float h) : lo(l), hi(h) {}
+    float lo, hi;
+    std::vector<glm::vec3> pts;
+    std::vector<std::uint32_t> ids;
+    Cloud cloud{&pts};  // nanoflann keeps a reference to the adaptor: a Tier never moves
+    std::unique_ptr<PointTree> tree;
+    std::size_t stale = 0;
+  };
+  std::vector<std::unique_ptr<Tier>> tiers_;
+  std::vector<std::uint8_t> where_;  // the point's tier, | kStale once the tree need not hold it
+  static constexpr std::uint8_t kStale = 0x80;
+  std::size_t tree_builds_ = 0;
   std::vector<std::int32_t> closest_;
   std::vector<float> closest_d2_;
   std::vector<std::uint8_t> alive_;

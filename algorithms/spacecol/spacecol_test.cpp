@@ -1,3 +1,5 @@
+#include <filesystem>
+
 #include <gtest/gtest.h>
 
 #include "algorithms/algorithm.hpp"
@@ -182,6 +184,31 @@ TEST(SpaceColonization, DeterministicAcrossThreadCountsAndRuns) {
   }
 }
 
+// Speed-ups must not change the plant. These hashes are the plants grown before the point tiers
+// (commit e041b84, `growbench run -a spacecol -s SCENE --set ...`, seed 1): a change to how points are
+// searched that moves any of them changed the algorithm, not only its cost. The last case has six tiers
+// and rebuilds them several times.
+TEST(SpaceColonization, PlantsAreThoseGrownBeforeThePointTiers) {
+  const Scene envelope = load_scene("envelope"), wall = load_scene("wall");
+  const SceneQuery qe(envelope), qw(wall);
+  struct Case {
+    const Scene* scene;
+    const SceneQuery* query;
+    std::vector<std::string> sets;
+    const char* hash;
+  };
+  for (const Case& c : std::vector<Case>{
+           {&envelope, &qe, {"point_count=3000"}, "dfee095c25ce8fc7"},
+           {&envelope, &qe, {"venation=closed", "point_count=2000"}, "d3bf8a1eca51bfcf"},
+           {&wall, &qw, {"surface=cling", "point_count=2000"}, "942bc4822577933a"},
+           {&envelope, &qe, {"surface=avoid", "point_count=3000", "noise=0.3", "tropism=0,0.2,0"}, "f18f97a11cd5ca20"},
+           {&envelope, &qe, {"point_count=20000", "kill=0.02", "step=0.01"}, "d68f3d0d33164039"},
+       })
+    for (const int threads : {1, 2})
+      EXPECT_EQ(grow("spacecol", *c.scene, *c.query, c.sets, threads).geometry_hash(), c.hash)
+          << c.sets.front() << ", " << threads << " threads";
+}
+
 TEST(SpaceColonization, BadParameterCombinationsAreInputErrors) {
   const Scene s = open_space({{0, 0, 0}});
   SceneQuery q(s, {.build_sdf = false});
@@ -195,6 +222,32 @@ TEST(SpaceColonization, BadParameterCombinationsAreInputErrors) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("points.txt:2:"), std::string::npos) << e.what();
   }
+}
+
+// The harness calls load_inputs() in the scene_load phase: after it, growth reads no file (this one is
+// gone by then) and grows the plant that reading the file in start() grows.
+TEST(SpaceColonization, PointsFileIsReadBeforeGrowth) {
+  const Scene s = open_space({{0, 0, 0}});
+  SceneQuery q(s, {.build_sdf = false});
+  const std::string f = points_file("loaded", "-0.5 1 0\n0.5 1 0\n0 1.5 0.5\n");
+  const std::vector<std::string> sets = exact(f);
+  const Plant direct = grow("spacecol", s, q, sets);
+  const AlgorithmEntry& e = find_algorithm("spacecol");
+  Params p = default_params(e);
+  for (const auto& a : sets) p.set_assignment(a);
+  auto algo = e.make();
+  algo->load_inputs(p);
+  std::filesystem::remove(f);
+  algo->start(s, q, p, 1);
+  while (algo->step()) {
+  }
+  algo->finish();
+  ASSERT_GT(direct.nodes.size(), 10u);
+  EXPECT_EQ(algo->plant().geometry_hash(), direct.geometry_hash());
+  // A second start() (the file read once is used once) reads the file again, which is now an error.
+  EXPECT_THROW(algo->start(s, q, p, 1), InputError);
+  // A file that cannot be read is an input error in load_inputs() already.
+  EXPECT_THROW(e.make()->load_inputs(p), InputError);
 }
 
 }  // namespace

@@ -357,8 +357,14 @@ struct TrialState {
 };
 
 // The scene_load and query_build phases; the scene's seeds replaced by --seed-at, snapped to the surface.
-void load_scene_and_query(const TrialSpec& spec, TrialState& st, PhaseTimer& timer, TrialRecord& rec) {
-  st.scene = timer.run("scene_load", rec.phases.scene_load, [&] { return load_scene(spec.scene, spec.scene_params); });
+// Scene load includes the algorithm's own input files (its load_inputs).
+void load_scene_and_query(const TrialSpec& spec, const Params& params, TrialState& st, PhaseTimer& timer,
+                          TrialRecord& rec) {
+  st.scene = timer.run("scene_load", rec.phases.scene_load, [&] {
+    Scene scene = load_scene(spec.scene, spec.scene_params);
+    st.algo->load_inputs(params);
+    return scene;
+  });
   SceneQueryOptions qo;
   qo.voxel_size = spec.voxel_size;
   st.query =
@@ -562,11 +568,11 @@ TrialRecord run_trial_record(const TrialSpec& spec, const std::function<void(con
   rec.max_steps = spec.max_steps;
   PhaseTimer timer;
   TrialState st;
-  load_scene_and_query(spec, st, timer, rec);
+  st.algo = entry.make();
+  load_scene_and_query(spec, params, st, timer, rec);
   rec.params = params.to_json();
   if (!spec.mesher.leaf_obj.empty()) rec.leaf_obj = spec.mesher.leaf_obj;
 
-  st.algo = entry.make();
   grow(spec, params, st, timer, rec, progress);
   const Plant& plant = st.algo->plant();
   if (const std::string bad = plant.validate(); !bad.empty()) {
