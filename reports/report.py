@@ -733,12 +733,14 @@ def peers_html(doc, path, out, formats):
             f.write("| " + " | ".join(x.replace("|", "\\|") for x in r) + " |\n")
     m = doc.get("machine", {})
     loads = [x for c in doc["cases"] for x in c.get("load_1min", [])]
+    first = doc.get("untimed_first_runs", 0)
+    first_runs = f"Each side ran {first} untimed time(s) before its timed repetitions. " if first else ""
     parts = ["<h2>Versus peers</h2>",
              f"<p>From {e(os.path.abspath(path))} (<code>make peers</code>, growbench {e(doc['growbench']['version'])}, "
              f"{e(doc.get('started', '?'))}): each peer and growbench on the same input, alternating, "
              f"{doc['repetitions']} repetitions each, each timed inside its own process. Machine: {e(m.get('cpu', '?'))}, "
              f"{m.get('cores', '?')} cores; 1-minute load during the runs {min(loads, default=0):.1f} to "
-             f"{max(loads, default=0):.1f}. lindenmayer is timed after {doc.get('lindenmayer_warmup', 0)} untimed "
+             f"{max(loads, default=0):.1f}. {first_runs}lindenmayer is timed after {doc.get('lindenmayer_warmup', 0)} untimed "
              f"derivation(s) in its own process (V8 warmed up).</p>",
              "<table><tr>" + "".join(f"<th>{e(h)}</th>" for h in PEERS_HEAD) + "</tr>"]
     parts += ["<tr>" + "".join(f"<td>{e(x)}</td>" for x in r) + "</tr>" for r in rows]

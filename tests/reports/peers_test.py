@@ -58,7 +58,7 @@ class Ratio(unittest.TestCase):
         self.assertLessEqual(hi, 5.0)
 
 
-DOC = {"schema": "growbench-peers/1", "started": "2026-01-01T00:00:00+00:00", "repetitions": 5,
+DOC = {"schema": "growbench-peers/1", "started": "2026-01-01T00:00:00+00:00", "repetitions": 5, "untimed_first_runs": 1,
        "interval": {"level": 0.95, "method": "bootstrap percentile of the ratio of medians, 4000 resamples"},
        "machine": {"cpu": "test cpu", "cores": 2}, "growbench": {"version": "abc1234"},
        "cases": [{"name": "ivy-cube", "kind": "ivy", "title": "ivy on a cube", "target": 50, "peer": "Blender 3.4.1",
@@ -90,7 +90,7 @@ class Report(unittest.TestCase):
             page = open(os.path.join(d, "r", "index.html")).read()
             self.assertIn("<h2>Versus peers</h2>", page)
             self.assertIn("<td>40.0x [30.0, 45.5]</td>", page)
-            self.assertIn("load during the runs 1.5 to 2.5", page)
+            self.assertIn("load during the runs 1.5 to 2.5. Each side ran 1 untimed time(s) before its timed", page)
             self.assertTrue(os.path.exists(os.path.join(d, "r", "fig-peers.png")))
 
     def test_not_a_peers_file(self):
