@@ -145,6 +145,12 @@ std::string Plant::validate() const {
     const auto& o = organs[i];
     if (!finite(o.position) || !std::isfinite(o.size) || o.size < 0.0f)
       return fmt::format("organ {} has a non-finite position or a bad size", i);
+    // Exporters and the mesher turn organs by this quaternion as a rotation: one that is not unit would
+    // scale a meshed organ but only turn an instanced one. The tolerance covers float rounding.
+    const glm::quat& q = o.orientation;
+    if (!(std::abs(glm::length(q) - 1.0f) <= 1e-3f))
+      return fmt::format("organ {} has orientation (w {}, x {}, y {}, z {}), not a unit quaternion", i, q.w, q.x, q.y,
+                         q.z);
     if (o.node != kNoParent && (o.node < 0 || static_cast<std::size_t>(o.node) >= nodes.size()))
       return fmt::format("organ {} refers to node {} of {}", i, o.node, nodes.size());
     if (o.shape != kKindShape && o.shape >= organ_shapes.size())

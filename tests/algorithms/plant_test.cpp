@@ -42,6 +42,16 @@ TEST(Plant, LengthHashAndValidation) {
   Plant r = y_plant();
   r.organs.push_back({{0, 0, 0}, {1, 0, 0, 0}, 0.1f, OrganKind::Leaf, 9});
   EXPECT_NE(r.validate().find("organ 0"), std::string::npos);
+  // An organ's orientation is a rotation: a quaternion of another length, or NaN, is refused.
+  Plant s = y_plant();
+  s.organs.push_back({{0, 0, 0}, {1, 0, 0, 0}, 0.1f, OrganKind::Leaf, 1});
+  EXPECT_EQ(s.validate(), "");
+  s.organs[0].orientation = glm::quat(2.0f, 0.0f, 0.0f, 0.0f);
+  EXPECT_EQ(s.validate(), "organ 0 has orientation (w 2, x 0, y 0, z 0), not a unit quaternion");
+  s.organs[0].orientation = glm::quat(0.0f, 0.0f, 0.0f, 0.0f);
+  EXPECT_NE(s.validate().find("not a unit quaternion"), std::string::npos);
+  s.organs[0].orientation.y = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_NE(s.validate().find("not a unit quaternion"), std::string::npos);
 }
 
 TEST(Plant, OptionalDataEntersTheHashOnlyWhenPresent) {
