@@ -160,6 +160,12 @@ Command add_run(CLI::App& app) {
   run->add_option("--sides", spec.mesher.sides, "tube sides of the branch mesh (3..64)")
       ->default_val(6)
       ->check(CLI::Range(3, 64));
+  run->add_option_function<std::string>(
+         "--glb", [a](const std::string& v) { a->spec.glb = parse_glb_layout(v); },
+         "layout of plant.glb: compact (instanced organs, quantized and meshopt-compressed; the default), "
+         "instanced (no compression) or plain (core glTF, floats: every reader loads it)")
+      ->check(CLI::IsMember({"plain", "instanced", "compact"}))
+      ->default_str(std::string(glb_layout_name(kDefaultGlbLayout)));
   run->add_option("--leaf-obj", spec.mesher.leaf_obj,
                   "a custom organ for every leaf, flower and bud whose plant names no shape: an OBJ with the blade "
                   "along +Z from the stem at z = 0 and its upper side toward +Y (scaled to unit length; the organ's "

@@ -12,14 +12,18 @@
 #include <iterator>
 #include <map>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
 #include <string_view>
 #include <type_traits>
 #include <vector>
 
+#include <fmt/compile.h>
 #include <fmt/format.h>
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
+#include <meshoptimizer.h>
+#include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
 #include "core/errors.hpp"
@@ -175,19 +179,19 @@ std::uint64_t write_obj(const std::string& path, const OutputMesh& m) {
   if (m.colors.empty()) {
     out.records(m.positions.size(), [&](std::size_t i, Buf& b) {
       const glm::vec3& v = m.positions[i];
-      fmt::format_to(std::back_inserter(b), "v {:.6g} {:.6g} {:.6g}\n", v.x, v.y, v.z);
+      fmt::format_to(fmt::appender(b), FMT_COMPILE("v {:.6g} {:.6g} {:.6g}\n"), v.x, v.y, v.z);
     });
   } else {  // the common `v x y z r g b` extension, sRGB-encoded as its readers show it
     out.records(m.positions.size(), [&](std::size_t i, Buf& b) {
       const glm::vec3& v = m.positions[i];
       const glm::vec3& c = m.colors[i];
-      fmt::format_to(std::back_inserter(b), "v {:.6g} {:.6g} {:.6g} {:.4g} {:.4g} {:.4g}\n", v.x, v.y, v.z,
+      fmt::format_to(fmt::appender(b), FMT_COMPILE("v {:.6g} {:.6g} {:.6g} {:.4g} {:.4g} {:.4g}\n"), v.x, v.y, v.z,
                      srgb_encode(c.x), srgb_encode(c.y), srgb_encode(c.z));
     });
   }
   out.records(m.normals.size(), [&](std::size_t i, Buf& b) {
     const glm::vec3& n = m.normals[i];
-    fmt::format_to(std::back_inserter(b), "vn {:.4f} {:.4f} {:.4f}\n", n.x, n.y, n.z);
+    fmt::format_to(fmt::appender(b), FMT_COMPILE("vn {:.4f} {:.4f} {:.4f}\n"), n.x, n.y, n.z);
   });
   for (const auto& g : m.groups) {
     if (g.plant_group.empty())
@@ -196,11 +200,11 @@ std::uint64_t write_obj(const std::string& path, const OutputMesh& m) {
       out.print("g {} {}\nusemtl {}\n", g.name, g.plant_group, g.material);
     out.records(g.triangle_count, [&](std::size_t i, Buf& b) {
       const glm::uvec3 f = m.triangles[g.first_triangle + i] + glm::uvec3(1);
-      fmt::format_to(std::back_inserter(b), "f {0}//{0} {1}//{1} {2}//{2}\n", f.x, f.y, f.z);
+      fmt::format_to(fmt::appender(b), FMT_COMPILE("f {0}//{0} {1}//{1} {2}//{2}\n"), f.x, f.y, f.z);
     });
     out.records(g.line_count, [&](std::size_t i, Buf& b) {
       const glm::uvec2 l = m.lines[g.first_line + i] + glm::uvec2(1);
-      fmt::format_to(std::back_inserter(b), "l {} {}\n", l.x, l.y);
+      fmt::format_to(fmt::appender(b), FMT_COMPILE("l {} {}\n"), l.x, l.y);
     });
   }
   return bytes + out.finish();
@@ -258,16 +262,22 @@ std::uint64_t write_ply(const std::string& path, const OutputMesh& m) {
 
 namespace {
 
-// The glTF document being filled: one binary buffer, its views and accessors.
+// The glTF document being filled: one binary buffer, its views and accessors. Counting only, it lays the
+// views out without copying any data: the document is the same, the binary chunk stays empty.
 struct GltfBuilder {
   tinygltf::Model model;
   tinygltf::Buffer buffer;
+  bool count_only = false;
+  std::size_t size = 0;  // the binary chunk's bytes
 
   std::size_t append(const void* p, std::size_t n) {
-    const auto off = buffer.data.size();
-    buffer.data.insert(buffer.data.end(), static_cast<const unsigned char*>(p),
-                       static_cast<const unsigned char*>(p) + n);
-    while (buffer.data.size() % 4 != 0) buffer.data.push_back(0);
+    const auto off = size;
+    size += n + (4 - n % 4) % 4;
+    if (!count_only) {
+      buffer.data.insert(buffer.data.end(), static_cast<const unsigned char*>(p),
+                         static_cast<const unsigned char*>(p) + n);
+      buffer.data.resize(size, 0);
+    }
     return off;
   }
   int view(const void* p, std::size_t length, int target) {
@@ -301,6 +311,42 @@ struct GltfBuilder {
   }
 };
 
+constexpr std::size_t pad4(std::size_t n) {
+  return n + (4 - n % 4) % 4;
+}
+
+// A .glb's bytes: the 12-byte header, the JSON chunk (padded with spaces) and, when there is binary data,
+// the BIN chunk (padded with zeros), each chunk after an 8-byte length and type.
+std::uint64_t glb_container_bytes(std::size_t json_bytes, std::size_t bin_bytes) {
+  return 12 + 8 + pad4(json_bytes) + (bin_bytes > 0 ? 8 + pad4(bin_bytes) : 0);
+}
+
+std::uint64_t write_glb_container(const std::string& path, const std::string& json,
+                                  const std::vector<unsigned char>& bin) {
+  auto file = std::make_unique<AtomicFile>(path);  // its buffer on the heap, not on a worker's stack
+  AtomicFile& f = *file;
+  const auto u32 = [&](std::uint64_t v) {
+    const auto x = static_cast<std::uint32_t>(v);
+    f.bytes(&x, 4);
+  };
+  const std::uint64_t total = glb_container_bytes(json.size(), bin.size());
+  if (total > UINT32_MAX) throw std::runtime_error(fmt::format("{}: {} bytes exceed a .glb's 4 GiB", path, total));
+  f.bytes("glTF", 4);
+  u32(2);
+  u32(total);
+  u32(pad4(json.size()));
+  f.bytes("JSON", 4);
+  f.bytes(json.data(), json.size());
+  f.bytes("   ", pad4(json.size()) - json.size());
+  if (!bin.empty()) {
+    u32(pad4(bin.size()));
+    f.bytes("BIN\0", 4);
+    f.bytes(bin.data(), bin.size());
+    f.bytes("\0\0\0", pad4(bin.size()) - bin.size());
+  }
+  return f.finish();
+}
+
 // The vertex attributes every primitive shares: POSITION and NORMAL, COLOR_0 when the mesh has colours
 // (clamped to [0, 1], as glTF's colours are), and each other attribute as _NAME (application-specific
 // attributes start with '_').
@@ -318,7 +364,9 @@ std::map<std::string, int> shared_attributes(GltfBuilder& b, const OutputMesh& m
   }
   attrs["NORMAL"] = b.accessor(b.view(m.normals.data(), nv * sizeof(glm::vec3), TINYGLTF_TARGET_ARRAY_BUFFER),
                                TINYGLTF_COMPONENT_TYPE_FLOAT, nv, TINYGLTF_TYPE_VEC3);
-  if (!m.colors.empty()) {
+  if (!m.colors.empty() && b.count_only) {
+    attrs["COLOR_0"] = b.vertex_floats(nullptr, nv, 3);
+  } else if (!m.colors.empty()) {
     std::vector<glm::vec3> clamped(m.colors);
     for (auto& c : clamped) c = glm::clamp(c, glm::vec3(0.0f), glm::vec3(1.0f));
     attrs["COLOR_0"] = b.vertex_floats(&clamped[0].x, nv, 3);
@@ -331,22 +379,30 @@ std::map<std::string, int> shared_attributes(GltfBuilder& b, const OutputMesh& m
   return attrs;
 }
 
-}  // namespace
-
 // Long because tinygltf's model is filled field by field: buffers, views, accessors, materials, then the
 // meshes and nodes. Without plant groups there is one mesh "plant" (a primitive and material per part) on
 // one node; with them, the ungrouped parts stay there and each plant group is a mesh and a child node of
 // its own, named as the group.
-std::uint64_t write_glb(const std::string& path, const OutputMesh& m) {
-  GltfBuilder b;
+void build_plain_glb(GltfBuilder& b, const OutputMesh& m) {
   tinygltf::Model& model = b.model;
   model.asset.version = "2.0";
   model.asset.generator = "growbench";
+  if (m.positions.empty()) {  // nothing to draw: a root node alone, as glTF has no empty accessor or buffer
+    tinygltf::Node root;
+    root.name = "plant";
+    model.nodes.push_back(root);
+    tinygltf::Scene scene;
+    scene.nodes = {0};
+    model.scenes.push_back(scene);
+    model.defaultScene = 0;
+    return;
+  }
   // One allocation for the whole binary chunk (positions, normals, indices, each padded to 4 bytes).
   std::size_t vertex_floats = m.colors.empty() ? 6 : 9;
   for (const auto& a : m.attributes) vertex_floats += static_cast<std::size_t>(a.components);
-  b.buffer.data.reserve(vertex_floats * m.positions.size() * sizeof(float) + m.triangles.size() * sizeof(glm::uvec3) +
-                        m.lines.size() * sizeof(glm::uvec2) + 4 * (2 * m.groups.size() + 2 + m.attributes.size()));
+  if (!b.count_only)
+    b.buffer.data.reserve(vertex_floats * m.positions.size() * sizeof(float) + m.triangles.size() * sizeof(glm::uvec3) +
+                          m.lines.size() * sizeof(glm::uvec2) + 4 * (2 * m.groups.size() + 2 + m.attributes.size()));
   const std::map<std::string, int> attributes = shared_attributes(b, m);
   std::map<std::string, std::vector<double>> colours;
   for (const auto& c : material_colors()) colours[c.material] = {c.r, c.g, c.b, 1.0};
@@ -383,7 +439,6 @@ std::uint64_t write_glb(const std::string& path, const OutputMesh& m) {
     if (g.line_count > 0)
       primitive(b.indices(&m.lines[g.first_line], std::size_t{g.line_count} * 2), TINYGLTF_MODE_LINE);
   }
-  model.buffers.push_back(std::move(b.buffer));
   tinygltf::Node root;
   root.name = "plant";
   if (!meshes[0].primitives.empty() || meshes.size() == 1) {
@@ -403,36 +458,443 @@ std::uint64_t write_glb(const std::string& path, const OutputMesh& m) {
   scene.nodes = {0};
   model.scenes.push_back(scene);
   model.defaultScene = 0;
-  // Streamed to the file: a string stream of the whole file and its copy cost several times its size in
-  // fresh pages. tinygltf still copies the binary chunk once.
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw std::runtime_error(fmt::format("{}: cannot open for writing", tmp));
-    tinygltf::TinyGLTF writer;
-    if (!writer.WriteGltfSceneToStream(&model, out, false, true))
-      throw std::runtime_error(fmt::format("{}: glTF serialisation failed", path));
-    out.close();
-    if (!out) throw std::runtime_error(fmt::format("{}: write failed", tmp));
+}
+
+// The plain layout's JSON: tinygltf's, with the buffer (which tinygltf would copy whole to write it) added
+// here. Both serialise through nlohmann::json, so the text is what tinygltf alone would write.
+std::string plain_glb_json(GltfBuilder& b) {
+  const std::size_t size = b.size;
+  b.model.buffers.clear();
+  std::ostringstream text;
+  tinygltf::TinyGLTF writer;
+  if (!writer.WriteGltfSceneToStream(&b.model, text, false, false))
+    throw std::runtime_error("glTF serialisation failed");
+  nlohmann::json doc = nlohmann::json::parse(text.str());
+  if (size > 0) doc["buffers"] = nlohmann::json::array({{{"byteLength", size}}});
+  return doc.dump();
+}
+
+}  // namespace
+
+std::uint64_t write_glb(const std::string& path, const OutputMesh& m) {
+  GltfBuilder b;
+  build_plain_glb(b, m);
+  const std::string json = plain_glb_json(b);
+  return write_glb_container(path, json, b.buffer.data);
+}
+
+std::uint64_t plain_glb_bytes(const OutputMesh& m) {
+  GltfBuilder b;
+  b.count_only = true;
+  build_plain_glb(b, m);
+  return glb_container_bytes(plain_glb_json(b).size(), b.size);
+}
+
+namespace {
+
+using Json = nlohmann::json;
+
+constexpr int kByte = 5120, kShort = 5122, kUnsignedShort = 5123, kUnsignedInt = 5125, kFloat = 5126;
+constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;
+constexpr std::uint32_t kNoVertex = UINT32_MAX;
+// uint16 indices, without 65535: glTF forbids the primitive restart value in an index buffer.
+constexpr std::size_t kPieceVertices = 65535;
+
+// A meshoptimizer filter for a compressed view (EXT_meshopt_compression's OCTAHEDRAL, QUATERNION,
+// EXPONENTIAL): the view's values as floats (4 per unit vector or quaternion, stride / 4 otherwise), encoded
+// with `bits` bits. The filtered bytes compress better than the plain quantized ones, and decode to the
+// same accessor types.
+struct ViewFilter {
+  const char* name;
+  int bits;
+  std::vector<float> values;
+};
+
+// The document of the quantized layouts: JSON and the binary chunk. Compressed, every view's bytes are
+// encoded by meshoptimizer into the binary chunk, and the view describes its decoded bytes in a second
+// buffer without data of its own (EXT_meshopt_compression's fallback buffer).
+class CompactGlb {
+ public:
+  explicit CompactGlb(bool compress) : compress_(compress) {
+    doc_["asset"] = {{"version", "2.0"}, {"generator", "growbench"}};
+    for (const char* k : {"accessors", "bufferViews", "materials", "meshes", "nodes"}) doc_[k] = Json::array();
   }
-  std::error_code ec;
-  const auto bytes = std::filesystem::file_size(tmp, ec);
-  if (ec) throw std::runtime_error(fmt::format("{}: cannot read its size: {}", tmp, ec.message()));
-  rename_into_place(tmp, path);
-  return bytes;
+  [[nodiscard]] bool compressed() const { return compress_; }
+  // `count` records of `stride` bytes (a multiple of 4) at p; `vertex` for vertex attributes. Compressed,
+  // with a filter, the filter's encoding of its values replaces the bytes at p.
+  int attribute_view(const void* p, std::size_t count, std::size_t stride, bool vertex,
+                     const ViewFilter* filter = nullptr) {
+    Json v = {{"byteLength", count * stride}};
+    if (vertex) {
+      v["byteStride"] = stride;
+      v["target"] = kArrayBuffer;
+    }
+    if (!compress_) return plain_view(std::move(v), p, count * stride);
+    std::vector<unsigned char> filtered;
+    if (filter) {
+      filtered.resize(count * stride);
+      const std::string_view name = filter->name;
+      if (name == "OCTAHEDRAL")
+        meshopt_encodeFilterOct(filtered.data(), count, stride, filter->bits, filter->values.data());
+      if (name == "QUATERNION")
+        meshopt_encodeFilterQuat(filtered.data(), count, stride, filter->bits, filter->values.data());
+      if (name == "EXPONENTIAL")
+        meshopt_encodeFilterExp(filtered.data(), count, stride, filter->bits, filter->values.data());
+      p = filtered.data();
+    }
+    std::vector<unsigned char> out(meshopt_encodeVertexBufferBound(count, stride));
+    out.resize(meshopt_encodeVertexBuffer(out.data(), out.size(), p, count, stride));
+    const int view = compressed_view(std::move(v), out, stride, count, "ATTRIBUTES");
+    if (filter) at("bufferViews", view)["extensions"]["EXT_meshopt_compression"]["filter"] = filter->name;
+    return view;
+  }
+  // `count` indices (a multiple of 3 for triangles) written as uint16 when `narrow`, else uint32.
+  int index_view(const std::uint32_t* p, std::size_t count, bool narrow, bool triangles) {
+    const std::size_t size = narrow ? 2 : 4;
+    Json v = {{"byteLength", count * size}, {"target", kElementArrayBuffer}};
+    if (compress_) {
+      std::vector<unsigned char> out(triangles ? meshopt_encodeIndexBufferBound(count, count)
+                                               : meshopt_encodeIndexSequenceBound(count, count));
+      out.resize(triangles ? meshopt_encodeIndexBuffer(out.data(), out.size(), p, count)
+                           : meshopt_encodeIndexSequence(out.data(), out.size(), p, count));
+      return compressed_view(std::move(v), out, size, count, triangles ? "TRIANGLES" : "INDICES");
+    }
+    if (!narrow) return plain_view(std::move(v), p, count * 4);
+    std::vector<std::uint16_t> shorts(p, p + count);
+    return plain_view(std::move(v), shorts.data(), count * 2);
+  }
+  int accessor(int view, int component, std::size_t count, const char* type, bool normalized = false) {
+    Json a = {{"bufferView", view}, {"componentType", component}, {"count", count}, {"type", type}};
+    if (normalized) a["normalized"] = true;
+    return add("accessors", std::move(a));
+  }
+  int add(const char* array, Json item) {
+    doc_[array].push_back(std::move(item));
+    return static_cast<int>(doc_[array].size() - 1);
+  }
+  Json& at(const char* array, int i) { return doc_[array][static_cast<std::size_t>(i)]; }
+  void use(const char* extension, bool required) {
+    auto listed = [&](const char* list) {
+      Json& l = doc_[list];
+      if (std::find(l.begin(), l.end(), extension) == l.end()) l.push_back(extension);
+    };
+    listed("extensionsUsed");
+    if (required) listed("extensionsRequired");
+  }
+  std::uint64_t write(const std::string& path, int root) {
+    doc_["scenes"] = Json::array({{{"nodes", {root}}}});
+    doc_["scene"] = 0;
+    for (const char* k : {"accessors", "bufferViews", "materials", "meshes"})
+      if (doc_[k].empty()) doc_.erase(k);  // glTF's arrays hold at least one item when present
+    doc_["buffers"] = Json::array({{{"byteLength", bin_.size()}}});
+    if (compress_) {
+      use("EXT_meshopt_compression", true);
+      doc_["buffers"].push_back(
+          {{"byteLength", fallback_}, {"extensions", {{"EXT_meshopt_compression", {{"fallback", true}}}}}});
+    }
+    return write_glb_container(path, doc_.dump(), bin_);
+  }
+
+ private:
+  std::size_t append(const void* p, std::size_t n) {
+    const std::size_t off = bin_.size();
+    bin_.insert(bin_.end(), static_cast<const unsigned char*>(p), static_cast<const unsigned char*>(p) + n);
+    bin_.resize(pad4(bin_.size()), 0);
+    return off;
+  }
+  int plain_view(Json v, const void* p, std::size_t n) {
+    v["buffer"] = 0;
+    v["byteOffset"] = append(p, n);
+    return add("bufferViews", std::move(v));
+  }
+  int compressed_view(Json v, const std::vector<unsigned char>& data, std::size_t stride, std::size_t count,
+                      const char* mode) {
+    v["buffer"] = 1;
+    v["byteOffset"] = fallback_;
+    fallback_ += pad4(v["byteLength"].get<std::size_t>());
+    v["extensions"]["EXT_meshopt_compression"] = {{"buffer", 0},
+                                                  {"byteOffset", append(data.data(), data.size())},
+                                                  {"byteLength", data.size()},
+                                                  {"byteStride", stride},
+                                                  {"count", count},
+                                                  {"mode", mode}};
+    return add("bufferViews", std::move(v));
+  }
+  bool compress_;
+  Json doc_;
+  std::vector<unsigned char> bin_;
+  std::size_t fallback_ = 0;
+};
+
+// Primitives of `arity` indices cut, in order, into pieces of at most kPieceVertices distinct vertices:
+// each piece's vertices (mesh indices, in order of first use) and its indices into them. `local` holds
+// kNoVertex for every mesh vertex, and does again on return.
+struct Piece {
+  std::vector<std::uint32_t> vertices, indices;
+};
+std::vector<Piece> cut_pieces(const std::uint32_t* idx, std::size_t primitives, std::size_t arity,
+                              std::vector<std::uint32_t>& local) {
+  std::vector<Piece> pieces(1);
+  for (std::size_t t = 0; t < primitives; ++t) {
+    const std::uint32_t* prim = idx + t * arity;
+    std::size_t fresh = 0;
+    for (std::size_t k = 0; k < arity; ++k) fresh += local[prim[k]] == kNoVertex ? 1 : 0;
+    if (pieces.back().vertices.size() + fresh > kPieceVertices) {
+      for (const auto v : pieces.back().vertices) local[v] = kNoVertex;
+      pieces.emplace_back();
+    }
+    Piece& p = pieces.back();
+    for (std::size_t k = 0; k < arity; ++k) {
+      std::uint32_t& l = local[prim[k]];
+      if (l == kNoVertex) {
+        l = static_cast<std::uint32_t>(p.vertices.size());
+        p.vertices.push_back(prim[k]);
+      }
+      p.indices.push_back(l);
+    }
+  }
+  for (const auto v : pieces.back().vertices) local[v] = kNoVertex;
+  if (pieces.back().indices.empty()) pieces.pop_back();
+  return pieces;
+}
+
+template <class T, std::size_t N>
+int vertex_accessor(CompactGlb& g, const std::vector<std::array<T, N>>& values, int component, const char* type,
+                    bool normalized) {
+  const int view = g.attribute_view(values.data(), values.size(), sizeof(T) * N, true);
+  return g.accessor(view, component, values.size(), type, normalized);
+}
+
+// The vertex attributes of a piece, quantized; `box_min` and `step` dequantize its positions.
+Json piece_attributes(CompactGlb& g, const OutputMesh& m, const Piece& p, const glm::vec3& box_min, float step) {
+  const std::size_t n = p.vertices.size();
+  std::vector<std::array<std::uint16_t, 4>> pos(n, {0, 0, 0, 0});
+  std::vector<std::array<std::int8_t, 4>> nrm(n, {0, 0, 0, 0});
+  std::array<long, 3> lo{65535, 65535, 65535}, hi{0, 0, 0};
+  for (std::size_t i = 0; i < n; ++i) {
+    const glm::vec3 q = glm::round((m.positions[p.vertices[i]] - box_min) / step);
+    const glm::vec3 nv = glm::round(glm::clamp(m.normals[p.vertices[i]], -1.0f, 1.0f) * 127.0f);
+    for (int k = 0; k < 3; ++k) {
+      const long c = std::clamp(std::lround(q[k]), 0L, 65535L);
+      pos[i][static_cast<std::size_t>(k)] = static_cast<std::uint16_t>(c);
+      lo[static_cast<std::size_t>(k)] = std::min(lo[static_cast<std::size_t>(k)], c);
+      hi[static_cast<std::size_t>(k)] = std::max(hi[static_cast<std::size_t>(k)], c);
+      nrm[i][static_cast<std::size_t>(k)] = static_cast<std::int8_t>(nv[k]);
+    }
+  }
+  Json attrs;
+  attrs["POSITION"] = vertex_accessor(g, pos, kUnsignedShort, "VEC3", false);
+  g.at("accessors", attrs["POSITION"])["min"] = lo;
+  g.at("accessors", attrs["POSITION"])["max"] = hi;
+  ViewFilter oct{"OCTAHEDRAL", 8, {}};
+  if (g.compressed()) {
+    oct.values.reserve(4 * n);
+    for (const auto v : p.vertices) {
+      const glm::vec3 d = m.normals[v];
+      const glm::vec3 u = glm::length(d) > 0.0f ? glm::normalize(d) : glm::vec3(0.0f, 0.0f, 1.0f);
+      oct.values.insert(oct.values.end(), {u.x, u.y, u.z, 0.0f});
+    }
+  }
+  attrs["NORMAL"] =
+      g.accessor(g.attribute_view(nrm.data(), n, 4, true, g.compressed() ? &oct : nullptr), kByte, n, "VEC3", true);
+  if (!m.colors.empty()) {
+    std::vector<std::array<std::uint16_t, 4>> col(n, {0, 0, 0, 0});
+    for (std::size_t i = 0; i < n; ++i)
+      for (int k = 0; k < 3; ++k)
+        col[i][static_cast<std::size_t>(k)] =
+            static_cast<std::uint16_t>(std::lround(std::clamp(m.colors[p.vertices[i]][k], 0.0f, 1.0f) * 65535.0f));
+    attrs["COLOR_0"] = vertex_accessor(g, col, kUnsignedShort, "VEC3", true);
+  }
+  for (const auto& a : m.attributes) {
+    static constexpr const char* kTypes[] = {"SCALAR", "VEC2", "VEC3", "VEC4"};
+    const auto c = static_cast<std::size_t>(std::clamp(a.components, 1, 4));
+    std::vector<float> values(n * c);
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t k = 0; k < c; ++k)
+        values[i * c + k] = a.values[p.vertices[i] * static_cast<std::size_t>(a.components) + k];
+    std::string name = "_" + attribute_word(a.name);
+    while (attrs.contains(name)) name += "_";
+    attrs[name] = g.accessor(g.attribute_view(values.data(), n, 4 * c, true), kFloat, n, kTypes[c - 1]);
+  }
+  return attrs;
+}
+
+// A piece as a mesh of one primitive on a node whose translation and uniform scale dequantize its
+// positions (uniform, so the normals stay as they are); returns the node.
+int write_piece(CompactGlb& g, const OutputMesh& m, const Piece& p, std::size_t arity, int material,
+                const std::string& name) {
+  Aabb box;
+  for (const auto v : p.vertices) box.extend(m.positions[v]);
+  const glm::vec3 extent = box.max - box.min;
+  float step = std::max({extent.x, extent.y, extent.z}) / 65535.0f;
+  if (!(step > 0.0f)) step = 1.0f;  // a single point
+  Json prim = {{"attributes", piece_attributes(g, m, p, box.min, step)}, {"material", material}};
+  prim["indices"] = g.accessor(g.index_view(p.indices.data(), p.indices.size(), true, arity == 3), kUnsignedShort,
+                               p.indices.size(), "SCALAR");
+  prim["mode"] = arity == 3 ? 4 : 1;
+  const int mesh = g.add("meshes", {{"name", name}, {"primitives", Json::array({prim})}});
+  return g.add("nodes", {{"name", name},
+                         {"mesh", mesh},
+                         {"translation", {box.min.x, box.min.y, box.min.z}},
+                         {"scale", {step, step, step}}});
+}
+
+// The organs mesh_plant put in its organ groups: "leaves" holds leaves and young leaves, "flowers"
+// flowers and buds.
+bool in_organ_group(const std::string& group, OrganKind kind) {
+  if (group == "leaves") return kind == OrganKind::Leaf || kind == OrganKind::YoungLeaf;
+  if (group == "flowers") return kind == OrganKind::Flower || kind == OrganKind::Bud;
+  return false;
+}
+
+// One organ shape as a mesh (float positions and normals: a few vertices) drawn at every organ of it by
+// EXT_mesh_gpu_instancing; returns the node.
+int write_instances(CompactGlb& g, const OrganShape& shape, const std::vector<const Organ*>& organs, int material,
+                    const std::string& name) {
+  const std::size_t nv = shape.mesh.vertices.size();
+  Json attrs;
+  attrs["POSITION"] = g.accessor(g.attribute_view(shape.mesh.vertices.data(), nv, 12, true), kFloat, nv, "VEC3");
+  Aabb box;
+  for (const auto& v : shape.mesh.vertices) box.extend(v);
+  g.at("accessors", attrs["POSITION"])["min"] = {box.min.x, box.min.y, box.min.z};
+  g.at("accessors", attrs["POSITION"])["max"] = {box.max.x, box.max.y, box.max.z};
+  attrs["NORMAL"] = g.accessor(g.attribute_view(shape.normals.data(), nv, 12, true), kFloat, nv, "VEC3");
+  const std::size_t ni = 3 * shape.mesh.triangles.size();
+  const bool narrow = nv <= kPieceVertices;
+  const int indices = g.accessor(g.index_view(&shape.mesh.triangles[0].x, ni, narrow, true),
+                                 narrow ? kUnsignedShort : kUnsignedInt, ni, "SCALAR");
+  Json prim = {{"attributes", attrs}, {"indices", indices}, {"material", material}};
+  const int mesh = g.add("meshes", {{"name", name}, {"primitives", Json::array({prim})}});
+  // Per organ: where it is, how it is turned (a unit quaternion as normalized int16 x, y, z, w) and its
+  // size: the transform add_organ applies to the shape.
+  const std::size_t n = organs.size();
+  std::vector<glm::vec3> translation(n), scale(n);
+  std::vector<std::array<std::int16_t, 4>> rotation(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    translation[i] = organs[i]->position;
+    scale[i] = glm::vec3(organs[i]->size);
+    const glm::quat q = glm::normalize(organs[i]->orientation);
+    const std::array<float, 4> xyzw{q.x, q.y, q.z, q.w};
+    for (std::size_t k = 0; k < 4; ++k) rotation[i][k] = static_cast<std::int16_t>(std::lround(xyzw[k] * 32767.0f));
+  }
+  // Compressed: translations to 16 bits of mantissa under an exponent shared by x, y and z (the branches'
+  // quantization step, for a plant a few metres across), rotations to 14 bits per component, sizes to 14.
+  ViewFilter t{"EXPONENTIAL", 16, {}}, r{"QUATERNION", 14, {}}, s{"EXPONENTIAL", 14, {}};
+  if (g.compressed()) {
+    for (std::size_t i = 0; i < n; ++i) {
+      const glm::quat q = glm::normalize(organs[i]->orientation);
+      t.values.insert(t.values.end(), {translation[i].x, translation[i].y, translation[i].z});
+      r.values.insert(r.values.end(), {q.x, q.y, q.z, q.w});
+      s.values.insert(s.values.end(), {scale[i].x, scale[i].y, scale[i].z});
+    }
+  }
+  const bool f = g.compressed();
+  Json inst;
+  inst["TRANSLATION"] =
+      g.accessor(g.attribute_view(translation.data(), n, 12, false, f ? &t : nullptr), kFloat, n, "VEC3");
+  inst["ROTATION"] =
+      g.accessor(g.attribute_view(rotation.data(), n, 8, false, f ? &r : nullptr), kShort, n, "VEC4", true);
+  inst["SCALE"] = g.accessor(g.attribute_view(scale.data(), n, 12, false, f ? &s : nullptr), kFloat, n, "VEC3");
+  g.use("EXT_mesh_gpu_instancing", false);
+  return g.add("nodes",
+               {{"name", name}, {"mesh", mesh}, {"extensions", {{"EXT_mesh_gpu_instancing", {{"attributes", inst}}}}}});
+}
+
+// An organ group's organs by shape (OrganShapes' index), when they are what the group holds: the group's
+// triangles are exactly theirs. Empty otherwise, and the group is written as pieces.
+std::vector<std::vector<const Organ*>> organs_by_shape(const MeshGroup& group, const Plant& plant,
+                                                       const OrganShapes& shapes) {
+  std::vector<std::vector<const Organ*>> by_shape(shapes.size());
+  std::size_t triangles = 0;
+  for (const auto& o : plant.organs) {
+    if (!in_organ_group(group.name, o.kind)) continue;
+    by_shape[shapes.index_of(o)].push_back(&o);
+    triangles += shapes.of(o).mesh.triangles.size();
+  }
+  if (triangles != group.triangle_count || group.line_count > 0 || !group.plant_group.empty()) return {};
+  return by_shape;
+}
+
+int glb_material(CompactGlb& g, const MeshGroup& group) {
+  Json mat = {{"name", group.material},
+              {"pbrMetallicRoughness", {{"metallicFactor", 0.0}}},
+              {"doubleSided", group.material != "bark"}};
+  for (const auto& c : material_colors())
+    if (group.material == c.material) mat["pbrMetallicRoughness"]["baseColorFactor"] = {c.r, c.g, c.b, 1.0};
+  return g.add("materials", std::move(mat));
+}
+
+}  // namespace
+
+GlbLayout parse_glb_layout(std::string_view name) {
+  for (const GlbLayout l : {GlbLayout::Plain, GlbLayout::Instanced, GlbLayout::Compact})
+    if (name == glb_layout_name(l)) return l;
+  throw InputError(fmt::format("unknown glTF layout '{}' (expected plain, instanced or compact)", name));
+}
+
+std::string_view glb_layout_name(GlbLayout layout) {
+  switch (layout) {
+    case GlbLayout::Plain:
+      return "plain";
+    case GlbLayout::Instanced:
+      return "instanced";
+    case GlbLayout::Compact:
+      return "compact";
+  }
+  return "plain";
+}
+
+std::uint64_t write_glb(const std::string& path, const OutputMesh& m, GlbLayout layout, const Plant& plant,
+                        const OrganShapes& shapes) {
+  // Nothing to instance or compress, and glTF wants every buffer at least one byte long: a plant with no
+  // geometry is written as the plain layout's empty scene, which every reader takes.
+  if (layout == GlbLayout::Plain || (m.triangles.empty() && m.lines.empty())) return write_glb(path, m);
+  CompactGlb g(layout == GlbLayout::Compact);
+  const bool instancing = m.colors.empty() && m.attributes.empty();
+  std::vector<std::uint32_t> local(m.positions.size(), kNoVertex);
+  std::vector<int> children;                            // of the root
+  std::map<std::string, std::vector<int>> group_nodes;  // plant group -> its nodes
+  for (const auto& group : m.groups) {
+    const int material = glb_material(g, group);
+    std::vector<int>& into = group.plant_group.empty() ? children : group_nodes[group.plant_group];
+    std::vector<std::vector<const Organ*>> by_shape;
+    if (instancing) by_shape = organs_by_shape(group, plant, shapes);
+    if (!by_shape.empty()) {
+      for (std::size_t s = 0; s < by_shape.size(); ++s)
+        if (!by_shape[s].empty()) into.push_back(write_instances(g, shapes.at(s), by_shape[s], material, group.name));
+      continue;
+    }
+    const auto pieces = [&](const std::uint32_t* idx, std::size_t count, std::size_t arity) {
+      for (const Piece& p : cut_pieces(idx, count, arity, local))
+        into.push_back(write_piece(g, m, p, arity, material, group.name));
+    };
+    if (group.triangle_count > 0) pieces(&m.triangles[group.first_triangle].x, group.triangle_count, 3);
+    if (group.line_count > 0) pieces(&m.lines[group.first_line].x, group.line_count, 2);
+    g.use("KHR_mesh_quantization", true);
+  }
+  for (const auto& [name, nodes] : group_nodes)
+    children.push_back(g.add("nodes", {{"name", name}, {"children", nodes}}));
+  Json root = {{"name", "plant"}};
+  if (!children.empty()) root["children"] = children;
+  return g.write(path, g.add("nodes", std::move(root)));
 }
 
 std::uint64_t write_skeleton_obj(const std::string& path, const Plant& plant) {
   TextFile out(path);
   out.print("# growbench skeleton: {} nodes; vertex i+1 is node i; '#r' gives the radius of the next vertex\n",
             plant.nodes.size());
-  for (const auto& n : plant.nodes)
-    out.print("#r {:.6g}\nv {:.6g} {:.6g} {:.6g}\n", n.radius, n.position.x, n.position.y, n.position.z);
-  for (const auto& chain : plant_chains(plant)) {
-    out.print("l");
-    for (const auto i : chain) out.print(" {}", i + 1);
-    out.print("\n");
-  }
+  using Buf = fmt::memory_buffer;
+  out.records(plant.nodes.size(), [&](std::size_t i, Buf& b) {
+    const PlantNode& n = plant.nodes[i];
+    fmt::format_to(fmt::appender(b), FMT_COMPILE("#r {:.6g}\nv {:.6g} {:.6g} {:.6g}\n"), n.radius, n.position.x,
+                   n.position.y, n.position.z);
+  });
+  const auto chains = plant_chains(plant);
+  out.records(chains.size(), [&](std::size_t c, Buf& b) {
+    b.push_back('l');
+    for (const auto i : chains[c]) fmt::format_to(fmt::appender(b), FMT_COMPILE(" {}"), i + 1);
+    b.push_back('\n');
+  });
   return out.finish();
 }
 

@@ -17,6 +17,7 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 #include "algorithms/plant.hpp"
 #include "harness/output/mesher.hpp"
@@ -54,7 +55,32 @@ std::uint64_t write_plant_snapshot(const std::string& path, const Plant& plant, 
 // snapshot without the decal section or the sections after it reads as a plant without them.
 Plant read_plant_snapshot(const std::string& path);
 
-// Binary glTF 2.0 (.glb) written with tinygltf: one mesh with a primitive (and material) per group,
-// float positions and normals, uint32 indices.
+// How a plant is laid out in a .glb (`growbench run --glb`):
+//  - plain: core glTF 2.0, every vertex as floats and uint32 indices; one mesh with a primitive (and
+//    material) per group. Every glTF reader loads it.
+//  - instanced: each organ shape (leaf, blossom, ...) one mesh drawn at every organ of that shape through
+//    EXT_mesh_gpu_instancing (a float translation, a normalized int16 rotation and a float scale per
+//    organ); the other parts quantized with KHR_mesh_quantization (see write_glb below). Requires
+//    KHR_mesh_quantization; a reader without EXT_mesh_gpu_instancing draws each organ shape once.
+//  - compact: instanced, with every buffer view compressed by meshoptimizer (EXT_meshopt_compression,
+//    required: the file holds no uncompressed copy).
+enum class GlbLayout { Plain, Instanced, Compact };
+inline constexpr GlbLayout kDefaultGlbLayout = GlbLayout::Compact;
+// "plain", "instanced", "compact"; InputError listing them for anything else.
+GlbLayout parse_glb_layout(std::string_view name);
+std::string_view glb_layout_name(GlbLayout layout);
+
+// Binary glTF 2.0 (.glb) in the plain layout: the JSON made by tinygltf, the binary chunk written as built.
 std::uint64_t write_glb(const std::string& path, const OutputMesh& mesh);
+// The bytes write_glb(path, mesh) would write, exactly, computed without building the binary chunk.
+std::uint64_t plain_glb_bytes(const OutputMesh& mesh);
+// `mesh` (made by mesh_plant from `plant` with these organ shapes) in `layout`. In the quantized layouts
+// the branches and polygons are cut into pieces of at most 65535 vertices (uint16 indices below the
+// primitive restart value), each a node whose translation and uniform scale turn its uint16 positions (the
+// piece's bounds in 65535 steps of its longest side) back into metres; normals are normalized int8,
+// colours normalized uint16, other attributes floats. Organs are instanced only when the mesh has no vertex
+// colours or attributes (a per-organ colour has no place in an instance); otherwise they are quantized
+// with the rest.
+std::uint64_t write_glb(const std::string& path, const OutputMesh& mesh, GlbLayout layout, const Plant& plant,
+                        const OrganShapes& shapes);
 }  // namespace growbench

@@ -294,6 +294,7 @@ json to_json(const OutputBytes& v) {
   put(j, "obj", v.obj);
   put(j, "ply", v.ply);
   put(j, "glb", v.glb);
+  put(j, "glb_plain", v.glb_plain);
   put(j, "skeleton_obj", v.skeleton_obj);
   put(j, "skeleton_ply", v.skeleton_ply);
   if (!v.algorithm_files.empty()) put(j, "algorithm_files", v.algorithm_files);
@@ -304,6 +305,7 @@ void read(const Node& n, OutputBytes& v) {
   f.field("obj", v.obj);
   f.field("ply", v.ply);
   f.field("glb", v.glb);
+  f.field("glb_plain", v.glb_plain);
   f.field("skeleton_obj", v.skeleton_obj);
   f.field("skeleton_ply", v.skeleton_ply);
   f.field("algorithm_files", v.algorithm_files);
@@ -558,6 +560,7 @@ json to_json(const TrialSpecRecord& v) {
             {"fault", v.fault}};
   put(j, "leaf_obj", v.leaf_obj);
   put(j, "organs", v.organs);
+  put(j, "glb", v.glb);
   put(j, "out_dir", v.out_dir);
   put(j, "context", v.context);
   put(j, "skip_teardown", v.skip_teardown);
@@ -584,6 +587,7 @@ void read(const Node& n, TrialSpecRecord& v) {
   f.field("fault", v.fault);
   f.field("leaf_obj", v.leaf_obj);
   f.field("organs", v.organs);
+  f.field("glb", v.glb);
   f.field("out_dir", v.out_dir);
   f.field("context", v.context);
   f.field("skip_teardown", v.skip_teardown);

@@ -77,6 +77,8 @@ struct Counts {
 // Bytes written per output format; empty when the trial wrote no files.
 struct OutputBytes {
   std::optional<std::uint64_t> obj, ply, glb, skeleton_obj, skeleton_ply;
+  // The bytes plant.glb would have in the plain layout (docs/metrics.md), computed without writing it.
+  std::optional<std::uint64_t> glb_plain;
   // The files only the algorithm makes (GrowthAlgorithm::write_outputs), by name; absent when none.
   std::map<std::string, std::uint64_t> algorithm_files;
 };
@@ -202,6 +204,7 @@ struct TrialSpecRecord {
   std::string fault;
   std::optional<std::string> leaf_obj;             // only when given: older specs stay as they were
   std::optional<std::vector<std::string>> organs;  // --organ key=value; only when given
+  std::optional<std::string> glb;                  // --glb layout; only when not the default
   // Only in the job a suite sends a trial's process (never in results).
   std::optional<std::string> out_dir;
   std::optional<bool> context, skip_teardown;

@@ -292,6 +292,7 @@ TrialSpecRecord to_record(const TrialSpec& s) {
   r.fault = s.fault;
   if (!s.mesher.leaf_obj.empty()) r.leaf_obj = s.mesher.leaf_obj;
   if (!s.organs.empty()) r.organs = s.organs;
+  if (s.glb != kDefaultGlbLayout) r.glb = std::string(glb_layout_name(s.glb));
   return r;
 }
 
@@ -311,6 +312,7 @@ TrialSpec trial_spec_of(const TrialSpecRecord& r) {
   s.mesher.sides = r.sides;
   s.mesher.leaf_obj = r.leaf_obj.value_or("");
   s.organs = r.organs.value_or(std::vector<std::string>{});
+  if (r.glb) s.glb = parse_glb_layout(*r.glb);
   s.budget_nodes = r.budget_nodes;
   s.budget_length_m = r.budget_length_m;
   s.metrics = r.metrics;
@@ -505,7 +507,8 @@ void mesh_export_measure(const TrialSpec& spec, const MesherOptions& mesher, Tri
     const std::filesystem::path d(spec.out_dir);
     rec.output_bytes.obj = write_obj((d / "plant.obj").string(), st.mesh);
     rec.output_bytes.ply = write_ply((d / "plant.ply").string(), st.mesh);
-    rec.output_bytes.glb = write_glb((d / "plant.glb").string(), st.mesh);
+    rec.output_bytes.glb = write_glb((d / "plant.glb").string(), st.mesh, spec.glb, plant, organ_shapes(plant, mesher));
+    rec.output_bytes.glb_plain = spec.glb == GlbLayout::Plain ? *rec.output_bytes.glb : plain_glb_bytes(st.mesh);
     rec.output_bytes.skeleton_obj = write_skeleton_obj((d / "skeleton.obj").string(), plant);
     rec.output_bytes.skeleton_ply = write_skeleton_ply((d / "skeleton.ply").string(), plant);
     for (const auto& f : algorithm_outputs(*st.algo, plant, {d.string(), "", false}))

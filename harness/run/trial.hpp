@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "harness/organs/options.hpp"
+#include "harness/output/exporters.hpp"
 #include "harness/output/mesher.hpp"
 #include "harness/record/record.hpp"
 
@@ -36,6 +37,7 @@ struct TrialSpec {
   float voxel_size = 0.0f;         // 0: automatic (see SceneQueryOptions)
   std::string out_dir;             // empty: measure but write no files
   MesherOptions mesher;
+  GlbLayout glb = kDefaultGlbLayout;  // the layout of plant.glb (harness/output/exporters.hpp)
   // The organ pass after growth (harness/organs/options.hpp), as key=value; empty: the plant as grown.
   std::vector<std::string> organs;
   // Comparable budgets across algorithms: stop once the plant has this many nodes / this much branch

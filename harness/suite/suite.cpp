@@ -85,7 +85,7 @@ class SuiteReader : public JsonPathReader {
     const json j = parse_input_json(file(), text);
     only_keys(j, "",
               {"schema_version", "name", "description", "repetitions", "warmup", "threads", "timeout_s",
-               "memory_limit_mb", "max_steps", "seeds", "budget", "scenes", "algorithms", "plugins"});
+               "memory_limit_mb", "max_steps", "seeds", "budget", "glb", "scenes", "algorithms", "plugins"});
     if (!j.contains("schema_version") || j["schema_version"] != 1) fail("/schema_version", "expected 1");
     Suite s;
     s.file = file();
@@ -105,6 +105,7 @@ class SuiteReader : public JsonPathReader {
     std::vector<std::uint64_t> seeds = {1};
     std::size_t budget_nodes = 0;
     double budget_length = 0.0;
+    GlbLayout glb = kDefaultGlbLayout;
   };
   struct SceneEntry {
     std::string spec, name;
@@ -164,6 +165,14 @@ class SuiteReader : public JsonPathReader {
         c.budget_nodes = static_cast<std::size_t>(number(j["budget"]["nodes"], "/budget/nodes", 0, 1e12));
       if (j["budget"].contains("length_m"))
         c.budget_length = number(j["budget"]["length_m"], "/budget/length_m", 0, 1e12);
+    }
+    if (j.contains("glb")) {
+      const std::string name = string_field(j, "", "glb", "", "the layout of plant.glb: plain, instanced or compact");
+      try {
+        c.glb = parse_glb_layout(name);
+      } catch (const InputError& err) {
+        fail("/glb", err.what());
+      }
     }
     return c;
   }
@@ -345,6 +354,7 @@ class SuiteReader : public JsonPathReader {
             c.spec.max_steps = common.max_steps;
             c.spec.budget_nodes = common.budget_nodes;
             c.spec.budget_length_m = common.budget_length;
+            c.spec.glb = common.glb;
             c.spec.fault = a.fault;
             c.spec.mesher.leaf_obj = a.leaf_obj;
             c.spec.organs = a.organs;

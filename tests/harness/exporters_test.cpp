@@ -13,6 +13,7 @@
 #include <tiny_gltf.h>
 #include <tiny_obj_loader.h>
 
+#include "core/json_util.hpp"
 #include "test_util.hpp"
 
 namespace growbench {
@@ -204,6 +205,36 @@ TEST(Exporters, SkeletonHasNodesAndPolylines) {
   ASSERT_EQ(l.size(), 2u);
   EXPECT_EQ(l[0], "l 1 2 3");
   EXPECT_EQ(l[1], "l 2 4");
+}
+
+// Large enough for parallel chunks of nodes and of chains: the file is what a serial loop writes.
+TEST(Exporters, LargeSkeletonIsTheSerialTextOnAnyThreadCount) {
+  Plant p;
+  p.nodes.push_back({{0, 0, 0}, 0.05f, kNoParent, 0, 0, 0});
+  for (std::int32_t i = 1; i < 30000; ++i) {  // a spine (even nodes) with a one-node twig on each (odd)
+    const std::int32_t parent = i % 2 == 1 ? i - 1 : i - 2;
+    const float t = static_cast<float>(i);
+    p.nodes.push_back({{std::sin(t), 0.001f * t, -1e-7f * t}, 0.05f / (1.0f + t), parent, 0, 0, 0});
+  }
+  std::string expected =
+      "# growbench skeleton: 30000 nodes; vertex i+1 is node i; '#r' gives the radius of the next vertex\n";
+  for (const auto& n : p.nodes)
+    expected += fmt::format("#r {:.6g}\nv {:.6g} {:.6g} {:.6g}\n", n.radius, n.position.x, n.position.y, n.position.z);
+  const auto chains = plant_chains(p);
+  ASSERT_GT(chains.size(), 10000u);
+  for (const auto& chain : chains) {
+    expected += "l";
+    for (const auto i : chain) expected += fmt::format(" {}", i + 1);
+    expected += "\n";
+  }
+  const auto dir = test::temp_dir("large_skeleton");
+  for (const int threads : {1, 2, 4}) {
+    const auto path = dir / fmt::format("s{}.obj", threads);
+    tbb::task_arena(threads).execute([&] { write_skeleton_obj(path.string(), p); });
+    const std::string text = read_text_file(path.string());
+    EXPECT_EQ(text.size(), expected.size()) << threads << " threads";
+    EXPECT_TRUE(text == expected) << threads << " threads";
+  }
 }
 
 // y_plant with two decals: one on scene mesh 2's texture coordinates, one planar with axes that are

@@ -92,6 +92,34 @@ TEST(Suite, SweepsMakeOneCellPerPoint) {
   EXPECT_EQ(res["trials"][3]["params"]["kill"], 0.1);
 }
 
+// "glb" chooses every cell's glTF layout, and is checked like every other key.
+TEST(Suite, GlbChoosesTheLayoutOfEveryCell) {
+  const auto dir = test::temp_dir("suite_glb");
+  const json algos = json::array({{{"name", "spacecol"}, {"params", kSmall}}});
+  for (const char* layout : {"plain", "compact"}) {
+    const auto out = dir / layout;
+    const auto r = growbench("suite -q -o " + out.string() + " " +
+                             suite_file(dir, {{"algorithms", algos}, {"glb", layout}, {"seeds", {1, 2}}}));
+    ASSERT_EQ(r.status, 0) << r.out;
+    const json res = read_json(out / "results.json");
+    ASSERT_EQ(res["trials"].size(), 2u);
+    for (const auto& t : res["trials"]) {
+      const auto& bytes = t["output_bytes"];
+      if (std::string(layout) == "plain")
+        EXPECT_EQ(bytes["glb"], bytes["glb_plain"]) << t["id"];
+      else
+        EXPECT_LT(bytes["glb"].get<double>(), 0.5 * bytes["glb_plain"].get<double>()) << t["id"];
+    }
+  }
+  for (const json& bad : {json("gzip"), json(3)}) {
+    const auto r = growbench("suite -q -o " + (dir / "bad").string() + " " +
+                             suite_file(dir, {{"algorithms", algos}, {"glb", bad}}));
+    EXPECT_EQ(r.status, 2) << r.out;
+    EXPECT_NE(r.out.find("at /glb: "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("plain, instanced or compact"), std::string::npos) << r.out;
+  }
+}
+
 TEST(Suite, CrashHangMemoryHogAndInvalidInputAreRecordedWhileOthersSucceed) {
   const auto dir = test::temp_dir("suite_isolation");
   json algos = json::array({

@@ -64,6 +64,22 @@ out = run(growbench, "run", "-q", "-a", "spacecol", "-s", "wall", "--set", "poin
 check(out.returncode == 0, f"growbench run: {out.stdout}{out.stderr}")
 run_record = json.load(open(os.path.join(work, "run", "record.json")))
 check(errors(run_record, "trial_record") == [], f"growbench run's record.json validates: {errors(run_record, 'trial_record')[:5]}")
+check(run_record["output_bytes"]["glb_plain"] > run_record["output_bytes"]["glb"] > 0,
+      f"the compact GLB is smaller than the plain size beside it: {run_record['output_bytes']}")
+out = run(growbench, "run", "-q", "-a", "spacecol", "-s", "wall", "--set", "point_count=300", "--glb", "plain", "-o",
+          os.path.join(work, "run-plain"))
+check(out.returncode == 0, f"growbench run --glb plain: {out.stdout}{out.stderr}")
+plain_record = json.load(open(os.path.join(work, "run-plain", "record.json")))
+check(errors(plain_record, "trial_record") == [], f"--glb plain's record validates: {errors(plain_record, 'trial_record')[:5]}")
+check(plain_record["output_bytes"]["glb_plain"] == plain_record["output_bytes"]["glb"] ==
+      run_record["output_bytes"]["glb_plain"], "the plain size is the same whichever layout was written")
+# A trial spec names its layout only when it is not the default; an unknown one does not validate.
+with_layout = copy.deepcopy(results)
+with_layout["trials"][0]["spec"]["glb"] = "plain"
+check(errors(with_layout) == [], f"a spec with a layout validates: {errors(with_layout)[:5]}")
+with_layout["trials"][0]["spec"]["glb"] = "draco"
+check(any(e.endswith("'draco' is not one of ['plain', 'instanced', 'compact']") for e in errors(with_layout)),
+      f"an unknown layout fails: {errors(with_layout)[:3]}")
 # No built-in algorithm writes files of its own yet: the record of one that does, by hand. Sizes by file
 # name validate; a size that is not a count, or the object written empty (the writer leaves it out), do not.
 with_files = copy.deepcopy(run_record)
