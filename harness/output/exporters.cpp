@@ -262,6 +262,18 @@ std::uint64_t write_ply(const std::string& path, const OutputMesh& m) {
 
 namespace {
 
+constexpr std::size_t pad4(std::size_t n) {
+  return n + (4 - n % 4) % 4;
+}
+
+// Appends n bytes at p to a glTF binary chunk, zero-padded to 4 bytes; returns their offset.
+std::size_t append_padded(std::vector<unsigned char>& bin, const void* p, std::size_t n) {
+  const std::size_t off = bin.size();
+  bin.insert(bin.end(), static_cast<const unsigned char*>(p), static_cast<const unsigned char*>(p) + n);
+  bin.resize(pad4(bin.size()), 0);
+  return off;
+}
+
 // The glTF document being filled: one binary buffer, its views and accessors. Counting only, it lays the
 // views out without copying any data: the document is the same, the binary chunk stays empty.
 struct GltfBuilder {
@@ -272,12 +284,8 @@ struct GltfBuilder {
 
   std::size_t append(const void* p, std::size_t n) {
     const auto off = size;
-    size += n + (4 - n % 4) % 4;
-    if (!count_only) {
-      buffer.data.insert(buffer.data.end(), static_cast<const unsigned char*>(p),
-                         static_cast<const unsigned char*>(p) + n);
-      buffer.data.resize(size, 0);
-    }
+    size += pad4(n);
+    if (!count_only) append_padded(buffer.data, p, n);
     return off;
   }
   int view(const void* p, std::size_t length, int target) {
@@ -310,10 +318,6 @@ struct GltfBuilder {
     return accessor(v, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, count, TINYGLTF_TYPE_SCALAR);
   }
 };
-
-constexpr std::size_t pad4(std::size_t n) {
-  return n + (4 - n % 4) % 4;
-}
 
 // A .glb's bytes: the 12-byte header, the JSON chunk (padded with spaces) and, when there is binary data,
 // the BIN chunk (padded with zeros), each chunk after an 8-byte length and type.
@@ -596,15 +600,9 @@ class CompactGlb {
   }
 
  private:
-  std::size_t append(const void* p, std::size_t n) {
-    const std::size_t off = bin_.size();
-    bin_.insert(bin_.end(), static_cast<const unsigned char*>(p), static_cast<const unsigned char*>(p) + n);
-    bin_.resize(pad4(bin_.size()), 0);
-    return off;
-  }
   int plain_view(Json v, const void* p, std::size_t n) {
     v["buffer"] = 0;
-    v["byteOffset"] = append(p, n);
+    v["byteOffset"] = append_padded(bin_, p, n);
     return add("bufferViews", std::move(v));
   }
   int compressed_view(Json v, const std::vector<unsigned char>& data, std::size_t stride, std::size_t count,
@@ -613,7 +611,7 @@ class CompactGlb {
     v["byteOffset"] = fallback_;
     fallback_ += pad4(v["byteLength"].get<std::size_t>());
     v["extensions"]["EXT_meshopt_compression"] = {{"buffer", 0},
-                                                  {"byteOffset", append(data.data(), data.size())},
+                                                  {"byteOffset", append_padded(bin_, data.data(), data.size())},
                                                   {"byteLength", data.size()},
                                                   {"byteStride", stride},
                                                   {"count", count},
@@ -770,25 +768,22 @@ int write_instances(CompactGlb& g, const OrganShape& shape, const std::vector<co
   const std::size_t n = organs.size();
   std::vector<glm::vec3> translation(n), scale(n);
   std::vector<std::array<std::int16_t, 4>> rotation(n);
+  // Compressed: translations to 16 bits of mantissa under an exponent shared by x, y and z (the branches'
+  // quantization step, for a plant a few metres across), rotations to 14 bits per component, sizes to 14.
+  ViewFilter t{"EXPONENTIAL", 16, {}}, r{"QUATERNION", 14, {}}, s{"EXPONENTIAL", 14, {}};
+  const bool f = g.compressed();
   for (std::size_t i = 0; i < n; ++i) {
     translation[i] = organs[i]->position;
     scale[i] = glm::vec3(organs[i]->size);
     const glm::quat q = glm::normalize(organs[i]->orientation);
     const std::array<float, 4> xyzw{q.x, q.y, q.z, q.w};
     for (std::size_t k = 0; k < 4; ++k) rotation[i][k] = static_cast<std::int16_t>(std::lround(xyzw[k] * 32767.0f));
-  }
-  // Compressed: translations to 16 bits of mantissa under an exponent shared by x, y and z (the branches'
-  // quantization step, for a plant a few metres across), rotations to 14 bits per component, sizes to 14.
-  ViewFilter t{"EXPONENTIAL", 16, {}}, r{"QUATERNION", 14, {}}, s{"EXPONENTIAL", 14, {}};
-  if (g.compressed()) {
-    for (std::size_t i = 0; i < n; ++i) {
-      const glm::quat q = glm::normalize(organs[i]->orientation);
+    if (f) {
       t.values.insert(t.values.end(), {translation[i].x, translation[i].y, translation[i].z});
-      r.values.insert(r.values.end(), {q.x, q.y, q.z, q.w});
+      r.values.insert(r.values.end(), xyzw.begin(), xyzw.end());
       s.values.insert(s.values.end(), {scale[i].x, scale[i].y, scale[i].z});
     }
   }
-  const bool f = g.compressed();
   Json inst;
   inst["TRANSLATION"] =
       g.accessor(g.attribute_view(translation.data(), n, 12, false, f ? &t : nullptr), kFloat, n, "VEC3");
