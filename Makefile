@@ -9,7 +9,7 @@ JOBS ?= $(shell nproc)
 # Repetitions per cell in `make demo` (a number, or "suite" for the standard suite's own).
 DEMO_REPETITIONS ?= 1
 
-.PHONY: all deps configure build cli test demo demo-full peers bench plugin-bench gate baseline readme-params plugin-sdk fuzz sanitize format clean
+.PHONY: all deps configure build cli test demo demo-full peers bench plugin-bench gate baseline schema readme-params plugin-sdk fuzz sanitize format clean
 
 all: build
 
@@ -49,12 +49,13 @@ peers: cli
 	/usr/bin/python3 reports/report.py --peers out/peers/peers.json --out out/peers/report
 
 # The deterministic regression gate (CI runs it after the tests): the quick suite once, single-threaded,
-# under callgrind, compared with the committed baseline. Instruction counts depend on the compiler flags:
-# the baseline is made with the CI preset (make baseline PRESET=ci).
+# under callgrind, its files checked against the generated schema, compared with the committed baseline.
+# Instruction counts depend on the compiler flags: the baseline is made with the CI preset (make baseline PRESET=ci).
 GATE := $(BUILD)/gate
 gate: build
 	rm -rf $(GATE)
 	$(GROWBENCH) suite bench/suites/quick.json --instructions --out $(GATE) -q > $(BUILD)/gate.log
+	/usr/bin/python3 scripts/check-schema $(GATE)/results.json $(GATE)/journal.jsonl reports/baselines/quick.json
 	$(GROWBENCH) compare reports/baselines/quick.json $(GATE)/results.json
 
 # Accept an intended change: rewrite reports/baselines/quick.json from a fresh gate run (commit it).
@@ -62,6 +63,11 @@ baseline: build
 	rm -rf $(GATE)
 	$(GROWBENCH) suite bench/suites/quick.json --instructions --out $(GATE) -q > $(BUILD)/gate.log
 	$(GROWBENCH) baseline update $(GATE)/results.json --baseline reports/baselines/quick.json
+
+# Rewrite harness/record/results.schema.json from the record declarations (commit it; the test
+# Record.SchemaFileIsGenerated fails while the committed file differs from the binary's).
+schema: cli
+	$(GROWBENCH) schema > harness/record/results.schema.json
 
 # Fill the parameter tables in algorithms/*/README.md from `growbench list --markdown NAME` (commit them;
 # the ctest readme.params fails while a committed table differs from the binary's).

@@ -101,11 +101,39 @@ struct ParamStruct {
   bool trivially_default_constructible;
 };
 
+// What `growbench lsystem FILE --print` shows: a rewriting algorithm's derived string (of the first plant)
+// and its symbol counts, without drawing (the turtle runs only if rules read its state).
+struct DerivedString {
+  std::string text;  // up to print_limit modules (0: all); empty without a print_limit
+  // From the parsed grammar to the last generation's string (the premise and every rewrite, with the
+  // turtle runs that rules reading its state need): the work a string-rewriting peer's own timer covers.
+  // Parsing the grammar is reading input; the text and the counts are output.
+  double seconds = 0.0;
+  // The same span's CPU time, summed over threads: on a loaded machine the wall time also holds waiting.
+  double cpu_seconds = 0.0;
+  std::size_t modules = 0;
+  std::size_t params = 0;
+  std::size_t bytes = 0;  // memory of the string
+  int generations = 0;
+  std::vector<std::pair<char, std::size_t>> counts;  // by symbol, in ASCII order
+};
+
+// What an algorithm that rewrites a string (an L-system) offers beyond growing: the string derived alone,
+// and the example inputs it ships. It says so with a static `string_rewriting()` on its class, which the
+// registration picks up; the command line reaches it through the registry, never the algorithm's header.
+struct StringRewriting {
+  std::function<DerivedString(const Params& params, std::uint64_t seed, const Scene* scene, const SceneQuery* query,
+                              std::optional<std::size_t> print_limit)>
+      derive;
+  std::function<std::vector<std::string>()> examples;
+};
+
 struct AlgorithmEntry {
   std::function<const AlgorithmInfo&()> info;
   std::function<std::unique_ptr<GrowthAlgorithm>()> make;
   std::vector<ParamStruct> param_structs;        // built-ins only
   std::shared_ptr<const PluginOrigin> plugin{};  // null for a built-in
+  std::optional<StringRewriting> rewriting{};    // a string-rewriting algorithm's extras
 };
 
 // Every algorithm, in the order of the add_subdirectory lines in algorithms/CMakeLists.txt (the order
@@ -130,6 +158,7 @@ AlgorithmEntry make_algorithm_entry(const AlgorithmInfo& (*info)(), std::string_
   const std::vector<std::string> names = split_type_list(param_struct_names, sizeof...(ParamStructs));
   std::size_t k = 0;
   (e.param_structs.push_back({names[k++], std::is_trivially_default_constructible_v<ParamStructs>}), ...);
+  if constexpr (requires { Algorithm::string_rewriting(); }) e.rewriting = Algorithm::string_rewriting();
   return e;
 }
 

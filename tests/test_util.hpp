@@ -53,14 +53,19 @@ struct CommandResult {
   std::string out;  // stdout and stderr together
 };
 
-// Runs the growbench binary with `args` (a shell command line), as a user would.
-inline CommandResult run_growbench(const std::string& args) {
+// Runs a shell command line, its output captured.
+inline CommandResult run_command(const std::string& command) {
   const auto log = temp_dir("cmd") / "log.txt";
-  const int rc = std::system((std::string(GROWBENCH_BINARY) + " " + args + " > " + log.string() + " 2>&1").c_str());
+  const int rc = std::system((command + " > " + log.string() + " 2>&1").c_str());
   std::ifstream in(log);
   std::stringstream ss;
   ss << in.rdbuf();
   return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, ss.str()};
+}
+
+// Runs the growbench binary with `args` (a shell command line), as a user would.
+inline CommandResult run_growbench(const std::string& args) {
+  return run_command(std::string(GROWBENCH_BINARY) + " " + args);
 }
 
 }  // namespace growbench::test

@@ -444,6 +444,19 @@ class LSystem final : public GrowthAlgorithm {
 
   const Plant& plant() const override { return plant_; }
 
+  // A grammar is a program in the input, whose arithmetic can divide by zero or overflow: the invalid plant
+  // it draws is bad input, not a bug.
+  void finish() override {
+    if (const std::string bad = plant_.validate(); !bad.empty()) {
+      const std::string grammar = setup_.params.text("grammar");
+      throw InputError(fmt::format(
+          "L-system{}: the plant its rules drew is invalid ({}): an expression divided by zero or overflowed",
+          grammar.empty() ? "" : fmt::format(" grammar '{}'", grammar), bad));
+    }
+  }
+
+  static StringRewriting string_rewriting() { return {derive_lsystem, lsystem_examples}; }
+
   std::vector<std::pair<std::string, double>> stats() const override {
     std::size_t symbols = 0, bytes = 0;
     for (const auto& pl : plants_) {

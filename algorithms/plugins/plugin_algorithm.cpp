@@ -11,10 +11,26 @@
 
 #include "algorithms/plugins/abi_convert.hpp"
 #include "core/errors.hpp"
+#include "core/outcome.hpp"
 #include "core/random.hpp"
 
 namespace growbench {
 namespace {
+
+// What a plugin's status says of how its call ended (include/growbench/plugin.h); a status the ABI does not
+// define is a failure.
+Outcome outcome_of_status(std::int32_t status) {
+  switch (status) {
+    case GROWBENCH_OK:
+      return Outcome::ok;
+    case GROWBENCH_INPUT_ERROR:
+      return Outcome::invalid_input;
+    case GROWBENCH_OUT_OF_MEMORY:
+      return Outcome::out_of_memory;
+    default:
+      return Outcome::failed;
+  }
+}
 
 using abi::points;
 
@@ -185,10 +201,8 @@ class PluginAlgorithm final : public GrowthAlgorithm {
       message = failure_.empty() ? "no message given" : failure_;
       failure_.clear();
     }
-    const std::string text = fmt::format("algorithm '{}' (a plugin) failed in {}: {}", info_.name, where, message);
-    if (status == GROWBENCH_INPUT_ERROR) throw InputError(text);
-    if (status == GROWBENCH_OUT_OF_MEMORY) throw std::bad_alloc();
-    throw std::runtime_error(text);
+    throw_as(outcome_of_status(status),
+             fmt::format("algorithm '{}' (a plugin) failed in {}: {}", info_.name, where, message));
   }
   void check(std::int32_t status, const std::string& where) const {
     if (status != GROWBENCH_OK) raise(status, where);

@@ -133,12 +133,12 @@ TEST(CPlugin, GrowsAndItsRecordNamesThePlugin) {
   const TrialRecord one = run_trial_record(spec, {}, &plant);
   spec.threads = 2;
   const TrialRecord two = run_trial_record(spec);
-  EXPECT_EQ(one.geometry_hash, two.geometry_hash);
+  EXPECT_EQ(one.results.geometry_hash, two.results.geometry_hash);
   EXPECT_EQ(plant.validate(), "");
   const Scene scene = load_scene("wall");
-  EXPECT_EQ(plant.nodes.size(), 20 * scene.seeds.size());  // `length` nodes per seed, nothing in the way
-  EXPECT_EQ(plant.organs.size(), scene.seeds.size());      // a leaf at each tip
-  EXPECT_EQ(one.algorithm_stats.at("steps"), 20.0);        // the 20th step grows nothing and ends growth
+  EXPECT_EQ(plant.nodes.size(), 20 * scene.seeds.size());    // `length` nodes per seed, nothing in the way
+  EXPECT_EQ(plant.organs.size(), scene.seeds.size());        // a leaf at each tip
+  EXPECT_EQ(one.results.algorithm_stats.at("steps"), 20.0);  // the 20th step grows nothing and ends growth
   ASSERT_TRUE(one.context.has_value());
   ASSERT_EQ(one.context->plugins.size(), 1u);
   const PluginOrigin& o = one.context->plugins[0];
@@ -210,11 +210,11 @@ TEST_P(SpacecolAsPlugin, GrowsTheBuiltInsPlant) {
   spec.algorithm = "spacecol_plugin";
   spec.plugins = {kSpacecolPlugin};
   const TrialRecord plugin = run_trial_record(spec);
-  EXPECT_EQ(plugin.geometry_hash, builtin.geometry_hash);
-  EXPECT_EQ(plugin.counts.nodes, builtin.counts.nodes);
-  EXPECT_EQ(plugin.steps, builtin.steps);
-  EXPECT_EQ(plugin.algorithm_stats, builtin.algorithm_stats);
-  EXPECT_GT(builtin.counts.nodes, 10u);
+  EXPECT_EQ(plugin.results.geometry_hash, builtin.results.geometry_hash);
+  EXPECT_EQ(plugin.results.counts.nodes, builtin.results.counts.nodes);
+  EXPECT_EQ(plugin.results.steps, builtin.results.steps);
+  EXPECT_EQ(plugin.results.algorithm_stats, builtin.results.algorithm_stats);
+  EXPECT_GT(builtin.results.counts.nodes, 10u);
 }
 
 std::vector<std::string> scene_names() {

@@ -21,12 +21,12 @@ struct AbArgs {
   std::vector<std::string> plugins;
 };
 
-ExitStatus run_ab_suite(const AbArgs& a) {
+Outcome run_ab_suite(const AbArgs& a) {
   load_plugins(a.plugins);  // each side's trials load them again: their specs list every plugin loaded
   const Suite suite = load_suite(a.suite);
   const AbResult r = run_ab(suite, a.options);
   fmt::print("{}", r.table);
-  return r.regression ? kExitRegression : kExitOk;
+  return r.regression ? Outcome::regression : Outcome::ok;
 }
 
 }  // namespace

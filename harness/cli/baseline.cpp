@@ -20,7 +20,7 @@ struct BaselineArgs {
   std::string results, file = "reports/baselines/quick.json";
 };
 
-ExitStatus update_baseline(const BaselineArgs& a) {
+Outcome update_baseline(const BaselineArgs& a) {
   const ResultsFile results = read_results(a.results);
   if (results.mode != "instructions")
     fmt::print(stderr,
@@ -38,7 +38,7 @@ ExitStatus update_baseline(const BaselineArgs& a) {
   }
   make_directories(std::filesystem::path(a.file).parent_path().string());
   write_file_atomic(a.file, json_text(to_json(fresh), 1));
-  return kExitOk;
+  return Outcome::ok;
 }
 
 }  // namespace

@@ -6,7 +6,10 @@
 
 #include <functional>
 #include <string>
+#include <string_view>
 #include <vector>
+
+#include "core/outcome.hpp"
 
 namespace CLI {
 class App;
@@ -16,24 +19,21 @@ class Validator;
 
 namespace growbench {
 struct RenderDirOptions;
+struct TrialSpec;
 enum class RenderQuality;
 }  // namespace growbench
 
 namespace growbench::cli {
 
-// The exit-status contract (README, "Exit status"). main is the one place that maps exceptions to it: an
-// InputError or a command-line error is kExitBadInput, any other exception kExitInternalError.
-enum ExitStatus : int {
-  kExitOk = 0,
-  kExitRegression = 1,     // compare or ab found a regression; nothing else exits 1
-  kExitBadInput = 2,       // bad input or usage, or an output path that cannot be written
-  kExitInternalError = 3,  // a bug: an unexpected exception, or a tool growbench runs failing on its own files
-};
-
+// How a command ended (core/outcome.hpp); main turns it, or the exception a command throws, into the exit
+// status (README, "Exit status"): regression 1, invalid input 2, an internal error 3.
 struct Command {
   CLI::App* app = nullptr;  // the subcommand: true when it was chosen
-  // Its exit status; a failure throws instead (InputError for bad input, anything else is a bug).
-  std::function<ExitStatus()> run;
+  // How it ended; a failure throws instead (InputError for bad input, anything else is a bug).
+  std::function<Outcome()> run;
+  // The exit status of each outcome: the command line's contract, except for `trial`, which reports as a
+  // trial's process does.
+  int (*exit_code)(Outcome) = exit_status;
 };
 
 // Checks for numeric options (->check(...)): a value outside is refused before anything runs, with the
@@ -41,12 +41,17 @@ struct Command {
 // 1e+06], got 'nan'"), instead of being replaced by another. number_in takes finite numbers from lo (or
 // just above it, when lo_open) to hi. integer_in takes whole numbers in [lo, hi]: an unsigned option's
 // "-1", which CLI11 would wrap around to the largest value, is refused.
-CLI::Validator number_in(double lo, double hi, bool lo_open = false);
+CLI::Validator number_in(double lo, double hi, bool lo_open = false, bool zero_or = false);
 CLI::Validator integer_in(long long lo, unsigned long long hi);
+
+// Adds the option FLAGS bound to the trial spec's field KEY (harness/record/trial_spec.hpp), checked against
+// its declared range or names, with the declaration's doc as help unless `help` is given.
+CLI::Option* add_spec_option(CLI::App* cmd, const std::string& flags, TrialSpec& spec, std::string_view key,
+                             const std::string& help = "");
 
 // A Python script's exit status (reports/report.py, reports/history.py) under the contract: 0, and 2 for
 // bad input, whose message the script printed; anything else (a traceback, a signal) is a bug, said so.
-ExitStatus script_status(int status, const std::string& script);
+Outcome script_status(int status, const std::string& script);
 
 // Adds --plugin PATH (repeatable), bound to `paths`, to a command that looks algorithms up. The command
 // loads them (algorithms/plugins/loader.hpp's load_plugins, which adds GROWBENCH_PLUGIN_PATH's) first
@@ -81,5 +86,6 @@ Command add_baseline(CLI::App& app);  // baseline update
 Command add_report(CLI::App& app);
 Command add_lsystem(CLI::App& app);
 Command add_summary(CLI::App& app);
+Command add_schema(CLI::App& app);  // internal: not listed in --help
 
 }  // namespace growbench::cli

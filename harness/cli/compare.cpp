@@ -17,13 +17,13 @@ struct CompareArgs {
   CompareOptions options;
 };
 
-ExitStatus compare_files(const CompareArgs& a) {
+Outcome compare_files(const CompareArgs& a) {
   // Both files are read before anything is compared: a file that cannot be read is bad input (2), never a
   // regression (1).
   const GateFile base = read_gate_file(a.base), fresh = read_gate_file(a.fresh);
   const auto r = compare_results(base, fresh, a.options);
   fmt::print("{}", r.table());
-  return r.fails() ? kExitRegression : kExitOk;
+  return r.fails() ? Outcome::regression : Outcome::ok;
 }
 
 }  // namespace

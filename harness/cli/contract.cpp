@@ -12,16 +12,17 @@
 
 namespace growbench::cli {
 
-CLI::Validator number_in(double lo, double hi, bool lo_open) {
+CLI::Validator number_in(double lo, double hi, bool lo_open, bool zero_or) {
   const std::string range = fmt::format("{}{:g}, {:g}]", lo_open ? "(" : "[", lo, hi);
+  const char* zero = zero_or ? "0 or " : "";
   return {[=](std::string& text) -> std::string {
             char* end = nullptr;
             const double v = std::strtod(text.c_str(), &end);
             const bool ok = !text.empty() && end == text.c_str() + text.size() && std::isfinite(v) &&
-                            (lo_open ? v > lo : v >= lo) && v <= hi;
-            return ok ? std::string() : fmt::format("expected a finite number in {}, got '{}'", range, text);
+                            ((zero_or && v == 0.0) || ((lo_open ? v > lo : v >= lo) && v <= hi));
+            return ok ? std::string() : fmt::format("expected {}a finite number in {}, got '{}'", zero, range, text);
           },
-          "NUMBER in " + range};
+          fmt::format("{}NUMBER in {}", zero, range)};
 }
 
 CLI::Validator integer_in(long long lo, unsigned long long hi) {
@@ -45,13 +46,14 @@ CLI::Validator integer_in(long long lo, unsigned long long hi) {
           "INTEGER in " + range};
 }
 
-ExitStatus script_status(int status, const std::string& script) {
-  if (status == kExitOk || status == kExitBadInput) return static_cast<ExitStatus>(status);
+Outcome script_status(int status, const std::string& script) {
+  if (status == exit_status(Outcome::ok)) return Outcome::ok;
+  if (status == exit_status(Outcome::invalid_input)) return Outcome::invalid_input;
   fmt::print(stderr,
              "growbench: internal error: {} ended with status {}\n"
              "This is a bug in growbench: please report it with the command line and the input that caused it.\n",
              script, status);
-  return kExitInternalError;
+  return Outcome::failed;
 }
 
 }  // namespace growbench::cli

@@ -34,7 +34,7 @@ Command add_history(CLI::App& app) {
   return {cmd, [a, add] {
             if (*add) {
               fmt::print("appended to {}\n", history_add(a->results, a->dir, a->machine));
-              return kExitOk;
+              return Outcome::ok;
             }
             return script_status(history_plot(a->dir, a->out), "reports/history.py");
           }};

@@ -75,11 +75,11 @@ void print_organs(bool markdown) {
   for (std::size_t i = 0; i < names.size(); ++i) fmt::print("    {:<12} {}\n", names[i], docs[i]);
 }
 
-ExitStatus list_algorithms(const ListArgs& a) {
+Outcome list_algorithms(const ListArgs& a) {
   load_plugins(a.plugins);
   if (a.name == "organs") {
     print_organs(a.markdown);
-    return kExitOk;
+    return Outcome::ok;
   }
   if (!a.name.empty()) {
     const AlgorithmEntry& e = find_algorithm(a.name);
@@ -87,7 +87,7 @@ ExitStatus list_algorithms(const ListArgs& a) {
       fmt::print("{}", markdown_of(e.info()));
     else
       print_text(e);
-    return kExitOk;
+    return Outcome::ok;
   }
   bool first = true;
   for (const AlgorithmEntry* e : all_algorithms()) {
@@ -100,7 +100,7 @@ ExitStatus list_algorithms(const ListArgs& a) {
     first = false;
   }
   if (!a.markdown) print_organs(false);
-  return kExitOk;
+  return Outcome::ok;
 }
 
 }  // namespace

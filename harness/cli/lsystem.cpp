@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -10,7 +11,6 @@
 #include <fmt/format.h>
 
 #include "algorithms/algorithm.hpp"
-#include "algorithms/lsystem/lsystem.hpp"
 #include "harness/cli/command.hpp"
 #include "scenes/scene_library.hpp"
 #include "scenes/scene_query.hpp"
@@ -29,12 +29,14 @@ struct LsystemArgs {
   std::size_t limit = 0;
 };
 
-ExitStatus derive(const LsystemArgs& a) {
+Outcome derive(const LsystemArgs& a) {
+  const AlgorithmEntry& entry = find_algorithm("lsystem");
+  if (!entry.rewriting) throw std::logic_error("the lsystem algorithm registered no string rewriting");
   if (a.examples) {
-    for (const auto& name : lsystem_examples()) fmt::print("{}\n", name);
-    return kExitOk;
+    for (const auto& name : entry.rewriting->examples()) fmt::print("{}\n", name);
+    return Outcome::ok;
   }
-  Params params = default_params(find_algorithm("lsystem"));
+  Params params = default_params(entry);
   if (!a.file.empty()) params.set("grammar", a.file);
   if (!a.generations.empty()) params.set("generations", a.generations);
   for (const auto& s : a.sets) params.set_assignment(s);
@@ -44,8 +46,8 @@ ExitStatus derive(const LsystemArgs& a) {
     scene = load_scene(a.scene);
     query = std::make_unique<SceneQuery>(*scene);
   }
-  const DerivedString d = derive_lsystem(params, a.seed, scene ? &*scene : nullptr, query.get(),
-                                         a.print ? std::optional(a.limit) : std::nullopt);
+  const DerivedString d = entry.rewriting->derive(params, a.seed, scene ? &*scene : nullptr, query.get(),
+                                                  a.print ? std::optional(a.limit) : std::nullopt);
   if (a.print) {
     fmt::print("{}", d.text);
     if (a.limit && d.modules > a.limit) fmt::print(" ... ({} more modules)", d.modules - a.limit);
@@ -54,7 +56,7 @@ ExitStatus derive(const LsystemArgs& a) {
   fmt::print(stderr, "generation {}: {} modules, {} parameters, {:.1f} MiB, derived in {:.6f} s ({:.6f} s CPU)\n",
              d.generations, d.modules, d.params, d.bytes / (1024.0 * 1024.0), d.seconds, d.cpu_seconds);
   for (const auto& [c, n] : d.counts) fmt::print(stderr, "  {}  {}\n", c, n);
-  return kExitOk;
+  return Outcome::ok;
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
 // growbench: the command line. main builds the app, asks each subcommand (one file each, command.hpp) to
-// register, parses, and runs the chosen one. It is the one place that turns exceptions into exit statuses
-// (command.hpp's ExitStatus, README "Exit status"): bad input and command-line errors 2, anything else,
-// being a bug, 3 with a request for a report.
+// register, parses, and runs the chosen one. It is the one place that turns exceptions into outcomes and
+// outcomes into exit statuses (core/outcome.hpp, README "Exit status"): bad input and command-line errors 2,
+// anything else, being a bug, 3 with a request for a report.
 #include <exception>
 #include <new>
 
@@ -20,19 +20,37 @@ namespace {
 constexpr const char* kOutOfMemory =
     "growbench: error: out of memory: the input asks for more memory than this process may use";
 
-int internal_error(const char* what) {
+gb::Outcome internal_error(const char* what) {
   fmt::print(stderr,
              "growbench: internal error: {}\n"
              "This is a bug in growbench: please report it with the command line and the input that caused it.\n",
              what);
-  return gb::cli::kExitInternalError;
+  return gb::Outcome::failed;
+}
+
+// Runs the chosen command; an exception becomes the outcome it stands for, its message printed.
+gb::Outcome run_command(const gb::cli::Command& command) {
+  try {
+    return command.run();
+  } catch (const gb::InputError& e) {
+    fmt::print(stderr, "growbench: error: {}\n", e.what());
+    return gb::Outcome::invalid_input;
+  } catch (const std::exception& e) {
+    const gb::Outcome o = gb::outcome_of(e);
+    if (o == gb::Outcome::out_of_memory)
+      fmt::print(stderr, "{}{}\n", kOutOfMemory,
+                 dynamic_cast<const std::bad_alloc*>(&e) ? "" : fmt::format(" ({})", e.what()));
+    return o == gb::Outcome::failed ? internal_error(e.what()) : o;
+  } catch (...) {
+    return internal_error("an exception of unknown type");
+  }
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   namespace cli = gb::cli;
-  gb::exit_on_escaped_bad_alloc(cli::kExitBadInput, kOutOfMemory);
+  gb::exit_on_escaped_bad_alloc(gb::exit_status(gb::Outcome::out_of_memory), kOutOfMemory);
   try {
     CLI::App app{"growbench: grow, measure and compare procedural plant growth algorithms on standard scenes"};
     app.require_subcommand(1);
@@ -42,27 +60,17 @@ int main(int argc, char** argv) {
                                      cli::add_suite(app),   cli::add_history(app),  cli::add_render(app),
                                      cli::add_trial(app),   cli::add_ab(app),       cli::add_compare(app),
                                      cli::add_merge(app),   cli::add_baseline(app), cli::add_report(app),
-                                     cli::add_lsystem(app), cli::add_summary(app)};
+                                     cli::add_lsystem(app), cli::add_summary(app),  cli::add_schema(app)};
     try {
       app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
       // --help and --version print and succeed; any other command-line error is bad usage.
-      return app.exit(e) == 0 ? cli::kExitOk : cli::kExitBadInput;
+      return gb::exit_status(app.exit(e) == 0 ? gb::Outcome::ok : gb::Outcome::invalid_input);
     }
     for (const auto& command : commands)
-      if (*command.app) return command.run();
-    return cli::kExitOk;
-  } catch (const gb::InputError& e) {
-    fmt::print(stderr, "growbench: error: {}\n", e.what());
-    return cli::kExitBadInput;
-  } catch (const std::exception& e) {
-    if (gb::is_out_of_memory(e)) {
-      fmt::print(stderr, "{}{}\n", kOutOfMemory,
-                 dynamic_cast<const std::bad_alloc*>(&e) ? "" : fmt::format(" ({})", e.what()));
-      return cli::kExitBadInput;
-    }
-    return internal_error(e.what());
-  } catch (...) {
-    return internal_error("an exception of unknown type");
+      if (*command.app) return command.exit_code(run_command(command));
+    return gb::exit_status(gb::Outcome::ok);
+  } catch (const std::exception& e) {  // building the command line itself
+    return gb::exit_status(internal_error(e.what()));
   }
 }

@@ -23,7 +23,7 @@ struct MergeArgs {
   bool mixed = false;
 };
 
-ExitStatus merge_shards(const MergeArgs& a) {
+Outcome merge_shards(const MergeArgs& a) {
   std::vector<ResultsFile> shards;
   for (const auto& f : a.inputs) shards.push_back(read_results(f));
   const ResultsFile merged = merge_results(shards, a.inputs, a.mixed);
@@ -34,7 +34,7 @@ ExitStatus merge_shards(const MergeArgs& a) {
         stderr,
         "growbench: warning: the shards ran on different machines or builds; their timings are not comparable\n");
   fmt::print("merged {} shards, {} cells, into {}\n", shards.size(), merged.trials.size(), a.out);
-  return kExitOk;
+  return Outcome::ok;
 }
 
 }  // namespace

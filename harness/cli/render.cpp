@@ -20,7 +20,7 @@ struct RenderArgs {
   RenderDirOptions options;
 };
 
-ExitStatus render_dir(RenderArgs& a) {
+Outcome render_dir(RenderArgs& a) {
   apply_render_flags(a.flags, parse_render_quality(a.quality), a.options);
   const RenderSummary r = render_directory_record(a.dir, a.options);
   fmt::print("rendered {} images ({} failed, {} POV-Ray warnings) in {:.1f} s with {} POV-Ray processes at once\n",
@@ -28,7 +28,7 @@ ExitStatus render_dir(RenderArgs& a) {
   if (r.grid) fmt::print("grid: {}\n", (std::filesystem::path(a.dir) / *r.grid).string());
   // A failed render is POV-Ray failing on the scene file growbench wrote (the record's message and the log
   // say why): an internal error.
-  return r.failed > 0 ? kExitInternalError : kExitOk;
+  return r.failed > 0 ? Outcome::failed : Outcome::ok;
 }
 
 }  // namespace

@@ -17,7 +17,7 @@ struct ReportArgs {
   std::string results, out;
 };
 
-ExitStatus report(ReportArgs& a) {
+Outcome report(ReportArgs& a) {
   if (a.out.empty()) a.out = (std::filesystem::path(a.results).parent_path() / "report").string();
   // Read first as the typed record: a file that does not fit is refused here with its JSON path, before
   // Python starts.

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <array>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -34,10 +35,12 @@ struct RunArgs {
   RenderFlags render_flags;
 };
 
-glm::vec3 parse_point(const std::string& text) {
+// X,Y,Z as a point, as given (the trial rounds it to the float a scene's positions have).
+std::array<double, 3> parse_point(const std::string& text) {
   Params p("--seed-at", {{"at", ParamType::Vec3, glm::dvec3(0.0), -1e9, 1e9, "m", "", {}}});
   p.set("at", text);
-  return glm::vec3(p.vec3("at"));
+  const glm::dvec3 v = p.vec3("at");
+  return {v.x, v.y, v.z};
 }
 
 // out/ALGORITHM-SCENE, the scene named by a mesh's or a scene file's stem.
@@ -51,24 +54,23 @@ std::string default_out_dir(const TrialSpec& spec) {
 }
 
 void print_record(const TrialRecord& rec, const TrialSpec& spec, const std::string& out_dir) {
-  // A trial that returns has run every phase; value() says so if one is ever missing.
-  const Phases& ph = rec.phases;
+  const TrialResults& r = rec.results;
   fmt::print("{} on {} (seed {}, {} threads): {} steps ({}), {} nodes, {} leaves, {:.2f} m of branches\n",
-             rec.algorithm, rec.scene.name, spec.seed, rec.threads, rec.steps, rec.stopped_by, rec.counts.nodes,
-             rec.counts.leaves, rec.total_length_m);
-  fmt::print(
-      "  time: scene {:.3f} s, query {:.3f} s, growth {:.3f} s, meshing {:.3f} s, export {:.3f} s; peak RSS {:.1f} "
-      "MiB\n",
-      ph.scene_load.value().wall_s, ph.query_build.value().wall_s, ph.growth.value().wall_s, ph.meshing.value().wall_s,
-      ph.exporting.value().wall_s, static_cast<double>(rec.peak_rss_bytes) / (1024.0 * 1024.0));
+             rec.algorithm, rec.scene.name, spec.seed, r.threads, r.steps, r.stopped_by, r.counts.nodes,
+             r.counts.leaves, r.total_length_m);
+  std::string times;  // each phase that ran, in pipeline order
+  rec.phases.each(
+      [&](Phase p, const PhaseMeasures& m) { times += fmt::format("{} {:.3f} s, ", phase_name(p), m.wall_s); });
+  fmt::print("  time: {}peak RSS {:.1f} MiB\n", times, static_cast<double>(rec.peak_rss_bytes) / (1024.0 * 1024.0));
   std::string own;  // the algorithm's own files (the vines' texture), as the record lists them
-  for (const auto& [name, bytes] : rec.output_bytes.algorithm_files) own += ", " + name;
+  for (const auto& [name, bytes] : r.output_bytes.algorithm_files) own += ", " + name;
   fmt::print(
-      "  wrote {}/plant.obj, plant.ply, plant.glb, skeleton.obj, skeleton.ply{}, record.json (geometry hash {})\n",
-      out_dir, own, rec.geometry_hash);
+      "  wrote {}/plant.obj, plant.ply, plant.glb, plant.gbplant, skeleton.obj, skeleton.ply{}, record.json (geometry "
+      "hash {})\n",
+      out_dir, own, r.geometry_hash);
   if (rec.frames)
     fmt::print("  kept {} frames in {}/frames (capture took {:.3f} s, not counted in growth)\n", rec.frames->count,
-               out_dir, ph.growth.value().frame_capture_wall_s.value());
+               out_dir, rec.phases[Phase::growth].value().frame_capture_wall_s.value());
 }
 
 // What the record says of the render's camera: "" for the scene's, else how the plant was framed.
@@ -80,27 +82,27 @@ std::string camera_note(const RenderRecord& rr) {
 
 // Renders the run directory and reports what the record says of it. A render that failed is POV-Ray failing
 // on the scene file growbench wrote (its log says why): an internal error.
-ExitStatus render_run(const std::string& out_dir, const RenderDirOptions& ro) {
+Outcome render_run(const std::string& out_dir, const RenderDirOptions& ro) {
   const RenderQuality quality = ro.render.quality;
   const RenderSummary r = render_directory_record(out_dir, ro);
   const std::string record_path = (std::filesystem::path(out_dir) / "record.json").string();
   const TrialRecord updated = read_trial_record(record_path);
-  if (!updated.render)
+  if (!updated.media.render)
     throw std::runtime_error(fmt::format("{}: at render: expected the render just made, found none", record_path));
-  const RenderRecord& rr = *updated.render;
+  const RenderRecord& rr = *updated.media.render;
   auto video = [](const std::optional<AnimationRecord>& a, const char* what) {
     return a ? fmt::format(", {} {} frames: {}", a->frames, what, a->file.value_or(a->status)) : std::string();
   };
   if (rr.status == "ok")
     fmt::print("  rendered {}/render.png ({}x{}, {}{}) in {:.2f} s of POV-Ray{}{}\n", out_dir, rr.width, rr.height,
-               to_string(quality), camera_note(rr), rr.wall_s, video(updated.animation, "growth"),
-               ro.turntable > 0 ? video(updated.turntable, "turntable") : "");
+               to_string(quality), camera_note(rr), rr.wall_s, video(updated.media.animation, "growth"),
+               ro.turntable > 0 ? video(updated.media.turntable, "turntable") : "");
   else
     fmt::print(stderr, "growbench: render failed: {}\n", rr.message.value_or(rr.status));
-  return r.failed > 0 ? kExitInternalError : kExitOk;
+  return r.failed > 0 ? Outcome::failed : Outcome::ok;
 }
 
-ExitStatus run_one(RunArgs& a) {
+Outcome run_one(RunArgs& a) {
   TrialSpec& spec = a.spec;
   for (const auto& s : a.seed_at) spec.seed_at.push_back(parse_point(s));
   if (a.out_dir.empty()) a.out_dir = default_out_dir(spec);
@@ -125,7 +127,7 @@ ExitStatus run_one(RunArgs& a) {
   const TrialRecord rec = run_trial_record(spec, progress);
   if (!a.quiet && isatty(STDERR_FILENO)) fmt::print(stderr, "\r{:60}\r", "");
   print_record(rec, spec, a.out_dir);
-  return render ? render_run(a.out_dir, *render) : kExitOk;
+  return render ? render_run(a.out_dir, *render) : Outcome::ok;
 }
 
 }  // namespace
@@ -141,32 +143,22 @@ Command add_run(CLI::App& app) {
          "for a bundled mesh (e.g. mesh:stanford-bunny)")
       ->required();
   run->add_option("--scene-param", spec.scene_params, "scene parameter key=value (repeatable)");
-  run->add_option("--seed", spec.seed, "random seed")->default_val(1)->check(integer_in(0, UINT64_MAX));
+  add_spec_option(run, "--seed", spec, "seed");
   run->add_option("--set", spec.params, "algorithm parameter key=value (repeatable)");
   add_plugin_option(run, spec.plugins);
   run->add_option("--seed-at", a->seed_at,
                   "seed position X,Y,Z, snapped to the nearest surface (repeatable; replaces the scene's seeds)");
-  run->add_option("--max-steps", spec.max_steps, "step cap")->default_val(5000)->check(integer_in(0, INT_MAX));
-  run->add_option("--time-limit", spec.time_limit_s, "stop growing after this many seconds (0: none)")
-      ->default_val(0)
-      ->check(number_in(0, kMaxTimeLimitS));
-  run->add_option("-j,--threads", spec.threads, "worker threads (0: all cores)")
-      ->default_val(0)
-      ->check(integer_in(0, kMaxThreads));
-  // No default: absent, the scene query picks its own (SceneQueryOptions); given, it must be a size.
-  run->add_option("--voxel-size", spec.voxel_size,
-                  "distance-field voxel size in metres (default: scene diagonal / 256)")
-      ->check(number_in(kMinVoxelSize, kMaxVoxelSize));
-  run->add_option("--sides", spec.mesher.sides, "tube sides of the branch mesh (3..64)")
-      ->default_val(6)
-      ->check(CLI::Range(3, 64));
-  run->add_option_function<std::string>(
-         "--glb", [a](const std::string& v) { a->spec.glb = parse_glb_layout(v); },
-         "layout of plant.glb: compact (instanced organs, quantized and meshopt-compressed; the default), "
-         "instanced (no compression) or plain (core glTF, floats: every reader loads it)")
-      ->check(CLI::IsMember({"plain", "instanced", "compact"}))
-      ->default_str(std::string(glb_layout_name(kDefaultGlbLayout)));
-  run->add_option("--leaf-obj", spec.mesher.leaf_obj,
+  add_spec_option(run, "--max-steps", spec, "max_steps");
+  add_spec_option(run, "--time-limit", spec, "time_limit_s");
+  add_spec_option(run, "-j,--threads", spec, "threads");
+  add_spec_option(run, "--voxel-size", spec, "voxel_size");
+  add_spec_option(run, "--sides", spec, "sides");
+  add_spec_option(run, "--budget-nodes", spec, "budget_nodes");
+  add_spec_option(run, "--budget-length", spec, "budget_length_m");
+  add_spec_option(run, "--glb", spec, "glb",
+                  "layout of plant.glb: compact (instanced organs, quantized and meshopt-compressed; the default), "
+                  "instanced (no compression) or plain (core glTF, floats: every reader loads it)");
+  add_spec_option(run, "--leaf-obj", spec, "leaf_obj",
                   "a custom organ for every leaf, flower and bud whose plant names no shape: an OBJ with the blade "
                   "along +Z from the stem at z = 0 and its upper side toward +Y (scaled to unit length; the organ's "
                   "size sizes it)");
@@ -178,11 +170,9 @@ Command add_run(CLI::App& app) {
   CLI::Option* render =
       run->add_option("--render", a->render, "render the plant with POV-Ray afterwards: preview or paper (render.png)");
   add_render_flags(run, a->render_flags, render);
-  run->add_option("--frames", spec.frame_every,
+  add_spec_option(run, "--frames", spec, "frame_every",
                   "growth animation: keep the plant every K steps (frames/); with --render, render them and make "
-                  "animation.mp4 with ffmpeg")
-      ->default_val(0)
-      ->check(integer_in(0, INT_MAX));
+                  "animation.mp4 with ffmpeg");
   // Test hook, not listed: fault=throw is an unexpected exception, which must exit 3 (README, "Exit status").
   run->add_option("--fault", spec.fault, "inject a fault into the trial (tests)")->group("");
   return {run, [a] { return run_one(*a); }};

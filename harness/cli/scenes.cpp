@@ -10,7 +10,7 @@ namespace growbench::cli {
 
 namespace {
 
-ExitStatus list_scenes() {
+Outcome list_scenes() {
   for (const auto& s : standard_scenes()) {
     fmt::print("{}\n  {}\n", s.name, s.summary);
     print_param_table(s.params);
@@ -24,7 +24,7 @@ ExitStatus list_scenes() {
   fmt::print(
       "FILE.json\n  a scene file (schema_version 1): meshes, seeds, light, envelope, zones, camera; see "
       "scenes/README.md\n");
-  return kExitOk;
+  return Outcome::ok;
 }
 
 }  // namespace

@@ -26,7 +26,7 @@ struct SuiteArgs {
   std::string file, out, shard;
   bool resume = false, quiet = false;
   int repetitions = 0;
-  bool instructions = false;
+  bool instructions = false, plan = false;
   std::string render, history;
   RenderFlags render_flags;
   std::vector<std::string> plugins;
@@ -53,13 +53,17 @@ void render_suite(const std::string& results_path, const RenderDirOptions& ro) {
              (std::filesystem::path(results_path).parent_path() / r.grid.value_or("")).string());
 }
 
-ExitStatus run_suite_file(const SuiteArgs& a) {
+Outcome run_suite_file(const SuiteArgs& a) {
   // First, while this process is small: the launcher that forks the trials (harness/run/process.hpp).
   std::unique_ptr<Launcher> launcher;
   if (!a.instructions) launcher = start_trial_launcher();
   load_plugins(a.plugins);
   Suite suite = load_suite(a.file);
   if (a.repetitions > 0) suite.repetitions = a.repetitions;
+  if (a.plan) {
+    fmt::print("{}", plan_text(suite));
+    return Outcome::ok;
+  }
   SuiteRunOptions o;
   o.launcher = launcher.get();
   o.out_dir = a.out;
@@ -84,7 +88,7 @@ ExitStatus run_suite_file(const SuiteArgs& a) {
   fmt::print("\nwrote {} and results.csv beside it\n", path);
   if (!a.history.empty()) fmt::print("history: appended to {}\n", history_add(path, a.history));
   if (render) render_suite(path, *render);
-  return kExitOk;
+  return Outcome::ok;
 }
 
 }  // namespace
@@ -97,6 +101,8 @@ Command add_suite(CLI::App& app) {
   cmd->add_option("-o,--out", a->out, "results directory (default: out/suites/NAME)");
   add_plugin_option(cmd, a->plugins);
   cmd->add_flag("--resume", a->resume, "continue an interrupted run in --out, skipping finished trials");
+  cmd->add_flag("--plan", a->plan,
+                "check the suite file and print what it would run (its cells and trials), running nothing");
   cmd->add_option("--shard", a->shard, "run only shard I of N (I/N, 0-based): a deterministic slice of the cells");
   cmd->add_flag("-q,--quiet", a->quiet, "no progress lines");
   cmd->add_option("--repetitions", a->repetitions,

@@ -13,10 +13,10 @@ namespace growbench::cli {
 
 namespace {
 
-ExitStatus summarize(const std::string& results_file) {
+Outcome summarize(const std::string& results_file) {
   // read_results refuses a file of another kind, or one without trials, naming the file and the JSON path.
   fmt::print("{}", summarize_results(read_results(results_file)));
-  return kExitOk;
+  return Outcome::ok;
 }
 
 }  // namespace

@@ -16,12 +16,10 @@ struct TrialArgs {
   std::string spec_file, fault;
 };
 
-ExitStatus run_spec(const TrialArgs& a) {
+Outcome run_spec(const TrialArgs& a) {
   TrialSpec ts = read_trial_spec(a.spec_file);  // errors name the spec file and the JSON path
   if (!a.fault.empty()) ts.fault = a.fault;
-  // Not the command line's contract: the statuses a trial's process reports to the suite or ab that ran it
-  // (suite.hpp's run_trial_child).
-  return static_cast<ExitStatus>(run_trial_child(ts, ts.out_dir));
+  return run_trial_child(ts, ts.out_dir);
 }
 
 }  // namespace
@@ -34,7 +32,8 @@ Command add_trial(CLI::App& app) {
   // Test hook: a wrapper script that appends `--fault slow:N` turns this binary into a planted slowdown
   // for `growbench ab` (tests/harness/ab_test.sh).
   cmd->add_option("--fault", a->fault, "inject a fault into the trial (tests)");
-  return {cmd, [a] { return run_spec(*a); }};
+  // Not the command line's contract: it reports to the suite or ab that ran it as a trial's process does.
+  return {cmd, [a] { return run_spec(*a); }, trial_exit_code};
 }
 
 }  // namespace growbench::cli

@@ -195,10 +195,11 @@ class Trials {
       cell.error = fmt::format("side {}: {}/record.json is unreadable: {}", kSides[side], dir.string(), e.what());
       return;
     }
-    cell.hash[static_cast<std::size_t>(side)] = rec.geometry_hash;
+    cell.hash[static_cast<std::size_t>(side)] = rec.results.geometry_hash;
     if (!into) return;  // a warm-up
     for (const auto& p : o_.phases) {
-      const PhaseMeasures* m = rec.phases.find(p);
+      const auto phase = phase_named(p);
+      const PhaseMeasures* m = phase ? rec.phases.find(*phase) : nullptr;
       if (!m) {
         cell.error = fmt::format("side {}: its record has no phase '{}'", kSides[side], p);
         return;

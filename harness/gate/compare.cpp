@@ -7,6 +7,7 @@
 
 #include "core/errors.hpp"
 #include "harness/record/files.hpp"
+#include "harness/record/reflect.hpp"
 
 namespace growbench {
 using json = nlohmann::json;
@@ -133,38 +134,33 @@ const GatedField kBehaviour[] = {
     {"metrics", [](const BaselineCell& c) { return json_of(c.metrics); }},
 };
 const GatedField kOutputBytes = {"output_bytes", [](const BaselineCell& c) { return json_of(c.output_bytes); }};
-const GatedField kAlloc = {"alloc", [](const BaselineCell& c) {
-                             if (!c.alloc) return std::optional<json>();
-                             json j = json::object();
-                             for (const auto& [phase, a] : *c.alloc) j[phase] = to_json(a);
-                             return std::optional<json>(j);
-                           }};
+const GatedField kAlloc = {"alloc", [](const BaselineCell& c) { return json_of(c.alloc); }};
 
 // Every changed instruction count: a rise past the threshold fails; anything else is shown.
 void compare_instructions(const std::string& id, const InstructionCounts& base, const InstructionCounts& now,
                           const CompareOptions& o, CompareResult& r) {
-  for (const auto& [phase, old_ir] : base) {
-    const auto it = now.find(phase);
-    if (it == now.end() || it->second == old_ir) continue;
-    const json v = old_ir, nv = it->second;
+  base.each([&](Phase phase, std::uint64_t old_ir) {
+    const std::uint64_t* new_ir = now.find(phase);
+    if (!new_ir || *new_ir == old_ir) return;
+    const json v = old_ir, nv = *new_ir;
     const double ratio = ratio_of(v, nv);
-    const double delta = static_cast<double>(it->second) - static_cast<double>(old_ir);
+    const double delta = static_cast<double>(*new_ir) - static_cast<double>(old_ir);
     if (std::abs(ratio - 1.0) < 1e-3 && std::abs(delta) < o.instructions_floor) {
       ++r.small_changes;  // heap-layout noise: counted, not listed
-      continue;
+      return;
     }
     const bool bad = ratio > 1.0 + o.instructions_threshold && delta > o.instructions_floor;
-    r.changes.push_back({id, "instructions." + phase, show(v), show(nv), ratio, bad,
+    r.changes.push_back({id, fmt::format("instructions.{}", phase_name(phase)), show(v), show(nv), ratio, bad,
                          fmt::format("instructions {:+.2f}%{}", 100.0 * (ratio - 1.0),
                                      bad ? fmt::format(" > +{:g}%", 100.0 * o.instructions_threshold)
                                      : ratio > 1.0 + o.instructions_threshold ? " (below the floor)"
                                                                               : "")});
-  }
+  });
 }
 
 // The repetitions of both runs, per phase, wall and CPU: judged when both have at least 3.
 void compare_timings(const GateCell& b, const GateCell& n, const CompareOptions& o, CompareResult& r) {
-  auto samples = [](const GateCell& t, std::string_view phase, bool cpu) {
+  auto samples = [](const GateCell& t, Phase phase, bool cpu) {
     std::vector<double> v;
     if (t.samples)
       for (const auto& s : *t.samples)
@@ -172,11 +168,11 @@ void compare_timings(const GateCell& b, const GateCell& n, const CompareOptions&
           v.push_back(cpu ? p->cpu_s : p->wall_s);
     return v;
   };
-  for (const char* phase : {"growth"})
+  for (const Phase phase : {Phase::growth})
     for (const bool cpu : {false, true}) {
       const auto a = samples(b, phase, cpu), c = samples(n, phase, cpu);
       if (a.size() >= 3 && c.size() >= 3)
-        r.timings.push_back({b.cell.id, fmt::format("{}.{}", phase, cpu ? "cpu_s" : "wall_s"),
+        r.timings.push_back({b.cell.id, fmt::format("{}.{}", phase_name(phase), cpu ? "cpu_s" : "wall_s"),
                              judge_timings(a, c, o.timing_effect, o.timing_alpha)});
     }
 }
@@ -258,31 +254,13 @@ CompareResult compare_results(const json& base, const json& now, const CompareOp
   return compare_results(gate_file_from_json(base, "the base"), gate_file_from_json(now, "the new results"), o);
 }
 
-BaselineCell baseline_cell_of(const SuiteCell& t) {
-  BaselineCell c;
-  c.id = t.id;
-  c.label = t.label;
-  c.algorithm = t.algorithm;
-  c.scene = t.scene;
-  c.seed = t.seed;
-  c.status = t.status;
-  c.threads = t.results.threads;
-  c.geometry_hash = t.results.geometry_hash;
-  c.counts = t.results.counts;
-  c.metrics = t.results.metrics;
-  c.output_bytes = t.results.output_bytes;
-  c.alloc = t.results.alloc;
-  c.instructions = t.results.instructions;
-  return c;
-}
-
 Baseline baseline_of(const ResultsFile& results) {
   Baseline b;
   b.mode = results.mode;
   b.suite = results.suite;
   b.suite_hash = results.suite_hash;
-  const RunContext& c = results.context;
-  b.context = {c.growbench_commit, c.dirty, c.compiler, c.cxx_flags, c.build_type, c.dependencies};
+  const RunContext& c = results.context;  // the fields of its context a baseline keeps
+  project(c, b.context);
   for (const auto& t : results.trials) b.trials.push_back(baseline_cell_of(t));
   return b;
 }

@@ -66,7 +66,6 @@ CompareResult compare_results(const nlohmann::json& base, const nlohmann::json& 
 
 // The deterministic part of a results file (no timings, no paths): what a committed baseline holds.
 Baseline baseline_of(const ResultsFile& results);
-BaselineCell baseline_cell_of(const SuiteCell& cell);
 nlohmann::json baseline_of(const nlohmann::json& results);
 
 // Reads a results or baseline file; InputError naming the file when it is neither or of a newer schema, and

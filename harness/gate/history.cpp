@@ -31,17 +31,19 @@ namespace {
 HistoryCell history_cell(const SuiteCell& t, bool timing) {
   HistoryCell c;
   c.status = t.status;
-  c.geometry_hash = t.results.geometry_hash;
-  if (t.results.counts) c.nodes = t.results.counts->nodes;
+  if (const auto& plant = t.results.plant) {
+    c.geometry_hash = plant->geometry_hash;
+    c.nodes = plant->counts.nodes;
+  }
   std::vector<double> total, growth_wall, growth_cpu, growth_rss;
   for (const auto& s : t.samples) {
     if (s.status != "ok" || !s.phases) continue;
     double sum = 0.0;
-    s.phases->each([&](std::string_view k, const PhaseMeasures& p) {
-      if (k != "metrics") sum += p.wall_s;
+    s.phases->each([&](Phase phase, const PhaseMeasures& p) {
+      if (phase != Phase::metrics) sum += p.wall_s;
     });
     total.push_back(sum);
-    if (const auto& g = s.phases->growth) {
+    if (const PhaseMeasures* g = s.phases->find(Phase::growth)) {
       growth_wall.push_back(g->wall_s);
       growth_cpu.push_back(g->cpu_s);
       growth_rss.push_back(static_cast<double>(g->peak_rss_bytes));

@@ -821,24 +821,6 @@ int glb_material(CompactGlb& g, const MeshGroup& group) {
 
 }  // namespace
 
-GlbLayout parse_glb_layout(std::string_view name) {
-  for (const GlbLayout l : {GlbLayout::Plain, GlbLayout::Instanced, GlbLayout::Compact})
-    if (name == glb_layout_name(l)) return l;
-  throw InputError(fmt::format("unknown glTF layout '{}' (expected plain, instanced or compact)", name));
-}
-
-std::string_view glb_layout_name(GlbLayout layout) {
-  switch (layout) {
-    case GlbLayout::Plain:
-      return "plain";
-    case GlbLayout::Instanced:
-      return "instanced";
-    case GlbLayout::Compact:
-      return "compact";
-  }
-  return "plain";
-}
-
 std::uint64_t write_glb(const std::string& path, const OutputMesh& m, GlbLayout layout, const Plant& plant,
                         const OrganShapes& shapes) {
   // Nothing to instance or compress, and glTF wants every buffer at least one byte long: a plant with no

@@ -21,6 +21,7 @@
 
 #include "algorithms/plant.hpp"
 #include "harness/output/mesher.hpp"
+#include "harness/record/trial_spec.hpp"
 
 namespace growbench {
 
@@ -64,11 +65,10 @@ Plant read_plant_snapshot(const std::string& path);
 //    KHR_mesh_quantization; a reader without EXT_mesh_gpu_instancing draws each organ shape once.
 //  - compact: instanced, with every buffer view compressed by meshoptimizer (EXT_meshopt_compression,
 //    required: the file holds no uncompressed copy).
-enum class GlbLayout { Plain, Instanced, Compact };
-inline constexpr GlbLayout kDefaultGlbLayout = GlbLayout::Compact;
-// "plain", "instanced", "compact"; InputError listing them for anything else.
-GlbLayout parse_glb_layout(std::string_view name);
-std::string_view glb_layout_name(GlbLayout layout);
+// (GlbLayout and its names are declared with the trial spec, harness/record/trial_spec.hpp.)
+constexpr std::string_view glb_layout_name(GlbLayout layout) {
+  return kGlbLayoutNames[static_cast<std::size_t>(layout)];
+}
 
 // Binary glTF 2.0 (.glb) in the plain layout: the JSON made by tinygltf, the binary chunk written as built.
 std::uint64_t write_glb(const std::string& path, const OutputMesh& mesh);

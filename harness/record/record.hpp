@@ -1,15 +1,17 @@
 // What the harness writes, declared once: a trial's record (record.json of `growbench run` and of a suite's
-// trial), the suite's journal lines and results file (results.json), its baseline, and a history file. Each
-// struct has one to_json and one from_json; every reader and writer of these files goes through them, in the
-// spirit of Google Benchmark's one `Run` record that each reporter serialises.
+// trial), the suite's journal lines and results file (results.json), its baseline, and a history file.
+//
+// Each struct lists its fields once, in fields() (harness/record/fields.hpp says what a declaration can
+// say). Everything else is derived from that list: to_json and from_json, merging a cell's results,
+// projecting a cell onto its baseline, the columns of results.csv, and results.schema.json beside this
+// file (results_schema(); a test fails while the committed file differs, `make schema` rewrites it). So a
+// field is added in one place, plus the code that computes it.
 //
 // Reading is tolerant of absence and strict about everything else. A field missing from the file reads as
 // its default (or as empty, for the std::optional members, whose absence means something: a failed sample
-// has no phases), so partial and hand-written files stay readable. A field of the wrong type, or one this
-// harness does not know (a renamed field), is an InputError naming the file and the JSON path:
-// "results.json: at trials[3].samples[0].phases.growth.wall_s: expected a number". What the suite always
-// writes is required by the JSON Schema beside this file (results.schema.json), which the tests and
-// reports/report.py check files against.
+// has no phases), so partial and hand-written files stay readable. A field of the wrong type, outside its
+// declared range, or one this harness does not know (a renamed field), is an InputError naming the file and
+// the JSON path: "results.json: at trials[3].samples[0].phases.growth.wall_s: expected a number".
 //
 // Open-ended parts stay JSON: algorithm parameters, metrics by name, sweep values, library versions.
 #pragma once
@@ -20,11 +22,16 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <tuple>
+#include <type_traits>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "core/outcome.hpp"
 #include "core/plugin_origin.hpp"
+#include "harness/record/fields.hpp"
+#include "harness/record/trial_spec.hpp"
 
 namespace growbench {
 
@@ -34,6 +41,36 @@ inline constexpr int kSchemaVersion = 1;
 inline constexpr std::string_view kResultsKind = "growbench-results";
 inline constexpr std::string_view kBaselineKind = "growbench-baseline";
 inline constexpr std::string_view kHistoryKind = "growbench-history";
+
+// The values some string fields take.
+inline constexpr std::array<std::string_view, 5> kStoppedBy = {"finished", "max_steps", "time_limit", "budget_nodes",
+                                                               "budget_length"};
+inline constexpr std::array<std::string_view, 3> kDirtyValues = {"true", "false", "unknown"};
+inline constexpr std::array<std::string_view, 2> kModes = {"timing", "instructions"};
+inline constexpr std::array<std::string_view, 4> kRenderStatuses = {"ok", "failed", "timeout", "no_povray"};
+inline constexpr std::array<std::string_view, 3> kAnimationStatuses = {"ok", "failed", "no_ffmpeg"};
+inline constexpr std::array<std::string_view, 2> kCameraUsed = {"scene", "fitted"};
+inline constexpr std::array<std::string_view, 2> kCameraAsked = {"auto", "scene"};
+inline constexpr std::array<std::string_view, 2> kBackdrops = {"scene", "studio"};
+// A trial's status in a suite (core/outcome.hpp), and a cell's, which is "pending" before it ran.
+inline constexpr auto kSampleStatuses = kTrialStatuses;
+inline constexpr auto kCellStatuses = [] {
+  std::array<std::string_view, kTrialStatuses.size() + 1> a{"pending"};
+  for (std::size_t i = 0; i < kTrialStatuses.size(); ++i) a[i + 1] = kTrialStatuses[i];
+  return a;
+}();
+
+// A record's fields, and its name in results.schema.json's $defs, for structs declared elsewhere.
+constexpr auto record_fields(std::type_identity<PluginOrigin>) {
+  using P = PluginOrigin;
+  return std::tuple{field("name", &P::name).with(kRequiredField), field("path", &P::path).with(kRequiredField),
+                    field("hash", &P::hash).with(kRequiredField),
+                    field("abi_version", &P::abi_version).with(kRequiredField).in(1, UINT32_MAX),
+                    field("version", &P::version)};
+}
+constexpr std::string_view record_schema_name(std::type_identity<PluginOrigin>) {
+  return "plugin";
+}
 
 // ---------------------------------------------------------------- a trial
 
@@ -49,29 +86,44 @@ struct PhaseMeasures {
   std::optional<double> voxel_size_m;
   // growth with --frames only: the frame capture's time, already taken out of wall_s and cpu_s.
   std::optional<double> frame_capture_wall_s, frame_capture_cpu_s;
+
+  static constexpr std::string_view kSchemaName = "phase";
+  static constexpr auto fields() {
+    using P = PhaseMeasures;
+    return std::tuple{field("wall_s", &P::wall_s),
+                      field("cpu_s", &P::cpu_s),
+                      field("peak_rss_bytes", &P::peak_rss_bytes),
+                      field("peak_rss_reset", &P::peak_rss_reset),
+                      field("alloc_count", &P::alloc_count),
+                      field("alloc_bytes", &P::alloc_bytes),
+                      field("bvh_s", &P::bvh_s),
+                      field("sdf_s", &P::sdf_s),
+                      field("sdf_active_voxels", &P::sdf_active_voxels),
+                      field("voxel_size_m", &P::voxel_size_m),
+                      field("frame_capture_wall_s", &P::frame_capture_wall_s),
+                      field("frame_capture_cpu_s", &P::frame_capture_cpu_s)};
+  }
 };
 
 // A trial's phases, each absent when it did not run (metrics with metrics off; all of them in a hand-written
-// sample). `exporting` is the JSON's "export" (a C++ keyword).
-struct Phases {
-  std::optional<PhaseMeasures> scene_load, query_build, growth, organs, meshing, exporting, metrics;
-  // The phase of that JSON name, or null (absent or unknown).
-  [[nodiscard]] const PhaseMeasures* find(std::string_view name) const;
-  [[nodiscard]] PhaseMeasures* find(std::string_view name);
-  // Calls f(name, measures) for each present phase in the order of their names, as the JSON holds them
-  // (sums over phases then add in the same order as before the record was typed).
-  template <class F>
-  void each(F&& f) const {
-    for (const std::string_view name : kNames)
-      if (const PhaseMeasures* p = find(name)) f(name, *p);
-  }
-  static constexpr std::array<std::string_view, 7> kNames = {"export", "growth",      "meshing",   "metrics",
-                                                             "organs", "query_build", "scene_load"};
-};
+// sample).
+using Phases = PhaseMap<PhaseMeasures>;
 
 struct Counts {
   std::uint64_t nodes = 0, segments = 0, leaves = 0, organs = 0, polygons = 0, mesh_vertices = 0, mesh_triangles = 0;
   friend bool operator==(const Counts&, const Counts&) = default;
+
+  static constexpr std::string_view kSchemaName = "counts";
+  static constexpr auto fields() {
+    using C = Counts;
+    return std::tuple{field("nodes", &C::nodes),
+                      field("segments", &C::segments),
+                      field("leaves", &C::leaves),
+                      field("organs", &C::organs),
+                      field("polygons", &C::polygons),
+                      field("mesh_vertices", &C::mesh_vertices),
+                      field("mesh_triangles", &C::mesh_triangles)};
+  }
 };
 
 // Bytes written per output format; empty when the trial wrote no files.
@@ -81,6 +133,23 @@ struct OutputBytes {
   std::optional<std::uint64_t> glb_plain;
   // The files only the algorithm makes (GrowthAlgorithm::write_outputs), by name; absent when none.
   std::map<std::string, std::uint64_t> algorithm_files;
+
+  static constexpr std::string_view kSchemaName = "output_bytes";
+  static constexpr auto fields() {
+    using O = OutputBytes;
+    return std::tuple{
+        field("obj", &O::obj),
+        field("ply", &O::ply),
+        field("glb", &O::glb),
+        field("glb_plain", &O::glb_plain),
+        field("skeleton_obj", &O::skeleton_obj),
+        field("skeleton_ply", &O::skeleton_ply),
+        field("algorithm_files", &O::algorithm_files)
+            .with(kOmitEmpty)
+            .refine(R"({"minProperties": 1, "propertyNames": {"minLength": 1}})")
+            .describe("bytes of each file only the algorithm makes (GrowthAlgorithm::write_outputs), by file "
+                      "name; absent when none")};
+  }
 };
 
 // The growth curve: a bounded number of points, thinned by doubling `every` (kCurveCap in harness/run/trial.cpp).
@@ -89,6 +158,13 @@ struct Curve {
   std::vector<int> step;
   std::vector<std::uint64_t> nodes, organs;
   std::vector<double> wall_s;
+
+  static constexpr std::string_view kSchemaName = "curve";
+  static constexpr auto fields() {
+    using C = Curve;
+    return std::tuple{field("every", &C::every).in(1, INT_MAX), field("step", &C::step).in(0, INT_MAX),
+                      field("nodes", &C::nodes), field("organs", &C::organs), field("wall_s", &C::wall_s)};
+  }
 };
 
 // The scene as the trial loaded it.
@@ -96,11 +172,25 @@ struct SceneInfo {
   std::string spec, name, hash;
   std::uint64_t triangles = 0, seeds = 0;
   std::vector<std::string> params;  // key=value
+
+  static constexpr std::string_view kSchemaName = "scene";
+  static constexpr auto fields() {
+    using S = SceneInfo;
+    return std::tuple{
+        field("spec", &S::spec),           field("name", &S::name),   field("hash", &S::hash).refine(kHashSchema),
+        field("triangles", &S::triangles), field("seeds", &S::seeds), field("params", &S::params)};
+  }
 };
 
 struct FramesInfo {
   int every = 0, count = 0;
   std::string dir;  // relative to the trial's directory
+
+  static constexpr std::string_view kSchemaName = "frames";
+  static constexpr auto fields() {
+    using F = FramesInfo;
+    return std::tuple{field("every", &F::every), field("count", &F::count), field("dir", &F::dir)};
+  }
 };
 
 // The build and machine a run used (run_context_record() in harness/run/trial.hpp).
@@ -118,6 +208,29 @@ struct RunContext {
   std::optional<bool> mixed_machines;  // merged shards that ran on different machines or builds
   // Every plugin loaded: a result says exactly what ran (absent when there were none).
   std::vector<PluginOrigin> plugins;
+
+  static constexpr std::string_view kSchemaName = "context";
+  static constexpr auto fields() {
+    using R = RunContext;
+    return std::tuple{
+        field("growbench_commit", &R::growbench_commit),
+        field("dirty", &R::dirty).one_of(kDirtyValues),
+        field("commit_time", &R::commit_time).with(kNullable),
+        field("configured_commit", &R::configured_commit),
+        field("build_type", &R::build_type),
+        field("compiler", &R::compiler),
+        field("cxx_flags", &R::cxx_flags),
+        field("binary_hash", &R::binary_hash),
+        field("cpu_model", &R::cpu_model),
+        field("hardware_threads", &R::hardware_threads),
+        field("date", &R::date),
+        field("alloc_counting", &R::alloc_counting),
+        field("dependencies", &R::dependencies).refine(R"({"additionalProperties": {"type": ["string", "number"]}})"),
+        field("suite_file_hash", &R::suite_file_hash).refine(kHashSchema),
+        field("parent_threads_at_fork", &R::parent_threads_at_fork),
+        field("mixed_machines", &R::mixed_machines),
+        field("plugins", &R::plugins).with(kOmitEmpty)};
+  }
 };
 
 // One render (growbench render): harness/render/render.hpp's RenderResult and how it was made. Paths are
@@ -138,6 +251,30 @@ struct RenderRecord {
   std::optional<std::string> camera, backdrop;
   std::optional<double> scene_extent;
   std::optional<bool> dof;
+
+  static constexpr std::string_view kSchemaName = "render";
+  static constexpr auto fields() {
+    using R = RenderRecord;
+    return std::tuple{field("status", &R::status).one_of(kRenderStatuses),
+                      field("message", &R::message),
+                      field("warnings", &R::warnings),
+                      field("png", &R::png),
+                      field("pov", &R::pov),
+                      field("log", &R::log),
+                      field("width", &R::width),
+                      field("height", &R::height),
+                      field("pov_bytes", &R::pov_bytes),
+                      field("write_s", &R::write_s),
+                      field("wall_s", &R::wall_s),
+                      field("cpu_s", &R::cpu_s),
+                      field("quality", &R::quality),
+                      field("branches", &R::branches),
+                      field("threads", &R::threads),
+                      field("camera", &R::camera).one_of(kCameraUsed),
+                      field("scene_extent", &R::scene_extent).in(0, kNoBound),
+                      field("backdrop", &R::backdrop).one_of(kBackdrops),
+                      field("dof", &R::dof)};
+  }
 };
 
 // The growth animation made from a trial's frames, or a turntable (the camera orbiting the plant).
@@ -146,113 +283,187 @@ struct AnimationRecord {
   std::uint64_t frames = 0;
   std::optional<std::string> frame_pattern, message, file;
   std::optional<std::uint64_t> bytes;
+
+  static constexpr std::string_view kSchemaName = "animation";
+  static constexpr auto fields() {
+    using A = AnimationRecord;
+    return std::tuple{field("status", &A::status).one_of(kAnimationStatuses),
+                      field("frames", &A::frames),
+                      field("frame_pattern", &A::frame_pattern),
+                      field("message", &A::message),
+                      field("file", &A::file),
+                      field("bytes", &A::bytes)};
+  }
 };
 
-// record.json: one trial (run_trial in harness/run/trial.hpp).
+// What `growbench render` made of a trial: written into the trial's record, or its cell.
+struct Media {
+  std::optional<RenderRecord> render;
+  std::optional<AnimationRecord> animation;
+  std::optional<AnimationRecord> turntable;  // growbench render --turntable N: turntable/frame_NNNN.png
+
+  static constexpr std::string_view kSchemaName = "media";
+  static constexpr auto fields() {
+    return std::tuple{field("render", &Media::render).with(kNoCsv), field("animation", &Media::animation).with(kNoCsv),
+                      field("turntable", &Media::turntable).with(kNoCsv)};
+  }
+};
+
 // The organ pass after growth (harness/organs/): its settings and what placement did.
 struct OrganPassRecord {
   nlohmann::json options = nlohmann::json::object();  // every organ option with its effective value
   std::uint64_t placed = 0, fallen_back = 0, dropped = 0;
+
+  static constexpr std::string_view kSchemaName = "organ_pass";
+  static constexpr auto fields() {
+    using O = OrganPassRecord;
+    return std::tuple{field("options", &O::options).with(kNoCsv), field("placed", &O::placed),
+                      field("fallen_back", &O::fallen_back), field("dropped", &O::dropped)};
+  }
 };
 
+// What a trial grew and what the plant measures: the same for every successful repetition of a cell, so a
+// suite keeps it once per cell. A trial's record and a cell's results both hold it, field for field.
+struct TrialResults {
+  std::string geometry_hash;
+  Counts counts;
+  OutputBytes output_bytes;
+  std::optional<nlohmann::json> metrics;  // by name (harness/output/metrics.hpp); absent with metrics off
+  double total_length_m = 0.0;
+  int steps = 0;
+  std::string stopped_by = "finished";  // kStoppedBy
+  Curve curve;
+  nlohmann::json params = nlohmann::json::object();  // the algorithm's effective parameters by name
+  std::map<std::string, double> algorithm_stats;
+  std::uint64_t threads = 0;              // the threads it ran with
+  std::optional<OrganPassRecord> organs;  // only when the pass ran (an organ option was given)
+
+  static constexpr std::string_view kSchemaName = "trial_results";
+  static constexpr auto fields() {
+    using T = TrialResults;
+    return std::tuple{field("geometry_hash", &T::geometry_hash).refine(kHashSchema),
+                      field("counts", &T::counts),
+                      field("output_bytes", &T::output_bytes),
+                      field("metrics", &T::metrics),
+                      field("total_length_m", &T::total_length_m),
+                      field("steps", &T::steps).in(0, INT_MAX),
+                      field("stopped_by", &T::stopped_by).one_of(kStoppedBy),
+                      field("curve", &T::curve).with(kNoCsv),
+                      field("params", &T::params).with(kNoCsv),
+                      field("algorithm_stats", &T::algorithm_stats),
+                      field("threads", &T::threads),
+                      field("organs", &T::organs)};
+  }
+};
+
+// record.json: one trial (run_trial in harness/run/trial.hpp).
 struct TrialRecord {
   int schema_version = kSchemaVersion;
   std::string status = "ok";
   std::string algorithm;
   std::uint64_t seed = 1;
-  std::uint64_t threads = 0;  // the threads it ran with
   int max_steps = 0;
+  TrialSpec spec;  // everything the trial was asked to do
   Phases phases;
   SceneInfo scene;
-  nlohmann::json params = nlohmann::json::object();  // the algorithm's effective parameters by name
   std::optional<std::string> leaf_obj;
-  std::optional<OrganPassRecord> organs;  // only when the pass ran (an organ option was given)
   std::optional<FramesInfo> frames;
-  int steps = 0;
-  std::string stopped_by;
-  Curve curve;
   std::optional<std::uint64_t> snapshot_bytes;  // plant.gbplant, when the trial wrote files
-  std::optional<nlohmann::json> metrics;        // by name (harness/output/metrics.hpp); absent with metrics off
-  Counts counts;
-  double total_length_m = 0.0;
-  OutputBytes output_bytes;
-  std::string geometry_hash;
-  std::map<std::string, double> algorithm_stats;
-  std::uint64_t peak_rss_bytes = 0;    // the whole process's, never reset
-  std::optional<RunContext> context;   // absent in a suite's trials (the suite records it once)
-  std::optional<RenderRecord> render;  // added by growbench render
-  std::optional<AnimationRecord> animation;
-  std::optional<AnimationRecord> turntable;  // growbench render --turntable N: turntable/frame_NNNN.png
-};
+  TrialResults results;
+  std::uint64_t peak_rss_bytes = 0;   // the whole process's, never reset
+  std::optional<RunContext> context;  // absent in a suite's trials (the suite records it once)
+  Media media;                        // added by growbench render
 
-// A trial as a suite hands it to its process and stores it in results (harness/run/trial.hpp's TrialSpec,
-// serialised).
-struct TrialSpecRecord {
-  std::string algorithm, scene;
-  std::vector<std::string> scene_params, params;  // key=value
-  std::uint64_t seed = 1;
-  std::vector<std::array<double, 3>> seed_at;
-  int max_steps = 5000;
-  double time_limit_s = 0.0;
-  int threads = 0;
-  double voxel_size = 0.0;
-  int sides = 6;
-  std::uint64_t budget_nodes = 0;
-  double budget_length_m = 0.0;
-  bool metrics = true;
-  int frame_every = 0;
-  std::string fault;
-  std::optional<std::string> leaf_obj;             // only when given: older specs stay as they were
-  std::optional<std::vector<std::string>> organs;  // --organ key=value; only when given
-  std::optional<std::string> glb;                  // --glb layout; only when not the default
-  // Only in the job a suite sends a trial's process (never in results).
-  std::optional<std::string> out_dir;
-  std::optional<bool> context, skip_teardown;
-  std::optional<std::vector<std::string>> plugins;  // every plugin the writing process had loaded
+  static constexpr std::string_view kSchemaName = "trial_record";
+  static constexpr auto fields() {
+    using T = TrialRecord;
+    return std::tuple{field("schema_version", &T::schema_version).with(kConstDefault),
+                      field("status", &T::status).with(kConstDefault),
+                      field("algorithm", &T::algorithm),
+                      field("seed", &T::seed),
+                      field("max_steps", &T::max_steps).in(0, INT_MAX),
+                      field("spec", &T::spec),
+                      field("phases", &T::phases),
+                      field("scene", &T::scene),
+                      field("leaf_obj", &T::leaf_obj),
+                      field("frames", &T::frames),
+                      field("snapshot_bytes", &T::snapshot_bytes),
+                      field("results", &T::results).with(kInline),
+                      field("peak_rss_bytes", &T::peak_rss_bytes),
+                      field("context", &T::context),
+                      field("media", &T::media).with(kInline)};
+  }
 };
 
 // ---------------------------------------------------------------- a suite
 
-using InstructionCounts = std::map<std::string, std::uint64_t>;  // phase -> instructions (callgrind)
+using InstructionCounts = PhaseMap<std::uint64_t>;  // instructions per phase (callgrind)
 
 struct AllocCount {
   std::uint64_t count = 0, bytes = 0;
+  friend bool operator==(const AllocCount&, const AllocCount&) = default;
+
+  static constexpr std::string_view kSchemaName = "alloc_count";
+  static constexpr auto fields() {
+    return std::tuple{field("count", &AllocCount::count), field("bytes", &AllocCount::bytes)};
+  }
 };
-using AllocByPhase = std::map<std::string, AllocCount>;
+using AllocByPhase = PhaseMap<AllocCount>;
 
 // One repetition of a cell (a journal line's "sample", an entry of a cell's "samples").
 struct SuiteSample {
   int repetition = 0;
-  std::string status;  // ok | crashed | timeout | out_of_memory | invalid_input
+  std::string status;  // kSampleStatuses
   std::optional<std::string> message;
   double child_wall_s = 0.0, child_user_s = 0.0, child_system_s = 0.0;
   std::uint64_t child_max_rss_bytes = 0;
   std::optional<Phases> phases;  // ok samples
   std::optional<int> steps;
+  // Ok samples: the plant this repetition grew, compared with the cell's first to catch nondeterminism.
+  std::optional<std::string> geometry_hash;
   std::optional<InstructionCounts> instructions;  // --instructions
   // Where the time outside the phases went (timing mode; harness/suite/suite.cpp).
   std::optional<double> outside_phases_s, launch_s, launch_fork_s, child_bookkeeping_s, teardown_s, parent_s,
       harness_overhead_s;
+
+  static constexpr std::string_view kSchemaName = "sample";
+  static constexpr auto fields() {
+    using S = SuiteSample;
+    return std::tuple{field("repetition", &S::repetition).in(0, INT_MAX),
+                      field("status", &S::status).one_of(kSampleStatuses),
+                      field("message", &S::message),
+                      field("child_wall_s", &S::child_wall_s),
+                      field("child_user_s", &S::child_user_s),
+                      field("child_system_s", &S::child_system_s),
+                      field("child_max_rss_bytes", &S::child_max_rss_bytes),
+                      field("phases", &S::phases).with(kWhenOk),
+                      field("steps", &S::steps).with(kWhenOk).in(0, INT_MAX),
+                      field("geometry_hash", &S::geometry_hash).refine(kHashSchema),
+                      field("instructions", &S::instructions),
+                      field("outside_phases_s", &S::outside_phases_s),
+                      field("launch_s", &S::launch_s),
+                      field("launch_fork_s", &S::launch_fork_s),
+                      field("child_bookkeeping_s", &S::child_bookkeeping_s),
+                      field("teardown_s", &S::teardown_s),
+                      field("parent_s", &S::parent_s),
+                      field("harness_overhead_s", &S::harness_overhead_s)};
+  }
 };
 
-// The per-cell fields, taken from the cell's first successful repetition. In a journal line after the first
-// success, only geometry_hash and counts (compared, to catch nondeterminism).
+// A cell's results, from its first successful repetition: what the plant is, and what the suite adds.
 struct CellResults {
-  std::optional<std::string> geometry_hash;
-  std::optional<Counts> counts;
-  std::optional<OutputBytes> output_bytes;
-  std::optional<nlohmann::json> metrics;  // by name
-  std::optional<double> total_length_m;
-  std::optional<int> steps;
-  std::optional<std::string> stopped_by;
-  std::optional<Curve> curve;
-  std::optional<nlohmann::json> params;  // by name
-  std::optional<std::map<std::string, double>> algorithm_stats;
-  std::optional<std::uint64_t> threads;
+  std::optional<TrialResults> plant;
   std::optional<std::string> scene_hash;
   std::optional<AllocByPhase> alloc;
   std::optional<InstructionCounts> instructions;
-  std::optional<OrganPassRecord> organs;  // the organ pass's counts, when it ran
+
+  static constexpr std::string_view kSchemaName = "cell_results";
+  static constexpr auto fields() {
+    using C = CellResults;
+    return std::tuple{field("plant", &C::plant).with(kInline | kWhenOk),
+                      field("scene_hash", &C::scene_hash).with(kWhenOk).refine(kHashSchema),
+                      field("alloc", &C::alloc).with(kWhenOk), field("instructions", &C::instructions)};
+  }
 };
 
 // A median and its distribution-free 95% interval (median_interval in harness/stats/stats.hpp).
@@ -260,18 +471,38 @@ struct MedianSummary {
   std::uint64_t n = 0;  // samples
   double median = 0.0, lo = 0.0, hi = 0.0;
   bool exact = false;  // false: fewer than 6 samples, [lo, hi] is the full range
+
+  static constexpr std::string_view kSchemaName = "median";
+  static constexpr auto fields() {
+    using M = MedianSummary;
+    return std::tuple{field("n", &M::n).in(1, kNoBound), field("median", &M::median), field("lo", &M::lo),
+                      field("hi", &M::hi), field("exact", &M::exact)};
+  }
+  static constexpr std::string_view kSchemaDoc =
+      "A median and its distribution-free 95% interval (harness/stats/stats.hpp median_interval); exact is false "
+      "below 6 samples, where [lo, hi] is the full range.";
 };
 
 // Statistics of a cell's ok repetitions, computed by the suite so that reports do not compute them again.
 struct CellSummary {
   std::optional<MedianSummary> growth_s;  // the growth phase's wall time
+
+  static constexpr std::string_view kSchemaName = "cell_summary";
+  static constexpr auto fields() { return std::tuple{field("growth_s", &CellSummary::growth_s)}; }
 };
 
 // A line of journal.jsonl: one finished repetition, durable before the next trial starts.
 struct JournalEntry {
   std::string id;
   SuiteSample sample;
-  std::optional<CellResults> cell;  // null unless the repetition succeeded
+  std::optional<CellResults> cell;  // the cell's results, with its first successful repetition; else null
+
+  static constexpr std::string_view kSchemaName = "journal_entry";
+  static constexpr auto fields() {
+    using J = JournalEntry;
+    return std::tuple{field("id", &J::id).with(kRequiredField), field("sample", &J::sample),
+                      field("cell", &J::cell).with(kNullable)};
+  }
 };
 
 // An entry of results.json "trials": one cell of the suite's matrix with its repetitions.
@@ -279,24 +510,54 @@ struct SuiteCell {
   std::string id, label, algorithm, scene, scene_spec;
   std::uint64_t seed = 1;
   nlohmann::json sweep = nlohmann::json::object();  // the swept parameters' values
-  TrialSpecRecord spec;
+  TrialSpec spec;
   std::string status = "pending";  // ok, or the last failed repetition's status
   std::optional<std::string> message;
   std::optional<bool> nondeterministic;  // two repetitions grew different plants
   std::vector<SuiteSample> samples;
   CellResults results;  // written into the cell's own object
   std::optional<CellSummary> summary;
-  std::optional<RenderRecord> render;
-  std::optional<AnimationRecord> animation;
-  std::optional<AnimationRecord> turntable;  // growbench render --turntable N: turntable/frame_NNNN.png
+  Media media;
+
+  static constexpr std::string_view kSchemaName = "cell";
+  static constexpr auto fields() {
+    using C = SuiteCell;
+    return std::tuple{field("id", &C::id).with(kRequiredField),
+                      field("label", &C::label),
+                      field("algorithm", &C::algorithm),
+                      field("scene", &C::scene),
+                      field("scene_spec", &C::scene_spec),
+                      field("seed", &C::seed),
+                      field("sweep", &C::sweep),
+                      field("spec", &C::spec).with(kNoCsv),
+                      field("status", &C::status).one_of(kCellStatuses),
+                      field("message", &C::message),
+                      field("nondeterministic", &C::nondeterministic),
+                      field("samples", &C::samples),
+                      field("results", &C::results).with(kInline),
+                      field("summary", &C::summary).with(kNoCsv),
+                      field("media", &C::media).with(kInline)};
+  }
 };
 
 struct SuiteInfo {
   std::string name, file, description;
+
+  static constexpr std::string_view kSchemaName = "suite";
+  static constexpr auto fields() {
+    return std::tuple{field("name", &SuiteInfo::name), field("file", &SuiteInfo::file),
+                      field("description", &SuiteInfo::description)};
+  }
 };
 
 struct ShardInfo {
   int index = 0, count = 1;
+
+  static constexpr std::string_view kSchemaName = "shard";
+  static constexpr auto fields() {
+    return std::tuple{field("index", &ShardInfo::index).in(0, INT_MAX),
+                      field("count", &ShardInfo::count).in(1, INT_MAX)};
+  }
 };
 
 // A merged file's record of one shard.
@@ -304,6 +565,12 @@ struct ShardRecord {
   int index = 0;
   std::string file;
   RunContext context;
+
+  static constexpr std::string_view kSchemaName = "shard_record";
+  static constexpr auto fields() {
+    return std::tuple{field("index", &ShardRecord::index).in(0, INT_MAX), field("file", &ShardRecord::file),
+                      field("context", &ShardRecord::context)};
+  }
 };
 
 // The renders of a results directory (growbench render).
@@ -317,6 +584,32 @@ struct RenderSummary {
   std::optional<std::string> camera, backdrop;                       // as asked: auto | scene, scene | studio
   std::optional<bool> dof;
   std::optional<std::uint64_t> turntable;  // frames per trial
+
+  static constexpr std::string_view kSchemaName = "render_summary";
+  static constexpr auto fields() {
+    using R = RenderSummary;
+    return std::tuple{field("quality", &R::quality),
+                      field("branches", &R::branches),
+                      field("width", &R::width),
+                      field("height", &R::height),
+                      field("povray", &R::povray),
+                      field("jobs", &R::jobs),
+                      field("threads_per_render", &R::threads_per_render),
+                      field("renders", &R::renders),
+                      field("ok", &R::ok),
+                      field("failed", &R::failed),
+                      field("warnings", &R::warnings),
+                      field("skipped_without_snapshot", &R::skipped_without_snapshot),
+                      field("povray_s", &R::povray_s),
+                      field("wall_s", &R::wall_s),
+                      field("grid", &R::grid),
+                      field("grid_error", &R::grid_error),
+                      field("grid_per_scene", &R::grid_per_scene),
+                      field("camera", &R::camera).one_of(kCameraAsked),
+                      field("backdrop", &R::backdrop).one_of(kBackdrops),
+                      field("dof", &R::dof),
+                      field("turntable", &R::turntable)};
+  }
 };
 
 // Growth time over the seeds of one algorithm entry (and sweep point) on one scene: the rows of the
@@ -326,10 +619,24 @@ struct PooledSummary {
   nlohmann::json sweep = nlohmann::json::object();
   std::vector<std::string> cells;  // the ok cells pooled
   MedianSummary growth_s;
+
+  static constexpr std::string_view kSchemaName = "pooled_summary";
+  static constexpr auto fields() {
+    using P = PooledSummary;
+    return std::tuple{field("label", &P::label), field("scene", &P::scene), field("sweep", &P::sweep),
+                      field("cells", &P::cells), field("growth_s", &P::growth_s)};
+  }
 };
 
 struct ResultsSummary {
   std::vector<PooledSummary> growth_s_over_seeds;
+
+  static constexpr std::string_view kSchemaName = "results_summary";
+  static constexpr auto fields() {
+    return std::tuple{field("growth_s_over_seeds", &ResultsSummary::growth_s_over_seeds)
+                          .describe("Per algorithm entry (and sweep point) and scene: the growth time of every ok "
+                                    "repetition of its ok cells (one per seed), pooled.")};
+  }
 };
 
 // results.json.
@@ -346,6 +653,23 @@ struct ResultsFile {
   std::optional<std::vector<ShardRecord>> shards;  // merged files
   std::optional<RenderSummary> renders;
   std::optional<ResultsSummary> summary;
+
+  static constexpr std::string_view kSchemaName = "results";
+  static constexpr auto fields() {
+    using R = ResultsFile;
+    return std::tuple{field("schema_version", &R::schema_version).with(kConstDefault),
+                      field("kind", &R::kind).with(kRequiredField | kConstDefault),
+                      field("mode", &R::mode).one_of(kModes),
+                      field("suite", &R::suite),
+                      field("suite_hash", &R::suite_hash).refine(kHashSchema),
+                      field("repetitions", &R::repetitions).in(1, INT_MAX),
+                      field("shard", &R::shard),
+                      field("context", &R::context),
+                      field("trials", &R::trials).with(kRequiredField),
+                      field("shards", &R::shards),
+                      field("renders", &R::renders),
+                      field("summary", &R::summary)};
+  }
 };
 
 // ---------------------------------------------------------------- the gate and the history
@@ -353,9 +677,22 @@ struct ResultsFile {
 struct BaselineContext {
   std::string growbench_commit, dirty, compiler, cxx_flags, build_type;
   nlohmann::json dependencies = nlohmann::json::object();
+
+  static constexpr std::string_view kSchemaName = "baseline_context";
+  static constexpr auto fields() {
+    using B = BaselineContext;
+    return std::tuple{
+        field("growbench_commit", &B::growbench_commit),
+        field("dirty", &B::dirty).one_of(kDirtyValues),
+        field("compiler", &B::compiler),
+        field("cxx_flags", &B::cxx_flags),
+        field("build_type", &B::build_type),
+        field("dependencies", &B::dependencies).refine(R"({"additionalProperties": {"type": ["string", "number"]}})")};
+  }
 };
 
-// A cell as a baseline keeps it: what the regression gate compares, no timings.
+// A cell as a baseline keeps it: what the regression gate compares, no timings. Each field is the cell's
+// field of the same key (project() in harness/record/reflect.hpp copies them).
 struct BaselineCell {
   std::string id, label, algorithm, scene;
   std::uint64_t seed = 1;
@@ -367,6 +704,24 @@ struct BaselineCell {
   std::optional<OutputBytes> output_bytes;
   std::optional<AllocByPhase> alloc;
   std::optional<InstructionCounts> instructions;
+
+  static constexpr std::string_view kSchemaName = "baseline_cell";
+  static constexpr auto fields() {
+    using B = BaselineCell;
+    return std::tuple{field("id", &B::id).with(kRequiredField),
+                      field("label", &B::label),
+                      field("algorithm", &B::algorithm),
+                      field("scene", &B::scene),
+                      field("seed", &B::seed),
+                      field("status", &B::status).one_of(kCellStatuses),
+                      field("threads", &B::threads),
+                      field("geometry_hash", &B::geometry_hash).refine(kHashSchema),
+                      field("counts", &B::counts),
+                      field("metrics", &B::metrics),
+                      field("output_bytes", &B::output_bytes),
+                      field("alloc", &B::alloc),
+                      field("instructions", &B::instructions)};
+  }
 };
 
 // reports/baselines/*.json.
@@ -378,6 +733,18 @@ struct Baseline {
   std::string suite_hash;
   BaselineContext context;
   std::vector<BaselineCell> trials;
+
+  static constexpr std::string_view kSchemaName = "baseline";
+  static constexpr auto fields() {
+    using B = Baseline;
+    return std::tuple{field("schema_version", &B::schema_version).with(kConstDefault),
+                      field("kind", &B::kind).with(kRequiredField | kConstDefault),
+                      field("mode", &B::mode).one_of(kModes),
+                      field("suite", &B::suite),
+                      field("suite_hash", &B::suite_hash).refine(kHashSchema),
+                      field("context", &B::context),
+                      field("trials", &B::trials).with(kRequiredField)};
+  }
 };
 
 // A cell of one run in a history file: medians over its ok repetitions (harness/gate/history.hpp).
@@ -389,11 +756,35 @@ struct HistoryCell {
   std::optional<double> total_wall_s, growth_wall_s, growth_cpu_s, growth_peak_rss_bytes;
   std::optional<std::uint64_t> total_wall_s_n, growth_wall_s_n, growth_cpu_s_n, growth_peak_rss_bytes_n;
   std::optional<InstructionCounts> instructions;
+
+  static constexpr std::string_view kSchemaName = "history_cell";
+  static constexpr auto fields() {
+    using H = HistoryCell;
+    return std::tuple{field("status", &H::status),
+                      field("geometry_hash", &H::geometry_hash),
+                      field("nodes", &H::nodes),
+                      field("total_wall_s", &H::total_wall_s),
+                      field("total_wall_s_n", &H::total_wall_s_n),
+                      field("growth_wall_s", &H::growth_wall_s),
+                      field("growth_wall_s_n", &H::growth_wall_s_n),
+                      field("growth_cpu_s", &H::growth_cpu_s),
+                      field("growth_cpu_s_n", &H::growth_cpu_s_n),
+                      field("growth_peak_rss_bytes", &H::growth_peak_rss_bytes),
+                      field("growth_peak_rss_bytes_n", &H::growth_peak_rss_bytes_n),
+                      field("instructions", &H::instructions)};
+  }
 };
 
 struct HistoryRun {
   std::string date, mode, dirty, build_type;
   std::map<std::string, HistoryCell> cells;  // by cell id
+
+  static constexpr std::string_view kSchemaName = "history_run";
+  static constexpr auto fields() {
+    using H = HistoryRun;
+    return std::tuple{field("date", &H::date), field("mode", &H::mode), field("dirty", &H::dirty),
+                      field("build_type", &H::build_type), field("cells", &H::cells)};
+  }
 };
 
 // DIR/MACHINE/SUITE/COMMIT.json.
@@ -405,48 +796,57 @@ struct HistoryFile {
   std::string machine, cpu_model, suite;
   std::uint64_t hardware_threads = 0;
   std::vector<HistoryRun> runs;
+
+  static constexpr std::string_view kSchemaName = "history";
+  static constexpr auto fields() {
+    using H = HistoryFile;
+    return std::tuple{field("kind", &H::kind).with(kRequiredField | kConstDefault),
+                      field("schema_version", &H::schema_version).with(kConstDefault),
+                      field("commit", &H::commit),
+                      field("commit_time", &H::commit_time).with(kNullable),
+                      field("machine", &H::machine),
+                      field("cpu_model", &H::cpu_model),
+                      field("hardware_threads", &H::hardware_threads),
+                      field("suite", &H::suite),
+                      field("runs", &H::runs)};
+  }
 };
 
 // ---------------------------------------------------------------- serialising
 
-nlohmann::json to_json(const PhaseMeasures& v);
-nlohmann::json to_json(const Phases& v);
-nlohmann::json to_json(const Counts& v);
-nlohmann::json to_json(const OutputBytes& v);
-nlohmann::json to_json(const Curve& v);
-nlohmann::json to_json(const SceneInfo& v);
-nlohmann::json to_json(const FramesInfo& v);
-nlohmann::json to_json(const OrganPassRecord& v);
-nlohmann::json to_json(const RunContext& v);
-nlohmann::json to_json(const RenderRecord& v);
-nlohmann::json to_json(const AnimationRecord& v);
-nlohmann::json to_json(const TrialRecord& v);
-nlohmann::json to_json(const TrialSpecRecord& v);
-nlohmann::json to_json(const AllocCount& v);
-nlohmann::json to_json(const SuiteSample& v);
-nlohmann::json to_json(const CellResults& v);
-nlohmann::json to_json(const MedianSummary& v);
-nlohmann::json to_json(const CellSummary& v);
-nlohmann::json to_json(const JournalEntry& v);
-nlohmann::json to_json(const SuiteCell& v);
-nlohmann::json to_json(const SuiteInfo& v);
-nlohmann::json to_json(const ShardInfo& v);
-nlohmann::json to_json(const ShardRecord& v);
-nlohmann::json to_json(const RenderSummary& v);
-nlohmann::json to_json(const PooledSummary& v);
-nlohmann::json to_json(const ResultsSummary& v);
-nlohmann::json to_json(const ResultsFile& v);
-nlohmann::json to_json(const BaselineContext& v);
-nlohmann::json to_json(const BaselineCell& v);
-nlohmann::json to_json(const Baseline& v);
-nlohmann::json to_json(const HistoryCell& v);
-nlohmann::json to_json(const HistoryRun& v);
-nlohmann::json to_json(const HistoryFile& v);
-
-// T from JSON read from `source` (a file name, for errors). Throws InputError "SOURCE: at PATH: WHAT" for a
-// value of the wrong type or an unknown field. Defined for every struct above.
-template <class T>
+// Every struct above (and TrialSpec, PluginOrigin) as JSON, and back: T from JSON read from `source` (a file
+// name, for errors). Throws InputError "SOURCE: at PATH: WHAT" for a value of the wrong type, outside its
+// range, or an unknown field.
+template <Declared T>
+nlohmann::json to_json(const T& v);
+template <Declared T>
 T from_json(const nlohmann::json& j, const std::string& source);
+// Phases, allocations and instructions by phase.
+template <class T>
+nlohmann::json to_json(const PhaseMap<T>& v);
+
+// Reads `j` into the TrialSpec field declared under `key`, with its type, range and names: how a suite file's
+// settings are checked as the command line's are. InputError "SOURCE: at PATH: WHAT".
+void read_spec_field(TrialSpec& spec, std::string_view key, const nlohmann::json& j, const std::string& source,
+                     const std::string& path);
+
+// InputError "the trial spec: KEY: WHAT" for the first setting outside its declared range: a spec made in
+// code is held to what the command line and suite files are.
+void check_trial_spec(const TrialSpec& spec);
+
+// results.schema.json as this binary declares it (its $defs also describe record.json, the baseline, the
+// journal and history files).
+nlohmann::json results_schema();
+
+// The column names of results.csv, and its rows: one per repetition, the cell's fields and then the
+// sample's, each a dotted JSON path ("counts.nodes", "sample.phases.growth.wall_s").
+std::string results_csv(const ResultsFile& results);
+
+// The cell as its baseline keeps it.
+BaselineCell baseline_cell_of(const SuiteCell& cell);
+
+// Every present field of `from` into `to` (the results of a cell's first successful repetition).
+void take_present(CellResults& to, const CellResults& from);
 
 // ---------------------------------------------------------------- the files
 

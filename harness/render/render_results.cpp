@@ -289,24 +289,10 @@ struct RenderTargets {
   ResultsFile* results = nullptr;                  // a suite
   TrialRecord* record = nullptr;                   // a run
   std::map<std::string, std::size_t> trial_index;  // id -> index in results->trials
-  void set(const std::string& key, RenderRecord r) {
-    if (results)
-      results->trials[trial_index.at(key)].render = std::move(r);
-    else
-      record->render = std::move(r);
-  }
-  void set(const std::string& key, AnimationRecord a) {
-    if (results)
-      results->trials[trial_index.at(key)].animation = std::move(a);
-    else
-      record->animation = std::move(a);
-  }
-  void set_turntable(const std::string& key, AnimationRecord a) {
-    if (results)
-      results->trials[trial_index.at(key)].turntable = std::move(a);
-    else
-      record->turntable = std::move(a);
-  }
+  Media& media(const std::string& key) { return results ? results->trials[trial_index.at(key)].media : record->media; }
+  void set(const std::string& key, RenderRecord r) { media(key).render = std::move(r); }
+  void set(const std::string& key, AnimationRecord a) { media(key).animation = std::move(a); }
+  void set_turntable(const std::string& key, AnimationRecord a) { media(key).turntable = std::move(a); }
 };
 
 // The frames of one kind (growth or turntable) per trial, and the first failure among them.
@@ -391,12 +377,12 @@ void write_grids(const ResultsFile& doc, const fs::path& dir, const RenderOption
     const SuiteCell& t = *it->second;
     if (t.status != "ok")
       note = t.status;
-    else if (!t.render)
+    else if (!t.media.render)
       note = "no snapshot";
-    else if (t.render->status != "ok")
-      note = "render " + t.render->status;
+    else if (t.media.render->status != "ok")
+      note = "render " + t.media.render->status;
     else
-      return (dir / t.render->png).string();
+      return (dir / t.media.render->png).string();
     return std::string();
   };
   std::vector<std::vector<std::string>> cells(rows.size(), std::vector<std::string>(cols.size()));
@@ -449,7 +435,7 @@ RenderSummary render_directory_record(const std::string& dir_arg, const RenderDi
       const SuiteCell& t = results.trials[i];
       targets.trial_index[t.id] = i;
       if (!add_trial(jobs, t.id, dir / "trials" / t.id, t.spec.scene.empty() ? t.scene_spec : t.spec.scene,
-                     t.spec.scene_params, t.spec.leaf_obj.value_or(""), o.turntable))
+                     t.spec.scene_params, t.spec.leaf_obj, o.turntable))
         ++skipped;
     }
   } else {

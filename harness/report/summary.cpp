@@ -43,11 +43,11 @@ std::string cell_row(const SuiteCell& t, std::vector<std::string>& warnings) {
   std::vector<double> growth, total, rss;
   for (const auto& s : t.samples) {
     if (s.status != "ok" || !s.phases) continue;
-    const PhaseMeasures& g = s.phases->growth.value();
+    const PhaseMeasures& g = s.phases->at[static_cast<std::size_t>(Phase::growth)].value();
     growth.push_back(g.wall_s);
     double tot = 0.0;
-    s.phases->each([&](std::string_view k, const PhaseMeasures& v) {
-      if (k != "metrics") tot += v.wall_s;
+    s.phases->each([&](Phase p, const PhaseMeasures& v) {
+      if (p != Phase::metrics) tot += v.wall_s;
     });
     total.push_back(tot);
     rss.push_back(static_cast<double>(g.peak_rss_bytes));
@@ -58,18 +58,18 @@ std::string cell_row(const SuiteCell& t, std::vector<std::string>& warnings) {
   const std::string ci = growth.empty() ? "-"
                                         : fmt::format("{} [{}{}, {}]", format_seconds(med), exact ? "" : "~",
                                                       format_seconds(lo), format_seconds(hi));
-  const CellResults& r = t.results;
-  const json m = r.metrics.value_or(json::object());
+  const std::optional<TrialResults>& r = t.results.plant;
+  const json m = r && r->metrics ? *r->metrics : json::object();
   auto metric = [&](const char* k) {
     // Metrics are open-ended in the file: a value that is not a number (a hand-edited file) shows as such.
     return !m.contains(k) ? std::string("-") : m[k].is_number() ? fmt::format("{:.3f}", m[k].get<double>()) : "?";
   };
-  std::string row = fmt::format(
-      "{:<40} {:>6} {:>30} {:>10} {:>11} {:>8} {:>9} {:>10} {:>8} {:>8} {:>8}\n", cell.substr(0, 40), t.status, ci,
-      format_seconds(median(total)), si_bytes(median(rss)), r.counts ? std::to_string(r.counts->nodes) : "-",
-      r.total_length_m ? fmt::format("{:.2f}", *r.total_length_m) : "-",
-      r.output_bytes && r.output_bytes->ply ? si_bytes(static_cast<double>(*r.output_bytes->ply)) : "-",
-      metric("coverage"), metric("attached_fraction"), metric("penetration_nodes"));
+  std::string row =
+      fmt::format("{:<40} {:>6} {:>30} {:>10} {:>11} {:>8} {:>9} {:>10} {:>8} {:>8} {:>8}\n", cell.substr(0, 40),
+                  t.status, ci, format_seconds(median(total)), si_bytes(median(rss)),
+                  r ? std::to_string(r->counts.nodes) : "-", r ? fmt::format("{:.2f}", r->total_length_m) : "-",
+                  r && r->output_bytes.ply ? si_bytes(static_cast<double>(*r->output_bytes.ply)) : "-",
+                  metric("coverage"), metric("attached_fraction"), metric("penetration_nodes"));
   if (growth.size() >= 2) {
     double mean = 0.0, var = 0.0;
     for (const double g : growth) mean += g;

@@ -95,13 +95,15 @@ bool reset_peak_rss() {
 class PhaseTimer {
  public:
   template <class F>
-  auto run(const char* name, std::optional<PhaseMeasures>& slot, F&& f) {
+  auto run(Phase phase, Phases& phases, F&& f) {
+    std::optional<PhaseMeasures>& slot = phases[phase];
+    const char* name = phase_name(phase).data();  // a literal's: null-terminated
     const bool reset = reset_peak_rss();
     // Under callgrind (`growbench suite --instructions`, which starts with instrumentation off) each
     // phase is instrumented and dumped on its own; natively these are a few no-op instructions. The
     // query build (OpenVDB's level set and Embree's BVH, the same for every algorithm) is left
     // uninstrumented: under callgrind's slowdown it would take most of the gate's time.
-    const bool instrument = std::strcmp(name, "query_build") != 0;
+    const bool instrument = phase != Phase::query_build;
     if (instrument) {
       CALLGRIND_ZERO_STATS;
       CALLGRIND_START_INSTRUMENTATION;
@@ -223,6 +225,11 @@ bool is_out_of_memory(const std::exception& e) {
          what.find(fmt::format("(error {})", static_cast<int>(RTC_ERROR_OUT_OF_MEMORY))) != std::string_view::npos;
 }
 
+Outcome outcome_of(const std::exception& e) {
+  if (dynamic_cast<const InputError*>(&e)) return Outcome::invalid_input;
+  return is_out_of_memory(e) ? Outcome::out_of_memory : Outcome::failed;
+}
+
 // The running binary's content hash: what identifies the build whose timings these are, whatever the
 // source tree's state is by the time it runs (a commit made while a sharded run is under way).
 std::string binary_hash() {
@@ -272,79 +279,21 @@ nlohmann::json run_context() {
   return to_json(run_context_record());
 }
 
-TrialSpecRecord to_record(const TrialSpec& s) {
-  TrialSpecRecord r;
-  r.algorithm = s.algorithm;
-  r.scene = s.scene;
-  r.scene_params = s.scene_params;
-  r.params = s.params;
-  r.seed = s.seed;
-  for (const auto& p : s.seed_at) r.seed_at.push_back({p.x, p.y, p.z});
-  r.max_steps = s.max_steps;
-  r.time_limit_s = s.time_limit_s;
-  r.threads = s.threads;
-  r.voxel_size = s.voxel_size;
-  r.sides = s.mesher.sides;
-  r.budget_nodes = s.budget_nodes;
-  r.budget_length_m = s.budget_length_m;
-  r.metrics = s.metrics;
-  r.frame_every = s.frame_every;
-  r.fault = s.fault;
-  if (!s.mesher.leaf_obj.empty()) r.leaf_obj = s.mesher.leaf_obj;
-  if (!s.organs.empty()) r.organs = s.organs;
-  if (s.glb != kDefaultGlbLayout) r.glb = std::string(glb_layout_name(s.glb));
-  return r;
-}
-
-TrialSpec trial_spec_of(const TrialSpecRecord& r) {
-  TrialSpec s;
-  s.algorithm = r.algorithm;
-  s.scene = r.scene;
-  s.scene_params = r.scene_params;
-  s.params = r.params;
-  s.seed = r.seed;
-  for (const auto& p : r.seed_at)
-    s.seed_at.emplace_back(static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2]));
-  s.max_steps = r.max_steps;
-  s.time_limit_s = r.time_limit_s;
-  s.threads = r.threads;
-  s.voxel_size = static_cast<float>(r.voxel_size);
-  s.mesher.sides = r.sides;
-  s.mesher.leaf_obj = r.leaf_obj.value_or("");
-  s.organs = r.organs.value_or(std::vector<std::string>{});
-  if (r.glb) s.glb = parse_glb_layout(*r.glb);
-  s.budget_nodes = r.budget_nodes;
-  s.budget_length_m = r.budget_length_m;
-  s.metrics = r.metrics;
-  s.frame_every = r.frame_every;
-  s.out_dir = r.out_dir.value_or("");
-  s.context = r.context.value_or(true);
-  s.skip_teardown = r.skip_teardown.value_or(false);
-  s.fault = r.fault;
-  s.plugins = r.plugins.value_or(std::vector<std::string>{});
-  return s;
-}
-
-nlohmann::json to_json(const TrialSpec& s) {
-  return to_json(to_record(s));
-}
-
 TrialSpec trial_spec_from_json(const nlohmann::json& j) {
-  return trial_spec_of(from_json<TrialSpecRecord>(j, "the trial spec"));
+  return from_json<TrialSpec>(j, "the trial spec");
 }
 
 TrialSpec read_trial_spec(const std::string& path) {
-  return trial_spec_of(from_json<TrialSpecRecord>(read_json_file(path), path));
+  return from_json<TrialSpec>(read_json_file(path), path);
 }
 
 namespace {
 
 // The algorithm's effective parameters; InputError for bad input, before anything is loaded or grown.
 Params checked_params(const TrialSpec& spec, const AlgorithmEntry& entry) {
+  check_trial_spec(spec);
   Params params = default_params(entry);
   for (const auto& a : spec.params) params.set_assignment(a);
-  if (spec.max_steps < 0) throw InputError(fmt::format("--max-steps must be >= 0, got {}", spec.max_steps));
-  if (spec.frame_every < 0) throw InputError(fmt::format("--frames must be >= 0, got {}", spec.frame_every));
   if (spec.frame_every > 0 && spec.out_dir.empty()) throw InputError("--frames needs an output directory");
   return params;
 }
@@ -362,23 +311,23 @@ struct TrialState {
 // Scene load includes the algorithm's own input files (its load_inputs).
 void load_scene_and_query(const TrialSpec& spec, const Params& params, TrialState& st, PhaseTimer& timer,
                           TrialRecord& rec) {
-  st.scene = timer.run("scene_load", rec.phases.scene_load, [&] {
+  st.scene = timer.run(Phase::scene_load, rec.phases, [&] {
     Scene scene = load_scene(spec.scene, spec.scene_params);
     st.algo->load_inputs(params);
     return scene;
   });
   SceneQueryOptions qo;
-  qo.voxel_size = spec.voxel_size;
-  st.query =
-      timer.run("query_build", rec.phases.query_build, [&] { return std::make_unique<SceneQuery>(st.scene, qo); });
-  PhaseMeasures& q = *rec.phases.query_build;
+  qo.voxel_size = static_cast<float>(spec.voxel_size);
+  st.query = timer.run(Phase::query_build, rec.phases, [&] { return std::make_unique<SceneQuery>(st.scene, qo); });
+  PhaseMeasures& q = *rec.phases[Phase::query_build];
   q.bvh_s = st.query->bvh_build_seconds();
   q.sdf_s = st.query->sdf_build_seconds();
   q.sdf_active_voxels = st.query->sdf_active_voxels();
   q.voxel_size_m = st.query->voxel_size();
   if (!spec.seed_at.empty()) {
     st.scene.seeds.clear();
-    for (const auto& p : spec.seed_at) {
+    for (const auto& a : spec.seed_at) {
+      const glm::vec3 p(static_cast<float>(a[0]), static_cast<float>(a[1]), static_cast<float>(a[2]));
       const ClosestHit h = st.query->closest_point(p);
       st.scene.seeds.push_back({h.found ? h.point : p, {0, 1, 0}, 0});
     }
@@ -439,7 +388,7 @@ void grow(const TrialSpec& spec, const Params& params, TrialState& st, PhaseTime
   std::string stopped_by = "finished";
   CurveSampler curve;
   FrameCapture frames{spec};
-  timer.run("growth", rec.phases.growth, [&] {
+  timer.run(Phase::growth, rec.phases, [&] {
     inject_fault(spec.fault);
     if (spec.time_limit_s > 0.0)
       algo.set_deadline(std::chrono::steady_clock::now() +
@@ -478,16 +427,16 @@ void grow(const TrialSpec& spec, const Params& params, TrialState& st, PhaseTime
     frames.capture(steps, algo);
   });
   if (spec.frame_every > 0) {
-    PhaseMeasures& g = *rec.phases.growth;
+    PhaseMeasures& g = *rec.phases[Phase::growth];
     g.wall_s -= frames.wall_s;
     g.cpu_s -= frames.cpu_s;
     g.frame_capture_wall_s = frames.wall_s;
     g.frame_capture_cpu_s = frames.cpu_s;
     rec.frames = FramesInfo{spec.frame_every, frames.frames, "frames"};
   }
-  rec.steps = steps;
-  rec.stopped_by = stopped_by;
-  rec.curve = std::move(curve.curve);
+  rec.results.steps = steps;
+  rec.results.stopped_by = stopped_by;
+  rec.results.curve = std::move(curve.curve);
 }
 
 // The meshing, export and metrics phases, then what the plant and its mesh hold.
@@ -500,35 +449,37 @@ void mesh_export_measure(const TrialSpec& spec, const MesherOptions& mesher, Tri
     make_directories(spec.out_dir);
     rec.snapshot_bytes = write_plant_snapshot((std::filesystem::path(spec.out_dir) / "plant.gbplant").string(), plant);
   }
-  st.mesh = timer.run("meshing", rec.phases.meshing, [&] { return mesh_plant(plant, mesher); });
-  timer.run("export", rec.phases.exporting, [&] {
+  TrialResults& out = rec.results;
+  st.mesh = timer.run(Phase::meshing, rec.phases, [&] { return mesh_plant(plant, mesher); });
+  timer.run(Phase::exporting, rec.phases, [&] {
     if (spec.out_dir.empty()) return;
     make_directories(spec.out_dir);
     const std::filesystem::path d(spec.out_dir);
-    rec.output_bytes.obj = write_obj((d / "plant.obj").string(), st.mesh);
-    rec.output_bytes.ply = write_ply((d / "plant.ply").string(), st.mesh);
-    rec.output_bytes.glb = write_glb((d / "plant.glb").string(), st.mesh, spec.glb, plant, organ_shapes(plant, mesher));
-    rec.output_bytes.glb_plain = spec.glb == GlbLayout::Plain ? *rec.output_bytes.glb : plain_glb_bytes(st.mesh);
-    rec.output_bytes.skeleton_obj = write_skeleton_obj((d / "skeleton.obj").string(), plant);
-    rec.output_bytes.skeleton_ply = write_skeleton_ply((d / "skeleton.ply").string(), plant);
+    OutputBytes& b = out.output_bytes;
+    b.obj = write_obj((d / "plant.obj").string(), st.mesh);
+    b.ply = write_ply((d / "plant.ply").string(), st.mesh);
+    b.glb = write_glb((d / "plant.glb").string(), st.mesh, spec.glb, plant, organ_shapes(plant, mesher));
+    b.glb_plain = spec.glb == GlbLayout::Plain ? *b.glb : plain_glb_bytes(st.mesh);
+    b.skeleton_obj = write_skeleton_obj((d / "skeleton.obj").string(), plant);
+    b.skeleton_ply = write_skeleton_ply((d / "skeleton.ply").string(), plant);
     for (const auto& f : algorithm_outputs(*st.algo, plant, {d.string(), "", false}))
-      rec.output_bytes.algorithm_files[f.name] = f.bytes;
+      b.algorithm_files[f.name] = f.bytes;
   });
   if (spec.metrics) {
     MetricOptions metric_options;
     metric_options.custom_leaf = mesher.leaf;
-    rec.metrics =
-        timer.run("metrics", rec.phases.metrics, [&] { return compute_metrics(plant, *st.query, metric_options); });
+    out.metrics =
+        timer.run(Phase::metrics, rec.phases, [&] { return compute_metrics(plant, *st.query, metric_options); });
   }
   std::size_t segments = 0;
   for (const auto& n : plant.nodes) segments += n.parent != kNoParent ? 1 : 0;
-  rec.counts = {plant.nodes.size(),      segments,
+  out.counts = {plant.nodes.size(),      segments,
                 plant.leaf_count(),      plant.organs.size(),
                 plant.polygons.size(),   st.mesh.positions.size(),
                 st.mesh.triangles.size()};
-  rec.total_length_m = plant.total_length();
-  rec.geometry_hash = plant.geometry_hash();
-  for (const auto& [k, v] : st.algo->stats()) rec.algorithm_stats[k] = v;
+  out.total_length_m = plant.total_length();
+  out.geometry_hash = plant.geometry_hash();
+  for (const auto& [k, v] : st.algo->stats()) out.algorithm_stats[k] = v;
 }
 
 // The organ pass (variation, then placement) on a copy of the grown plant, when an option asks for it.
@@ -537,7 +488,7 @@ void organ_pass(const TrialSpec& spec, const OrganOptions& options, const Params
   if (spec.organs.empty()) return;
   OrganPassRecord out;
   out.options = given.to_json();
-  timer.run("organs", rec.phases.organs, [&] {
+  timer.run(Phase::organs, rec.phases, [&] {
     st.styled = st.algo->plant();
     vary_organs(*st.styled, options, spec.seed);
     const PlacementCounts c = place_organs(*st.styled, options, mesher.leaf.get());
@@ -545,7 +496,7 @@ void organ_pass(const TrialSpec& spec, const OrganOptions& options, const Params
     out.fallen_back = c.fallen_back;
     out.dropped = c.dropped;
   });
-  rec.organs = std::move(out);
+  rec.results.organs = std::move(out);
 }
 
 }  // namespace
@@ -556,7 +507,10 @@ TrialRecord run_trial_record(const TrialSpec& spec, const std::function<void(con
   const AlgorithmEntry& entry = find_algorithm(spec.algorithm);
   const Params params = checked_params(spec, entry);
   // A custom leaf is read first: a bad file is invalid input before anything is grown.
-  const MesherOptions mesher = with_leaf_mesh(spec.mesher);
+  MesherOptions mesher_options;
+  mesher_options.sides = spec.sides;
+  mesher_options.leaf_obj = spec.leaf_obj;
+  const MesherOptions mesher = with_leaf_mesh(mesher_options);
   Params organ_params;
   const OrganOptions organ_options = read_organ_options(spec.organs, &organ_params);
   std::unique_ptr<tbb::global_control> threads;
@@ -567,26 +521,22 @@ TrialRecord run_trial_record(const TrialSpec& spec, const std::function<void(con
   TrialRecord rec;
   rec.algorithm = spec.algorithm;
   rec.seed = spec.seed;
-  rec.threads = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
   rec.max_steps = spec.max_steps;
+  rec.spec = spec;
+  rec.results.threads = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
   PhaseTimer timer;
   TrialState st;
   st.algo = entry.make();
   load_scene_and_query(spec, params, st, timer, rec);
-  rec.params = params.to_json();
-  if (!spec.mesher.leaf_obj.empty()) rec.leaf_obj = spec.mesher.leaf_obj;
+  rec.results.params = params.to_json();
+  if (!spec.leaf_obj.empty()) rec.leaf_obj = spec.leaf_obj;
 
   grow(spec, params, st, timer, rec, progress);
   const Plant& plant = st.algo->plant();
-  if (const std::string bad = plant.validate(); !bad.empty()) {
-    // An L-system's grammar is a program in the input, whose arithmetic can divide by zero or overflow: its
-    // invalid plant is bad input. Any other algorithm's is a bug (its parameters are range-checked).
-    if (spec.algorithm == "lsystem")
-      throw InputError(fmt::format(
-          "L-system{}: the plant its rules drew is invalid ({}): an expression divided by zero or overflowed",
-          params.text("grammar").empty() ? "" : fmt::format(" grammar '{}'", params.text("grammar")), bad));
+  // An algorithm whose input can draw an invalid plant (an L-system's grammar is a program) refuses it in
+  // finish(), as bad input; any other invalid plant is a bug.
+  if (const std::string bad = plant.validate(); !bad.empty())
     throw std::logic_error(fmt::format("algorithm '{}' produced an invalid plant: {}", spec.algorithm, bad));
-  }
   organ_pass(spec, organ_options, organ_params, mesher, st, timer, rec);
   if (plant_out) *plant_out = st.styled ? *st.styled : plant;
   mesh_export_measure(spec, mesher, st, timer, rec);

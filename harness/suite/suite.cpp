@@ -27,6 +27,7 @@
 #include "algorithms/plugins/loader.hpp"
 #include "core/errors.hpp"
 #include "core/json_util.hpp"
+#include "harness/organs/options.hpp"
 #include "harness/output/exporters.hpp"
 #include "harness/record/record.hpp"
 #include "harness/run/process.hpp"
@@ -83,9 +84,11 @@ class SuiteReader : public JsonPathReader {
   Suite read() const {
     const std::string text = read_text(file());
     const json j = parse_input_json(file(), text);
-    only_keys(j, "",
-              {"schema_version", "name", "description", "repetitions", "warmup", "threads", "timeout_s",
-               "memory_limit_mb", "max_steps", "seeds", "budget", "glb", "scenes", "algorithms", "plugins"});
+    std::vector<std::string> keys = {"schema_version", "name",      "description",     "repetitions",
+                                     "warmup",         "timeout_s", "memory_limit_mb", "seeds",
+                                     "budget",         "scenes",    "algorithms",      "plugins"};
+    keys.insert(keys.end(), kSettings.begin(), kSettings.end());
+    only_keys(j, "", keys);
     if (!j.contains("schema_version") || j["schema_version"] != 1) fail("/schema_version", "expected 1");
     Suite s;
     s.file = file();
@@ -93,27 +96,30 @@ class SuiteReader : public JsonPathReader {
     const Common common = read_settings(j, s);
     const std::vector<SceneEntry> scenes = read_scenes(j);
     load_listed_plugins(j);
-    const std::vector<AlgoEntry> algos = read_algorithms(j);
+    const std::vector<AlgoEntry> algos = read_algorithms(j, common);
     make_cells(common, scenes, algos, s);
     return s;
   }
 
  private:
+  // The trial settings a suite file may give, at its top level for every cell or in an algorithm entry for
+  // its own: the trial spec's fields of the same names, checked as the spec declares them.
+  static constexpr std::array<const char*, 9> kSettings = {"threads",         "max_steps", "time_limit_s",
+                                                           "voxel_size",      "sides",     "budget_nodes",
+                                                           "budget_length_m", "metrics",   "glb"};
+
   // What every cell shares, from the top level of the file.
   struct Common {
-    int threads = 0, max_steps = 5000;
+    TrialSpec spec;  // its settings
     std::vector<std::uint64_t> seeds = {1};
-    std::size_t budget_nodes = 0;
-    double budget_length = 0.0;
-    GlbLayout glb = kDefaultGlbLayout;
   };
   struct SceneEntry {
     std::string spec, name;
     std::vector<std::string> params;
   };
   struct AlgoEntry {
-    std::string label, name, fault, leaf_obj;
-    std::vector<std::string> organs;  // the organ pass's key=value
+    std::string label, name;
+    TrialSpec spec;  // the common settings, with the entry's own (fault, leaf_obj, organs, settings)
     std::vector<std::string> params;
     std::vector<std::pair<std::string, std::vector<json>>> sweep;
     std::vector<json> points;  // explicit sweep points (instead of a product)
@@ -151,30 +157,29 @@ class SuiteReader : public JsonPathReader {
       s.memory_limit_bytes = static_cast<std::uint64_t>(number(j["memory_limit_mb"], "/memory_limit_mb", 64, 1e7))
                              << 20;
     Common c;
-    if (j.contains("threads")) c.threads = static_cast<int>(number(j["threads"], "/threads", 0, kMaxThreads));
-    if (j.contains("max_steps")) c.max_steps = static_cast<int>(number(j["max_steps"], "/max_steps", 0, 1e9));
+    read_settings_into(j, "", c.spec);
     if (j.contains("seeds")) {
       if (!j["seeds"].is_array() || j["seeds"].empty()) fail("/seeds", "expected a non-empty array of seeds");
       c.seeds.clear();
-      for (std::size_t i = 0; i < j["seeds"].size(); ++i)
-        c.seeds.push_back(static_cast<std::uint64_t>(number(j["seeds"][i], fmt::format("/seeds/{}", i), 0, 9e15)));
-    }
-    if (j.contains("budget")) {
-      only_keys(j["budget"], "/budget", {"nodes", "length_m"});
-      if (j["budget"].contains("nodes"))
-        c.budget_nodes = static_cast<std::size_t>(number(j["budget"]["nodes"], "/budget/nodes", 0, 1e12));
-      if (j["budget"].contains("length_m"))
-        c.budget_length = number(j["budget"]["length_m"], "/budget/length_m", 0, 1e12);
-    }
-    if (j.contains("glb")) {
-      const std::string name = string_field(j, "", "glb", "", "the layout of plant.glb: plain, instanced or compact");
-      try {
-        c.glb = parse_glb_layout(name);
-      } catch (const InputError& err) {
-        fail("/glb", err.what());
+      for (std::size_t i = 0; i < j["seeds"].size(); ++i) {
+        read_spec_field(c.spec, "seed", j["seeds"][i], file(), fmt::format("/seeds/{}", i));
+        c.seeds.push_back(c.spec.seed);
       }
     }
+    if (j.contains("budget")) {  // the older spelling of budget_nodes and budget_length_m
+      only_keys(j["budget"], "/budget", {"nodes", "length_m"});
+      if (j["budget"].contains("nodes"))
+        read_spec_field(c.spec, "budget_nodes", j["budget"]["nodes"], file(), "/budget/nodes");
+      if (j["budget"].contains("length_m"))
+        read_spec_field(c.spec, "budget_length_m", j["budget"]["length_m"], file(), "/budget/length_m");
+    }
     return c;
+  }
+
+  // The settings `j` gives (kSettings), into `spec`.
+  void read_settings_into(const json& j, const std::string& path, TrialSpec& spec) const {
+    for (const char* key : kSettings)
+      if (j.contains(key)) read_spec_field(spec, key, j[key], file(), fmt::format("{}/{}", path, key));
   }
 
   std::vector<SceneEntry> read_scenes(const json& j) const {
@@ -208,33 +213,38 @@ class SuiteReader : public JsonPathReader {
     return scenes;
   }
 
-  std::vector<AlgoEntry> read_algorithms(const json& j) const {
+  std::vector<AlgoEntry> read_algorithms(const json& j, const Common& common) const {
     std::vector<AlgoEntry> algos;
     if (!j.contains("algorithms") || !j["algorithms"].is_array() || j["algorithms"].empty())
       fail("/algorithms", "expected a non-empty array of algorithm entries");
     std::set<std::string> labels;
     for (std::size_t i = 0; i < j["algorithms"].size(); ++i) {
-      algos.push_back(read_algorithm(j["algorithms"][i], fmt::format("/algorithms/{}", i), labels));
+      algos.push_back(read_algorithm(j["algorithms"][i], fmt::format("/algorithms/{}", i), common, labels));
     }
     return algos;
   }
 
   // One entry of "algorithms"; its label must not be in `labels` (the entries before it), and is added.
-  AlgoEntry read_algorithm(const json& e, const std::string& path, std::set<std::string>& labels) const {
+  AlgoEntry read_algorithm(const json& e, const std::string& path, const Common& common,
+                           std::set<std::string>& labels) const {
     AlgoEntry a;
+    a.spec = common.spec;
     if (e.is_string()) {
       a.name = e.get<std::string>();
     } else {
-      only_keys(e, path, {"name", "label", "params", "sweep", "fault", "leaf_obj", "organs"});
+      std::vector<std::string> keys = {"name", "label", "params", "sweep", "fault", "leaf_obj", "organs"};
+      keys.insert(keys.end(), kSettings.begin(), kSettings.end());
+      only_keys(e, path, keys);
       if (!e.contains("name") || !e["name"].is_string()) fail(path + "/name", "expected the algorithm's name");
       a.name = e["name"].get<std::string>();
       a.label = string_field(e, path, "label", "", "the entry's label");
-      a.fault = string_field(e, path, "fault", "", "a fault to inject (crash, hang, oom, throw or slow:N)");
+      read_settings_into(e, path, a.spec);
+      if (e.contains("fault")) read_spec_field(a.spec, "fault", e["fault"], file(), path + "/fault");
       if (e.contains("leaf_obj")) {
         if (!e["leaf_obj"].is_string()) fail(path + "/leaf_obj", "expected the path of an OBJ file");
-        a.leaf_obj = relative_to_suite(e["leaf_obj"].get<std::string>());
+        a.spec.leaf_obj = relative_to_suite(e["leaf_obj"].get<std::string>());
         try {
-          (void)load_organ_obj(a.leaf_obj);
+          (void)load_organ_obj(a.spec.leaf_obj);
         } catch (const InputError& err) {
           fail(path + "/leaf_obj", err.what());
         }
@@ -276,10 +286,10 @@ class SuiteReader : public JsonPathReader {
       } catch (const InputError& err) {
         fail(path + "/" + k, err.what());
       }
-      a.organs.push_back(k + "=" + value_text(v));
+      a.spec.organs.push_back(k + "=" + value_text(v));
     }
     try {
-      (void)read_organ_options(a.organs);
+      (void)read_organ_options(a.spec.organs);
     } catch (const InputError& err) {
       fail(path, err.what());
     }
@@ -345,19 +355,12 @@ class SuiteReader : public JsonPathReader {
             SuiteConfig c;
             c.label = a.label;
             c.scene_name = sc.name;
+            c.spec = a.spec;
             c.spec.algorithm = a.name;
             c.spec.scene = sc.spec;
             c.spec.scene_params = sc.params;
             c.spec.params = a.params;
             c.spec.seed = seed;
-            c.spec.threads = common.threads;
-            c.spec.max_steps = common.max_steps;
-            c.spec.budget_nodes = common.budget_nodes;
-            c.spec.budget_length_m = common.budget_length;
-            c.spec.glb = common.glb;
-            c.spec.fault = a.fault;
-            c.spec.mesher.leaf_obj = a.leaf_obj;
-            c.spec.organs = a.organs;
             std::size_t rest = point;
             std::vector<std::string> parts;
             auto assign = [&](const std::string& k, const json& val) {
@@ -384,86 +387,6 @@ class SuiteReader : public JsonPathReader {
   fs::path dir_;
 };
 
-// Exit codes of a trial child.
-constexpr int kExitOk = 0, kExitInvalid = 2, kExitOom = 3, kExitError = 4;
-
-std::string csv_row(const std::vector<std::string>& cells) {
-  std::string row;
-  for (std::size_t i = 0; i < cells.size(); ++i) {
-    std::string c = cells[i];
-    if (c.find_first_of(",\"\n") != std::string::npos) {
-      std::string q = "\"";
-      for (const char ch : c) q += ch == '"' ? std::string("\"\"") : std::string(1, ch);
-      c = q + "\"";
-    }
-    row += (i ? "," : "") + c;
-  }
-  return row;
-}
-
-// The CSV's phase columns, in the order trials run them.
-const std::vector<std::string> kPhases = {"scene_load", "query_build", "growth", "organs",
-                                          "meshing",    "export",      "metrics"};
-
-// A number as the JSON has it ("" when absent), so the CSV and results.json agree digit for digit.
-template <class T>
-std::string num(const std::optional<T>& v) {
-  return v ? json(*v).dump() : std::string();
-}
-template <class T>
-std::string num(const T& v) {
-  return json(v).dump();
-}
-
-std::string results_csv(const ResultsFile& results) {
-  std::vector<std::string> head = {"id", "label", "algorithm", "scene", "seed", "sweep", "repetition", "status"};
-  for (const auto& ph : kPhases) {
-    head.push_back(ph + "_wall_s");
-    head.push_back(ph + "_cpu_s");
-    head.push_back(ph + "_peak_rss_bytes");
-    head.push_back(ph + "_alloc_count");
-  }
-  for (const auto& k :
-       {"child_wall_s", "child_max_rss_bytes", "harness_overhead_s", "nodes", "leaves", "total_length_m", "obj_bytes",
-        "ply_bytes", "glb_bytes", "coverage", "attached_fraction", "penetration_nodes", "geometry_hash"})
-    head.emplace_back(k);
-  std::string out = csv_row(head) + "\n";
-  for (const auto& t : results.trials) {
-    const CellResults& c = t.results;
-    for (const auto& s : t.samples) {
-      std::vector<std::string> row = {t.id,        t.label,        t.algorithm,       t.scene,
-                                      num(t.seed), t.sweep.dump(), num(s.repetition), s.status};
-      for (const auto& ph : kPhases) {
-        const PhaseMeasures* p = s.phases ? s.phases->find(ph) : nullptr;
-        row.push_back(p ? num(p->wall_s) : "");
-        row.push_back(p ? num(p->cpu_s) : "");
-        row.push_back(p ? num(p->peak_rss_bytes) : "");
-        row.push_back(p ? num(p->alloc_count) : "");
-      }
-      const bool ok = s.status == "ok";
-      const OutputBytes b = ok && c.output_bytes ? *c.output_bytes : OutputBytes{};
-      auto metric = [&](const char* k) {
-        return ok && c.metrics && c.metrics->contains(k) ? (*c.metrics)[k].dump() : std::string();
-      };
-      row.push_back(num(s.child_wall_s));
-      row.push_back(num(s.child_max_rss_bytes));
-      row.push_back(num(s.harness_overhead_s));
-      row.push_back(ok && c.counts ? num(c.counts->nodes) : "");
-      row.push_back(ok && c.counts ? num(c.counts->leaves) : "");
-      row.push_back(ok ? num(c.total_length_m) : "");
-      row.push_back(num(b.obj));
-      row.push_back(num(b.ply));
-      row.push_back(num(b.glb));
-      row.push_back(metric("coverage"));
-      row.push_back(metric("attached_fraction"));
-      row.push_back(metric("penetration_nodes"));
-      row.push_back(ok && c.geometry_hash ? *c.geometry_hash : "");
-      out += csv_row(row) + "\n";
-    }
-  }
-  return out;
-}
-
 // Under callgrind a trial runs this many times slower; its timeout grows with it.
 constexpr double kCallgrindSlowdown = 60.0;
 
@@ -488,65 +411,29 @@ InstructionCounts read_callgrind_phases(const fs::path& dir) {
         have = true;
       }
     }
-    if (!phase.empty() && have) out[phase] = ir;
+    if (const auto p = phase_named(phase); p && have) out[*p] = ir;
     fs::remove(f);
   }
   return out;
 }
 
-// The per-cell fields of a successful repetition's record: all of them for the cell's first success, else
-// just the geometry hash and counts, which are compared to catch nondeterminism.
-CellResults cell_results_of(const TrialRecord& rec, bool first, const std::optional<InstructionCounts>& instructions) {
+// A cell's results from its first successful repetition's record.
+CellResults cell_results_of(const TrialRecord& rec, const std::optional<InstructionCounts>& instructions) {
   CellResults c;
-  c.geometry_hash = rec.geometry_hash;
-  c.counts = rec.counts;
-  if (!first) return c;
-  c.output_bytes = rec.output_bytes;
-  c.metrics = rec.metrics;
-  c.total_length_m = rec.total_length_m;
-  c.steps = rec.steps;
-  c.stopped_by = rec.stopped_by;
-  c.curve = rec.curve;
-  c.params = rec.params;
-  c.algorithm_stats = rec.algorithm_stats;
-  c.threads = rec.threads;
+  c.plant = rec.results;
   c.scene_hash = rec.scene.hash;
-  AllocByPhase alloc;
-  rec.phases.each([&](std::string_view k, const PhaseMeasures& p) {
-    alloc[std::string(k)] = {p.alloc_count, p.alloc_bytes};
-  });
-  c.alloc = alloc;
+  AllocByPhase& alloc = c.alloc.emplace();
+  rec.phases.each([&](Phase p, const PhaseMeasures& m) { alloc[p] = AllocCount{m.alloc_count, m.alloc_bytes}; });
   c.instructions = instructions;
-  c.organs = rec.organs;
   return c;
-}
-
-// Every field `from` has, into `to`.
-void take_fields(CellResults& to, const CellResults& from) {
-  auto take = [](auto& a, const auto& b) {
-    if (b) a = b;
-  };
-  take(to.geometry_hash, from.geometry_hash);
-  take(to.counts, from.counts);
-  take(to.output_bytes, from.output_bytes);
-  take(to.metrics, from.metrics);
-  take(to.total_length_m, from.total_length_m);
-  take(to.steps, from.steps);
-  take(to.stopped_by, from.stopped_by);
-  take(to.curve, from.curve);
-  take(to.params, from.params);
-  take(to.algorithm_stats, from.algorithm_stats);
-  take(to.threads, from.threads);
-  take(to.scene_hash, from.scene_hash);
-  take(to.alloc, from.alloc);
-  take(to.instructions, from.instructions);
 }
 
 // The growth phase's wall time of every ok repetition of a cell, in repetition order.
 std::vector<double> growth_times(const SuiteCell& t) {
   std::vector<double> v;
   for (const auto& s : t.samples)
-    if (s.status == "ok" && s.phases && s.phases->growth) v.push_back(s.phases->growth->wall_s);
+    if (const PhaseMeasures* g = s.status == "ok" && s.phases ? s.phases->find(Phase::growth) : nullptr)
+      v.push_back(g->wall_s);
   return v;
 }
 
@@ -562,10 +449,14 @@ MedianSummary median_summary(const std::vector<double>& v) {
 
 // Adds one finished repetition to its cell: the live run and the journal replay both come here.
 void apply_sample(SuiteCell& t, const SuiteSample& sample, const std::optional<CellResults>& cell) {
-  if (sample.status == "ok" && cell) {
-    if (!t.results.geometry_hash) {
-      take_fields(t.results, *cell);
-    } else if (t.results.geometry_hash != cell->geometry_hash || t.results.counts != cell->counts) {
+  if (sample.status == "ok") {
+    // The plant this repetition grew (a journal written before samples kept it: its cell's).
+    const std::string* grown = sample.geometry_hash  ? &*sample.geometry_hash
+                               : cell && cell->plant ? &cell->plant->geometry_hash
+                                                     : nullptr;
+    if (!t.results.plant) {
+      if (cell) take_present(t.results, *cell);
+    } else if (grown && *grown != t.results.plant->geometry_hash) {
       t.nondeterministic = true;  // the same cell grew a different plant: report it loudly
     }
   }
@@ -627,6 +518,40 @@ std::string results_text(ResultsFile& results) {
 Suite load_suite(const std::string& path) {
   if (!fs::exists(path)) throw InputError(fmt::format("{}: no such suite file", path));
   return SuiteReader(path).read();
+}
+
+SuitePlan plan_of(const Suite& suite) {
+  std::set<std::string> entries, scenes, points;
+  std::set<std::uint64_t> seeds;
+  for (const auto& c : suite.configs) {
+    entries.insert(c.label);
+    scenes.insert(c.scene_name);
+    seeds.insert(c.spec.seed);
+    points.insert(c.label + '\n' + c.sweep.dump());
+  }
+  SuitePlan p;
+  p.cells = suite.configs.size();
+  p.entries = entries.size();
+  p.scenes = scenes.size();
+  p.seeds = seeds.size();
+  p.sweep_points = points.size();
+  p.repetitions = suite.repetitions;
+  p.warmup = suite.warmup;
+  p.trials = p.cells * static_cast<std::size_t>(suite.repetitions) + static_cast<std::size_t>(suite.warmup);
+  return p;
+}
+
+std::string plan_text(const Suite& suite) {
+  const SuitePlan p = plan_of(suite);
+  const std::string points =
+      p.sweep_points > p.entries ? fmt::format(", {} sweep points over the entries", p.sweep_points) : "";
+  std::string out = fmt::format(
+      "{}: {} cells ({} algorithm entries x {} scenes x {} seeds{}), {} repetition{} each and {} warm-up{}: {} "
+      "trials\n",
+      suite.name, p.cells, p.entries, p.scenes, p.seeds, points, p.repetitions, p.repetitions == 1 ? "" : "s", p.warmup,
+      p.warmup == 1 ? "" : "s", p.trials);
+  for (const auto& c : suite.configs) out += c.id + "\n";
+  return out;
 }
 
 namespace {
@@ -723,7 +648,7 @@ json merge_results(const std::vector<json>& shards, const std::vector<std::strin
   return to_json(merge_results(typed, names, mixed_machines));
 }
 
-int run_trial_child(const TrialSpec& spec, const std::string& dir_name, int report_fd) {
+Outcome run_trial_child(const TrialSpec& spec, const std::string& dir_name, int report_fd) {
   const fs::path dir(dir_name);
   auto write_error = [&](const std::string& msg) {
     try {
@@ -734,7 +659,8 @@ int run_trial_child(const TrialSpec& spec, const std::string& dir_name, int repo
   };
   const auto started = std::chrono::steady_clock::now();
   const std::string oom = "out of memory (allocation refused under the address-space limit)";
-  exit_on_escaped_bad_alloc(kExitOom, oom, (dir / "error.txt").string());  // a library's noexcept code, its threads
+  // A library's noexcept code, or its threads.
+  exit_on_escaped_bad_alloc(trial_exit_code(Outcome::out_of_memory), oom, (dir / "error.txt").string());
   try {
     run_trial(spec);
     if (report_fd >= 0) {
@@ -744,28 +670,23 @@ int run_trial_child(const TrialSpec& spec, const std::string& dir_name, int repo
                                              std::chrono::steady_clock::now().time_since_epoch().count());
       [[maybe_unused]] const auto n = write(report_fd, report.data(), report.size());
     }
-    return kExitOk;
-  } catch (const InputError& e) {
-    write_error(e.what());
-    return kExitInvalid;
+    return Outcome::ok;
   } catch (const std::exception& e) {
-    if (is_out_of_memory(e)) {
+    const Outcome o = outcome_of(e);
+    if (o != Outcome::out_of_memory)
+      write_error(e.what());
+    else
       write_error(dynamic_cast<const std::bad_alloc*>(&e) ? oom : fmt::format("{}: {}", oom, e.what()));
-      return kExitOom;
-    }
-    write_error(e.what());
-    return kExitError;
+    return o;
   }
 }
 
 json trial_job(const SuiteConfig& c, const std::string& dir) {
-  TrialSpecRecord spec = to_record(c.spec);
+  TrialSpec spec = c.spec;
   spec.out_dir = dir;
   spec.context = false;
   spec.skip_teardown = true;
-  std::vector<std::string> plugins;
-  for (const auto& p : loaded_plugins()) plugins.push_back(p.path);
-  if (!plugins.empty()) spec.plugins = std::move(plugins);
+  for (const auto& p : loaded_plugins()) spec.plugins.push_back(p.path);
   return to_json(spec);
 }
 
@@ -796,8 +717,9 @@ std::unique_ptr<Launcher> start_trial_launcher() {
   return std::make_unique<Launcher>([](const std::string& description) {
     const json j = json::parse(description);
     const TrialSpec spec = trial_spec_from_json(j);
-    return Launcher::Job{[spec](int report_fd) { return run_trial_child(spec, spec.out_dir, report_fd); },
-                         (fs::path(spec.out_dir) / "log.txt").string()};
+    return Launcher::Job{
+        [spec](int report_fd) { return trial_exit_code(run_trial_child(spec, spec.out_dir, report_fd)); },
+        (fs::path(spec.out_dir) / "log.txt").string()};
   });
 }
 
@@ -929,7 +851,7 @@ class SuiteRun {
       t.scene_spec = c.spec.scene;
       t.seed = c.spec.seed;
       t.sweep = c.sweep;
-      t.spec = to_record(c.spec);
+      t.spec = c.spec;
       results_.trials.push_back(std::move(t));
     }
   }
@@ -960,7 +882,7 @@ class SuiteRun {
         r = run_program({self_exe_, "trial", (dir / "spec.json").string()}, "", limits, (dir / "log.txt").string());
       }
       // Only refused input stops the suite: a crash or a hang is the trials' to record.
-      if (!r.timed_out && r.signal == 0 && r.exit_code == kExitInvalid) {
+      if (!r.timed_out && r.signal == 0 && outcome_of_trial_exit(r.exit_code) == Outcome::invalid_input) {
         const std::string error = read_text((dir / "error.txt").string());
         std::error_code ec;
         fs::remove_all(root, ec);
@@ -1064,8 +986,8 @@ class SuiteRun {
       });
     }
     p.t_reaped = std::chrono::steady_clock::now();
-    if (!p.cr.timed_out && p.cr.signal == 0 && p.cr.exit_code == kExitOk && fs::exists(rec_path) && !p.rec &&
-        p.rec_error.empty())
+    if (!p.cr.timed_out && p.cr.signal == 0 && p.cr.exit_code == trial_exit_code(Outcome::ok) && fs::exists(rec_path) &&
+        !p.rec && p.rec_error.empty())
       read_record();  // no report (callgrind trials)
     return p;
   }
@@ -1075,26 +997,24 @@ class SuiteRun {
     const ChildResult& cr = p.cr;
     const fs::path rec_path = dir / "record.json", err_path = dir / "error.txt";
     std::string message;
+    Outcome outcome = Outcome::ok;
     if (cr.timed_out) {
-      sample.status = "timeout";
+      outcome = Outcome::timeout;
       message = fmt::format("killed after {} s", suite_.timeout_s);
     } else if (cr.signal != 0) {
       // SIGKILL that we did not send is the kernel's OOM killer.
-      sample.status = cr.signal == SIGKILL ? "out_of_memory" : "crashed";
+      outcome = cr.signal == SIGKILL ? Outcome::out_of_memory : Outcome::crashed;
       message = signal_name(cr.signal);
-    } else if (cr.exit_code == kExitOk && fs::exists(rec_path)) {
+    } else if (outcome_of_trial_exit(cr.exit_code) == Outcome::ok && fs::exists(rec_path)) {
       if (!p.rec) {
-        sample.status = "crashed";
+        outcome = Outcome::crashed;
         message = fmt::format("{} is unreadable: {}", rec_path.string(), p.rec_error);
-      } else {
-        sample.status = "ok";
       }
     } else {
       message = fs::exists(err_path) ? read_text(err_path.string()) : fmt::format("exit code {}", cr.exit_code);
-      sample.status = cr.exit_code == kExitInvalid ? "invalid_input"
-                      : cr.exit_code == kExitOom   ? "out_of_memory"
-                                                   : "crashed";
+      outcome = cr.exit_code == trial_exit_code(Outcome::ok) ? Outcome::failed : outcome_of_trial_exit(cr.exit_code);
     }
+    sample.status = std::string(status_name(outcome));
     if (!message.empty()) sample.message = message;
   }
 
@@ -1145,9 +1065,10 @@ class SuiteRun {
       const TrialRecord& rec = *p.rec;
       sample.phases = rec.phases;
       double inside = 0.0;
-      rec.phases.each([&](std::string_view, const PhaseMeasures& m) { inside += m.wall_s; });
-      sample.steps = rec.steps;
-      cell = cell_results_of(rec, !t.results.geometry_hash, instructions);
+      rec.phases.each([&](Phase, const PhaseMeasures& m) { inside += m.wall_s; });
+      sample.steps = rec.results.steps;
+      sample.geometry_hash = rec.results.geometry_hash;
+      if (!t.results.plant) cell = cell_results_of(rec, instructions);
       account_overhead(p, inside, sample);
     }
     // The journal line is the durable record: appended and flushed before the next trial starts, so an

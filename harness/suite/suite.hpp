@@ -42,6 +42,18 @@ struct Suite {
 // checked before anything runs; an error names the file and the JSON path.
 Suite load_suite(const std::string& path);
 
+// What a suite runs, counted: its matrix and its trials (cells x repetitions, and the warm-ups). What
+// `growbench suite --plan` prints, and what the README's figures about the standard suite are checked against.
+struct SuitePlan {
+  std::size_t cells = 0, entries = 0, scenes = 0, seeds = 0, sweep_points = 0;
+  int repetitions = 0, warmup = 0;
+  std::size_t trials = 0;  // cells x repetitions + warm-ups
+};
+SuitePlan plan_of(const Suite& suite);
+// "NAME: 240 cells (8 algorithm entries x 10 scenes x 3 seeds), 5 repetitions each and 1 warm-up: 1201
+// trials", then each cell's id on a line.
+std::string plan_text(const Suite& suite);
+
 struct SuiteRunOptions {
   std::string out_dir;  // default: out/suites/NAME
   bool resume = false;
@@ -64,12 +76,12 @@ nlohmann::json trial_job(const SuiteConfig& cell, const std::string& dir);
 // jobs are trials (a job is the JSON {"spec", "dir"} run_suite sends).
 std::unique_ptr<Launcher> start_trial_launcher();
 
-// The body of a trial's own process: runs the trial into DIR (record.json) and returns the exit status
-// the suite reads (0 ok, 2 invalid input, 3 out of memory, 4 other error; error.txt says why). When
+// The body of a trial's own process: runs the trial into DIR (record.json) and returns how it ended, which
+// the process reports as trial_exit_code (core/outcome.hpp; error.txt says why it failed). When
 // report_fd >= 0 it writes "STARTED FINISHED" there (steady-clock nanoseconds: when the body began, and
 // when record.json was in place) with one write, for the suite's overhead accounting.
 // `growbench trial SPEC.json` calls it too (the callgrind mode runs trials that way), without a report.
-int run_trial_child(const TrialSpec& spec, const std::string& dir, int report_fd = -1);
+Outcome run_trial_child(const TrialSpec& spec, const std::string& dir, int report_fd = -1);
 
 // Runs the suite and returns the path of results.json. Throws InputError if results already exist
 // and resume is off.

@@ -36,6 +36,40 @@ TEST(Cli, HelpAndLists) {
   EXPECT_NE(r.out.find("unknown mesh 'bunny' (did you mean 'stanford-bunny'?)"), std::string::npos) << r.out;
 }
 
+// record.json holds the whole trial spec: the trial can be run again from the record alone, and grows the
+// same plant.
+TEST(Cli, TheRecordHoldsTheWholeSpecAndReproducesThePlant) {
+  const auto dir = test::temp_dir("cli_spec");
+  const std::string out = (dir / "run").string();
+  auto r = growbench(
+      "run -q -a spacecol -s wall --set point_count=300 --sides 8 --glb plain --time-limit 100 "
+      "--seed 7 --seed-at 0.5,0.2,0 --budget-nodes 400 --voxel-size 0.05 -o " +
+      out);
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::ifstream in(dir / "run" / "record.json");
+  const nlohmann::json rec = nlohmann::json::parse(in);
+  const nlohmann::json& spec = rec["spec"];
+  EXPECT_EQ(spec["sides"], 8);
+  EXPECT_EQ(spec["glb"], "plain");
+  EXPECT_EQ(spec["time_limit_s"], 100.0);
+  EXPECT_EQ(spec["seed"], 7);
+  EXPECT_EQ(spec["seed_at"], nlohmann::json::parse("[[0.5, 0.2, 0.0]]"));  // as given
+  EXPECT_EQ(spec["budget_nodes"], 400);
+  EXPECT_EQ(spec["voxel_size"], 0.05);
+  EXPECT_EQ(spec["params"], nlohmann::json::parse(R"(["point_count=300"])"));
+  EXPECT_EQ(spec["out_dir"], out);
+  nlohmann::json again = spec;
+  again["out_dir"] = (dir / "again").string();
+  const std::string spec_file = test::write_text(dir / "spec.json", again.dump());
+  r = growbench("trial " + spec_file);
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::ifstream in2(dir / "again" / "record.json");
+  const nlohmann::json rec2 = nlohmann::json::parse(in2);
+  EXPECT_EQ(rec2["geometry_hash"], rec["geometry_hash"]);
+  EXPECT_EQ(rec2["counts"], rec["counts"]);
+  EXPECT_EQ(rec2["output_bytes"]["glb"], rec["output_bytes"]["glb"]);
+}
+
 TEST(Cli, ListOneAlgorithmAsTextOrMarkdown) {
   auto r = growbench("list spacecol");
   EXPECT_EQ(r.status, 0);

@@ -74,10 +74,11 @@ std::string write_results(const fs::path& path, const std::string& hash) {
   SuiteSample s;
   s.status = "ok";
   s.phases.emplace();
-  s.phases->growth = PhaseMeasures{0.25, 0.5, 1u << 20, true, 10, 4096, {}, {}, {}, {}, {}, {}};
+  (*s.phases)[Phase::growth] = PhaseMeasures{0.25, 0.5, 1u << 20, true, 10, 4096, {}, {}, {}, {}, {}, {}};
   c.samples.push_back(s);
-  c.results.geometry_hash = hash;
-  c.results.counts = Counts{10, 9, 2, 2, 0, 100, 50};
+  TrialResults& plant = c.results.plant.emplace();
+  plant.geometry_hash = hash;
+  plant.counts = Counts{10, 9, 2, 2, 0, 100, 50};
   r.trials.push_back(c);
   return test::write_text(path, json_text(to_json(r), 1));
 }
@@ -119,7 +120,7 @@ TEST(ExitStatus, BadInputIsTwoForEveryCommandWithItsSourceNamed) {
       {"list spacel", "did you mean 'spacecol'"},
       {"scenes extra", "extra"},
       {"run -a spacecol -s wall --voxel-size nan",
-       "--voxel-size: expected a finite number in [1e-06, 1e+06], got 'nan'"},
+       "--voxel-size: expected 0 or a finite number in [1e-06, 1e+06], got 'nan'"},
       {"suite " + d + "/missing.json", d + "/missing.json: no such suite file"},
       {"history add " + bad, bad + ":2:1: invalid JSON"},
       {"history plot --dir " + d + "/empty", d + "/empty: no history files"},
@@ -246,9 +247,14 @@ TEST(ExitStatus, NumericOptionsOutOfRangeAreRefusedNotReplaced) {
     std::string args, expect;
   } cases[] = {
       {"run -a spacecol -s wall --voxel-size nan",
-       "--voxel-size: expected a finite number in [1e-06, 1e+06], got 'nan'"},
-      {"run -a spacecol -s wall --voxel-size -1", "--voxel-size: expected a finite number in [1e-06, 1e+06], got '-1'"},
-      {"run -a spacecol -s wall --voxel-size 0", "--voxel-size: expected a finite number in [1e-06, 1e+06], got '0'"},
+       "--voxel-size: expected 0 or a finite number in [1e-06, 1e+06], got 'nan'"},
+      {"run -a spacecol -s wall --voxel-size -1",
+       "--voxel-size: expected 0 or a finite number in [1e-06, 1e+06], got '-1'"},
+      {"run -a spacecol -s wall --voxel-size 1e-9",
+       "--voxel-size: expected 0 or a finite number in [1e-06, 1e+06], got '1e-9'"},
+      {"run -a spacecol -s wall --sides 2", "--sides: expected an integer in [3, 64], got '2'"},
+      {"run -a spacecol -s wall --budget-nodes -1",
+       "--budget-nodes: expected an integer in [0, 1000000000000], got '-1'"},
       {"run -a spacecol -s wall --time-limit -5", "--time-limit: expected a finite number in [0, 1e+09], got '-5'"},
       {"run -a spacecol -s wall --time-limit nan", "--time-limit: expected a finite number in [0, 1e+09], got 'nan'"},
       {"run -a spacecol -s wall --threads -1", "--threads: expected an integer in [0, 1024], got '-1'"},

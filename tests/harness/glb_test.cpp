@@ -18,6 +18,7 @@
 #include "core/errors.hpp"
 #include "core/json_util.hpp"
 #include "harness/output/exporters.hpp"
+#include "harness/record/record.hpp"
 #include "test_util.hpp"
 
 namespace growbench {
@@ -351,14 +352,22 @@ TEST(Glb, RunWritesTheChosenLayout) {
 }
 
 TEST(Glb, LayoutNames) {
-  for (const GlbLayout l : {GlbLayout::Plain, GlbLayout::Instanced, GlbLayout::Compact})
-    EXPECT_EQ(parse_glb_layout(glb_layout_name(l)), l);
+  // A spec names its layout; reading it back gives the same layout, and an unknown name is refused at its path.
+  for (const GlbLayout l : {GlbLayout::Plain, GlbLayout::Instanced, GlbLayout::Compact}) {
+    TrialSpec spec;
+    spec.glb = l;
+    const nlohmann::json j = to_json(spec);
+    EXPECT_EQ(j["glb"], std::string(glb_layout_name(l)));
+    EXPECT_EQ(from_json<TrialSpec>(j, "spec.json").glb, l);
+  }
   EXPECT_EQ(glb_layout_name(kDefaultGlbLayout), "compact");
+  nlohmann::json j = to_json(TrialSpec{});
+  j["glb"] = "draco";
   try {
-    (void)parse_glb_layout("draco");
+    (void)from_json<TrialSpec>(j, "spec.json");
     FAIL() << "no error";
   } catch (const InputError& e) {
-    EXPECT_STREQ(e.what(), "unknown glTF layout 'draco' (expected plain, instanced or compact)");
+    EXPECT_STREQ(e.what(), "spec.json: at glb: expected one of plain, instanced, compact, got \"draco\"");
   }
 }
 

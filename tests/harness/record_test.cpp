@@ -2,7 +2,10 @@
 // error that names the file and the JSON path.
 #include <filesystem>
 #include <fstream>
+#include <algorithm>
 #include <iterator>
+#include <sstream>
+#include <vector>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -35,13 +38,17 @@ ResultsFile small_results() {
   SuiteSample s;
   s.status = "ok";
   s.phases.emplace();
-  s.phases->growth = PhaseMeasures{0.25, 0.5, 1u << 20, true, 10, 4096, {}, {}, {}, {}, {}, {}};
+  (*s.phases)[Phase::growth] = PhaseMeasures{0.25, 0.5, 1u << 20, true, 10, 4096, {}, {}, {}, {}, {}, {}};
   s.launch_s = 0.001;
+  s.geometry_hash = "fedcba9876543210";
   c.samples.push_back(s);
-  c.results.geometry_hash = "fedcba9876543210";
-  c.results.counts = Counts{10, 9, 2, 2, 0, 100, 50};
-  c.results.metrics = json{{"coverage", 0.5}, {"bbox_min", {0.0, 1.0, 2.0}}};
-  c.results.alloc = AllocByPhase{{"growth", {10, 4096}}};
+  TrialResults& plant = c.results.plant.emplace();
+  plant.geometry_hash = "fedcba9876543210";
+  plant.counts = Counts{10, 9, 2, 2, 0, 100, 50};
+  plant.metrics = json{{"coverage", 0.5}, {"bbox_min", {0.0, 1.0, 2.0}}};
+  plant.stopped_by = "finished";
+  c.results.scene_hash = "00112233445566ff";
+  c.results.alloc.emplace()[Phase::growth] = AllocCount{10, 4096};
   r.trials.push_back(c);
   return r;
 }
@@ -108,11 +115,11 @@ TEST(Record, PartialFilesReadWithDefaults) {
       {"trials", {{{"id", "a"}, {"samples", {{{"phases", {{"growth", {{"wall_s", 1}, {"peak_rss_bytes", 1e6}}}}}}}}}}}};
   const ResultsFile r = from_json<ResultsFile>(j, "partial.json");
   ASSERT_EQ(r.trials.size(), 1u);
-  const PhaseMeasures* g = r.trials[0].samples[0].phases->find("growth");
+  const PhaseMeasures* g = r.trials[0].samples[0].phases->find(Phase::growth);
   ASSERT_NE(g, nullptr);
   EXPECT_EQ(g->wall_s, 1.0);
   EXPECT_EQ(g->peak_rss_bytes, 1000000u);
-  EXPECT_EQ(r.trials[0].samples[0].phases->find("meshing"), nullptr);
+  EXPECT_EQ(r.trials[0].samples[0].phases->find(Phase::meshing), nullptr);
   EXPECT_EQ(r.schema_version, kSchemaVersion);
   EXPECT_EQ(r.mode, "timing");
 }
@@ -120,22 +127,22 @@ TEST(Record, PartialFilesReadWithDefaults) {
 TEST(Record, AlgorithmFilesRoundTripAndAreLeftOutWhenNone) {
   const auto dir = test::temp_dir("record_algorithm_files");
   TrialRecord rec;
-  rec.output_bytes.obj = 100;
-  rec.output_bytes.algorithm_files = {{"texture.png", 5000000000u}, {"skeleton.svg", 7}};
+  rec.results.output_bytes.obj = 100;
+  rec.results.output_bytes.algorithm_files = {{"texture.png", 5000000000u}, {"skeleton.svg", 7}};
   const json j = to_json(rec);
   EXPECT_EQ(j["output_bytes"]["algorithm_files"], json({{"skeleton.svg", 7}, {"texture.png", 5000000000u}}));
   // Read back from a record file, as `growbench render` and the suite read them.
   const TrialRecord back = read_trial_record(test::write_text(dir / "record.json", j.dump()));
-  EXPECT_EQ(back.output_bytes.algorithm_files, rec.output_bytes.algorithm_files);
-  EXPECT_EQ(back.output_bytes.obj, 100u);
+  EXPECT_EQ(back.results.output_bytes.algorithm_files, rec.results.output_bytes.algorithm_files);
+  EXPECT_EQ(back.results.output_bytes.obj, 100u);
   // A suite cell carries them in its results.
   ResultsFile r = small_results();
-  r.trials[0].results.output_bytes = rec.output_bytes;
+  r.trials[0].results.plant->output_bytes = rec.results.output_bytes;
   const json rj = to_json(r);
   EXPECT_EQ(rj["trials"][0]["output_bytes"]["algorithm_files"]["texture.png"], 5000000000u);
   EXPECT_EQ(to_json(from_json<ResultsFile>(rj, "results.json")), rj);
   // An algorithm that writes no files of its own leaves the key out, as records before it did.
-  rec.output_bytes.algorithm_files.clear();
+  rec.results.output_bytes.algorithm_files.clear();
   EXPECT_FALSE(to_json(rec)["output_bytes"].contains("algorithm_files"));
   // A size that is not a byte count is an error at its path.
   json bad = j;
@@ -150,15 +157,19 @@ TEST(Record, AlgorithmFilesRoundTripAndAreLeftOutWhenNone) {
   }
 }
 
-TEST(Record, PhasesInTheOrderTheJsonHoldsThem) {
+TEST(Record, PhasesInPipelineOrder) {
   Phases p;
-  p.scene_load = PhaseMeasures{};
-  p.exporting = PhaseMeasures{};
-  p.growth = PhaseMeasures{};
+  p[Phase::metrics] = PhaseMeasures{};
+  p[Phase::exporting] = PhaseMeasures{};
+  p[Phase::scene_load] = PhaseMeasures{};
   std::vector<std::string> names;
-  p.each([&](std::string_view n, const PhaseMeasures&) { names.emplace_back(n); });
-  EXPECT_EQ(names, (std::vector<std::string>{"export", "growth", "scene_load"}));
-  EXPECT_EQ(to_json(p).begin().key(), "export");
+  p.each([&](Phase phase, const PhaseMeasures&) { names.emplace_back(phase_name(phase)); });
+  EXPECT_EQ(names, (std::vector<std::string>{"scene_load", "export", "metrics"}));
+  const json j = to_json(p);
+  EXPECT_EQ(j.size(), 3u);
+  EXPECT_TRUE(j.contains("export"));
+  for (std::size_t i = 0; i < kPhaseCount; ++i) EXPECT_EQ(phase_named(kPhaseNames[i]), kPhases[i]);
+  EXPECT_EQ(phase_named("exporting"), std::nullopt);
 }
 
 TEST(Record, InputFilesThatCannotBeReadNameTheFileAndWhy) {
@@ -254,6 +265,121 @@ TEST(Record, FilesAreCheckedForKindAndVersion) {
   const auto entries = read_journal(journal);
   ASSERT_EQ(entries.size(), 1u);
   EXPECT_EQ(to_json(entries[0]), to_json(e));
+}
+
+// results.schema.json is generated from the declarations: the committed file is what this binary declares.
+TEST(Record, SchemaFileIsGenerated) {
+  const std::string path = std::string(GROWBENCH_SOURCE_DIR) + "/harness/record/results.schema.json";
+  std::ifstream in(path);
+  ASSERT_TRUE(in) << path;
+  const json committed = json::parse(in);
+  EXPECT_TRUE(committed == results_schema())
+      << path << " differs from the record declarations: run `make schema` and commit it";
+  // The writer and the schema agree field for field: every key a full record writes is a property.
+  const json defs = results_schema()["$defs"];
+  ResultsFile r = small_results();
+  r.trials[0].results.plant->organs = OrganPassRecord{json{{"placement", "avoid"}}, 3, 1, 2};
+  const json cell = to_json(r)["trials"][0];
+  for (const auto& [k, v] : cell.items()) EXPECT_TRUE(defs["cell"]["properties"].contains(k)) << k;
+  // What only ok cells carry is required of them, and of no other.
+  const json then = defs["cell"]["then"]["required"];
+  for (const char* k : {"geometry_hash", "counts", "output_bytes", "curve", "scene_hash", "alloc"})
+    EXPECT_NE(std::find(then.begin(), then.end(), k), then.end()) << k;
+  const json always = defs["cell"]["required"];
+  EXPECT_EQ(std::find(always.begin(), always.end(), "geometry_hash"), always.end());
+  EXPECT_EQ(defs["results"]["properties"]["schema_version"]["const"], kSchemaVersion);
+  EXPECT_EQ(defs["spec"]["properties"]["sides"]["maximum"], 64);
+}
+
+// A projection copies each field of the same key, looking into inline structs: a baseline cell is its cell's
+// gated fields, whatever field is added to either.
+TEST(Record, ABaselineCellIsItsCellsFieldsOfTheSameKeys) {
+  const ResultsFile r = small_results();
+  const SuiteCell& c = r.trials[0];
+  const BaselineCell b = baseline_cell_of(c);
+  EXPECT_EQ(b.id, c.id);
+  EXPECT_EQ(b.status, "ok");
+  EXPECT_EQ(b.geometry_hash, c.results.plant->geometry_hash);
+  EXPECT_EQ(b.counts, c.results.plant->counts);
+  EXPECT_EQ(b.metrics, c.results.plant->metrics);
+  EXPECT_EQ(b.threads, c.results.plant->threads);
+  EXPECT_EQ(b.alloc, c.results.alloc);
+  EXPECT_FALSE(b.instructions);
+  // A cell without results (pending, failed) projects none.
+  SuiteCell pending = c;
+  pending.results = {};
+  pending.status = "pending";
+  const BaselineCell p = baseline_cell_of(pending);
+  EXPECT_FALSE(p.geometry_hash);
+  EXPECT_FALSE(p.counts);
+  EXPECT_FALSE(p.alloc);
+}
+
+// Merging takes every present field of a cell's results, the organ pass's included (a field the copy once
+// left out).
+TEST(Record, TakingACellsResultsTakesEveryField) {
+  CellResults from = small_results().trials[0].results;
+  from.plant->organs = OrganPassRecord{json{{"placement", "avoid"}}, 231, 4, 5};
+  from.instructions.emplace()[Phase::growth] = 12345;
+  CellResults to;
+  take_present(to, from);
+  EXPECT_EQ(to_json(to), to_json(from));
+  EXPECT_EQ(to.plant->organs->placed, 231u);
+}
+
+// results.csv: a row per repetition, a column per field named by its JSON path; a failed repetition's row
+// has no plant results.
+TEST(Record, CsvColumnsAreJsonPaths) {
+  ResultsFile r = small_results();
+  SuiteSample failed;
+  failed.repetition = 1;
+  failed.status = "crashed";
+  failed.message = "signal 11, \"SIGSEGV\"";
+  r.trials[0].samples.push_back(failed);
+  const std::string csv = results_csv(r);
+  std::vector<std::string> lines;
+  std::istringstream in(csv);
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  ASSERT_EQ(lines.size(), 3u) << csv;
+  std::vector<std::string> head;
+  std::istringstream hs(lines[0]);
+  for (std::string c; std::getline(hs, c, ',');) head.push_back(c);
+  auto column = [&](const std::string& name) {
+    return static_cast<std::size_t>(std::find(head.begin(), head.end(), name) - head.begin());
+  };
+  for (const char* k : {"id", "counts.nodes", "metrics.coverage", "alloc.growth.count", "sample.phases.growth.wall_s",
+                        "sample.repetition", "sample.status", "geometry_hash", "scene_hash"})
+    EXPECT_LT(column(k), head.size()) << k << " in " << lines[0];
+  EXPECT_EQ(column("metrics.bbox_min"), head.size()) << "arrays are not columns";
+  EXPECT_EQ(column("spec.algorithm"), head.size()) << "the spec is not a column";
+  EXPECT_NE(lines[1].find(",10,"), std::string::npos) << lines[1];  // the ok row's node count
+  EXPECT_EQ(lines[2].find("fedcba9876543210,"), lines[2].find("fedcba9876543210,"));
+  EXPECT_EQ(lines[2].find("fedcba9876543210"), std::string::npos) << "a failed row shows no plant: " << lines[2];
+  EXPECT_NE(lines[2].find("\"signal 11, \"\"SIGSEGV\"\"\""), std::string::npos) << lines[2];
+}
+
+// A spec made in code is held to the declared ranges, as the command line and suite files are.
+TEST(Record, ASpecOutsideItsDeclaredRangesIsRefused) {
+  TrialSpec s;
+  s.algorithm = "spacecol";
+  s.scene = "wall";
+  EXPECT_NO_THROW(check_trial_spec(s));
+  s.sides = 2;
+  EXPECT_EQ(test::error_of([&] { check_trial_spec(s); }),
+            "the trial spec: sides: expected an integer in [3, 64], got 2");
+  s.sides = 6;
+  s.voxel_size = 1e-9;
+  EXPECT_EQ(test::error_of([&] { check_trial_spec(s); }),
+            "the trial spec: voxel_size: expected 0 or a number in [1e-06, 1e+06], got 1e-09");
+  s.voxel_size = 0.0;
+  s.seed_at = {{0.0, 2e9, 0.0}};
+  EXPECT_EQ(test::error_of([&] { check_trial_spec(s); }),
+            "the trial spec: seed_at: expected a number in [-1e+09, 1e+09], got 2000000000.0");
+  // Read from a file, a value out of range names its path.
+  json j = to_json(TrialSpec{});
+  j["threads"] = 5000;
+  EXPECT_EQ(test::error_of([&] { (void)from_json<TrialSpec>(j, "spec.json"); }),
+            "spec.json: at threads: expected an integer in [0, 1024], got 5000");
 }
 
 }  // namespace

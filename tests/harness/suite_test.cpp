@@ -8,6 +8,9 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <set>
+#include <tuple>
+#include <vector>
 #include <sstream>
 #include <thread>
 
@@ -15,7 +18,10 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "algorithms/algorithm.hpp"
 #include "core/memory.hpp"
+#include "harness/record/record.hpp"
+#include "harness/suite/suite.hpp"
 #include "test_util.hpp"
 
 extern char** environ;
@@ -116,7 +122,7 @@ TEST(Suite, GlbChoosesTheLayoutOfEveryCell) {
                              suite_file(dir, {{"algorithms", algos}, {"glb", bad}}));
     EXPECT_EQ(r.status, 2) << r.out;
     EXPECT_NE(r.out.find("at /glb: "), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find("plain, instanced or compact"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("expected one of plain, instanced, compact, got "), std::string::npos) << r.out;
   }
 }
 
@@ -404,11 +410,106 @@ TEST(Suite, QuickSuiteEndToEndAndSummary) {
     for (const char* f : {"obj", "ply", "glb", "skeleton_obj", "skeleton_ply"})
       EXPECT_GT(t["output_bytes"][f].get<long>(), 0) << f;
   }
+  // The generated schema holds what the quick suite writes: results, journal and every trial's record.
+  const auto v =
+      test::run_command("/usr/bin/python3 " + std::string(GROWBENCH_SOURCE_DIR) + "/scripts/check-schema " + out +
+                        "/results.json " + out + "/journal.jsonl " + out + "/trials/*/*/*/record.json");
+  EXPECT_EQ(v.status, 0) << v.out;
+  EXPECT_NE(v.out.find("all valid"), std::string::npos) << v.out;
   const auto s = growbench("summary " + out + "/results.json");
   EXPECT_EQ(s.status, 0);
   EXPECT_NE(s.out.find("== scene wall"), std::string::npos) << s.out;
   EXPECT_NE(s.out.find("growth median [95% CI]"), std::string::npos) << s.out;
   EXPECT_EQ(growbench("summary /nonexistent.json").status, 2);
+}
+
+// The regression gate covers every algorithm: the quick suite has an entry for each registered one, and the
+// committed baseline was made from this very suite file, with an ok cell of each.
+TEST(Suite, TheQuickSuiteAndItsBaselineCoverEveryRegisteredAlgorithm) {
+  const std::string root = GROWBENCH_SOURCE_DIR;
+  const Suite quick = load_suite(root + "/bench/suites/quick.json");
+  const Baseline base = read_baseline(root + "/reports/baselines/quick.json");
+  EXPECT_EQ(base.suite_hash, quick.hash) << "reports/baselines/quick.json is not of bench/suites/quick.json: "
+                                            "run make baseline PRESET=ci";
+  std::set<std::string> in_suite, in_baseline;
+  for (const auto& c : quick.configs) in_suite.insert(c.spec.algorithm);
+  for (const auto& t : base.trials)
+    if (t.status == "ok") in_baseline.insert(t.algorithm);
+  for (const AlgorithmEntry& e : algorithm_registry()) {
+    const std::string& name = e.info().name;
+    EXPECT_TRUE(in_suite.count(name)) << name << " is registered but has no entry in bench/suites/quick.json";
+    EXPECT_TRUE(in_baseline.count(name)) << name << " has no ok cell in reports/baselines/quick.json";
+  }
+}
+
+// The README's figures about the standard suite (what `make demo` runs) are the suite file's.
+TEST(Suite, TheReadmesFiguresAreTheStandardSuites) {
+  const std::string root = GROWBENCH_SOURCE_DIR;
+  const SuitePlan p = plan_of(load_suite(root + "/bench/suites/standard.json"));
+  std::ifstream in(root + "/README.md");
+  std::string readme, word;
+  while (in >> word) readme += word + " ";  // lines wrap anywhere: compare with single spaces
+  for (const std::string& said :
+       {fmt::format("({} cells: {} algorithm entries x {} scenes x {} seeds,", p.cells, p.entries, p.scenes, p.seeds),
+        fmt::format("**one repetition** of each cell ({} trials, after one warm-up)", p.cells),
+        fmt::format("{} repetitions, {} trials,", p.repetitions, p.cells * static_cast<std::size_t>(p.repetitions))})
+    EXPECT_NE(readme.find(said), std::string::npos) << "README.md should say: " << said;
+}
+
+// A cell's results carry everything its first successful repetition measured: the organ pass's counts too,
+// as the journal has them.
+TEST(Suite, ACellCarriesItsOrganPassCounts) {
+  const auto dir = test::temp_dir("suite_organs");
+  const json algos = json::array({{{"name", "lsystem"},
+                                   {"params", {{"grammar", "cherry-blossom"}, {"generations", 4}}},
+                                   {"organs", {{"placement", "avoid"}}}}});
+  const auto r = growbench("suite -q -o " + (dir / "out").string() + " " + suite_file(dir, {{"algorithms", algos}}));
+  ASSERT_EQ(r.status, 0) << r.out;
+  const json cell = read_json(dir / "out" / "results.json")["trials"][0];
+  ASSERT_EQ(cell["status"], "ok") << cell.dump();
+  ASSERT_TRUE(cell.contains("organs")) << cell.dump();
+  std::ifstream in(dir / "out" / "journal.jsonl");
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  const json journal = json::parse(line)["cell"]["organs"];
+  EXPECT_EQ(cell["organs"], journal);
+  EXPECT_EQ(cell["organs"]["options"]["placement"], "avoid");
+  EXPECT_GT(cell["organs"]["placed"].get<int>(), 0) << cell["organs"].dump();
+  // Every repetition's plant is recorded with its sample, and the cell's is the first's.
+  EXPECT_EQ(cell["samples"][0]["geometry_hash"], cell["geometry_hash"]);
+}
+
+// The settings a suite file gives reach every cell's spec, checked against the same ranges as the command
+// line's options.
+TEST(Suite, SettingsAreTheTrialSpecsWithItsRanges) {
+  const auto dir = test::temp_dir("suite_settings");
+  const json algos = json::array({{{"name", "spacecol"}, {"params", kSmall}, {"sides", 5}}});
+  const auto r = growbench("suite -q -o " + (dir / "out").string() + " " +
+                           suite_file(dir, {{"algorithms", algos},
+                                            {"time_limit_s", 100},
+                                            {"voxel_size", 0.05},
+                                            {"sides", 8},
+                                            {"budget_nodes", 400},
+                                            {"seeds", {18446744073709551615ull}}}));
+  ASSERT_EQ(r.status, 0) << r.out;
+  const json cell = read_json(dir / "out" / "results.json")["trials"][0];
+  EXPECT_EQ(cell["spec"]["time_limit_s"], 100.0);
+  EXPECT_EQ(cell["spec"]["voxel_size"], 0.05);
+  EXPECT_EQ(cell["spec"]["sides"], 5) << "the entry's own setting wins over the suite's";
+  EXPECT_EQ(cell["spec"]["budget_nodes"], 400);
+  EXPECT_EQ(cell["seed"], 18446744073709551615ull) << "a seed is a 64-bit integer, not a double";
+  EXPECT_EQ(cell["stopped_by"], "budget_nodes");
+  for (const auto& [key, value, expect] : std::vector<std::tuple<std::string, json, std::string>>{
+           {"max_steps", -1, "at /max_steps: expected an integer in [0, 2147483647], got -1"},
+           {"max_steps", 3000000000ull, "at /max_steps: expected an integer, 3000000000 is too large"},
+           {"sides", 65, "at /sides: expected an integer in [3, 64], got 65"},
+           {"voxel_size", 1e-9, "at /voxel_size: expected 0 or a number in [1e-06, 1e+06], got 1e-09"},
+           {"threads", 2.5, "at /threads: expected an integer, got 2.5"}}) {
+    const auto bad = growbench("suite -q -o " + (dir / "bad").string() + " " +
+                               suite_file(dir, {{"algorithms", algos}, {key, value}}));
+    EXPECT_EQ(bad.status, 2) << key << ": " << bad.out;
+    EXPECT_NE(bad.out.find(expect), std::string::npos) << key << ": " << bad.out;
+  }
 }
 
 TEST(Suite, ShardsMergeIntoTheUnshardedRun) {

@@ -73,7 +73,7 @@ plain_record = json.load(open(os.path.join(work, "run-plain", "record.json")))
 check(errors(plain_record, "trial_record") == [], f"--glb plain's record validates: {errors(plain_record, 'trial_record')[:5]}")
 check(plain_record["output_bytes"]["glb_plain"] == plain_record["output_bytes"]["glb"] ==
       run_record["output_bytes"]["glb_plain"], "the plain size is the same whichever layout was written")
-# A trial spec names its layout only when it is not the default; an unknown one does not validate.
+# A trial spec names its layout; an unknown one does not validate.
 with_layout = copy.deepcopy(results)
 with_layout["trials"][0]["spec"]["glb"] = "plain"
 check(errors(with_layout) == [], f"a spec with a layout validates: {errors(with_layout)[:5]}")
