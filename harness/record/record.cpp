@@ -379,7 +379,12 @@ class SchemaBuilder {
     if (!s.contains("$ref")) apply_rule(s, ValueRule::of(f));
     if constexpr (f.has(kConstDefault)) s = {{"const", value_json(defaults_of<T>().*f.member)}};
     if (!f.schema.empty()) s.update(json::parse(f.schema));
-    if (f.has(kNullable)) s = {{"anyOf", json::array({s, {{"type", "null"}}})}};
+    if (f.has(kNullable)) {
+      json either = json::array();  // not built from an initializer list holding `s`, which it would replace
+      either.push_back(std::move(s));
+      either.push_back({{"type", "null"}});
+      s = {{"anyOf", std::move(either)}};
+    }
     if (!f.doc.empty()) s["description"] = std::string(f.doc);
     return s;
   }
