@@ -46,6 +46,15 @@ struct OutputRequest {
   bool frame = false;  // a growth frame: only the images plant().decals name (what renders of it need)
 };
 
+// The algorithm's own word on the plant it grew, after finish(): why the scene is one it cannot grow on
+// (not_applicable: an L-system wrap with nothing climbable to wrap onto), and the checks of its own that
+// the plant failed (space colonization: no attraction point reached). The harness adds its general
+// checks (harness/output/validity.hpp) and records the verdict.
+struct OwnVerdict {
+  std::string not_applicable;           // empty: a scene it can grow on
+  std::vector<std::string> degenerate;  // each own check the plant failed
+};
+
 class GrowthAlgorithm {
  public:
   virtual ~GrowthAlgorithm() = default;
@@ -72,6 +81,8 @@ class GrowthAlgorithm {
   virtual void finish() {}
   // Algorithm-specific figures for the trial record (e.g. attraction points left).
   [[nodiscard]] virtual std::vector<std::pair<std::string, double>> stats() const { return {}; }
+  // Its word on the plant as grown (OwnVerdict above); called after finish().
+  [[nodiscard]] virtual OwnVerdict own_verdict() const { return {}; }
   // Files only this algorithm makes, for the plant as it is now (the vines' texture, its normal map and
   // its skeleton as SVG). The image of each of plant().decals must be among them, named prefix + image.
   // Called in the export phase (timed there) and, for each growth frame, with frame set.

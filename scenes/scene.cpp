@@ -126,6 +126,12 @@ Aabb Scene::bounds() const {
   return b;
 }
 
+bool Scene::has_climbable() const {
+  for (const auto& m : meshes)
+    if (m.climbable) return true;
+  return false;
+}
+
 std::size_t Scene::triangle_count() const {
   std::size_t n = 0;
   for (const auto& m : meshes) n += m.triangles.size();

@@ -117,6 +117,8 @@ struct Scene {
   Camera camera;
 
   [[nodiscard]] Aabb bounds() const;
+  // Whether any mesh is climbable: a scene of ground alone (envelope) offers nothing to climb.
+  [[nodiscard]] bool has_climbable() const;
   [[nodiscard]] std::size_t triangle_count() const;
   // A hash of everything that defines the scene's content (geometry, seeds, light, envelope, zones,
   // camera), as 16 hex digits. Two scenes with the same hash grow the same plants.

@@ -173,13 +173,32 @@ Scene build_boulder(const Params& p) {
     phases[i] = static_cast<float>(rng.uniform(0.0, 6.283));
   }
   const glm::vec3 centre(0.0f, 0.75f * r, 0.0f);
-  for (auto& v : b.vertices) {
+  // The rock's surface in the direction of unit vector u from its centre.
+  auto surface = [&](const glm::vec3& u) {
     float bump = 0.0f;
-    for (int i = 0; i < 6; ++i) bump += std::sin(glm::dot(dirs[i], v) + phases[i]) / 6.0f;
-    v = centre + v * r * (1.0f + rough * bump) * glm::vec3(1.0f, 0.85f, 1.0f);
-  }
+    for (int i = 0; i < 6; ++i) bump += std::sin(glm::dot(dirs[i], u) + phases[i]) / 6.0f;
+    return centre + u * r * (1.0f + rough * bump) * glm::vec3(1.0f, 0.85f, 1.0f);
+  };
+  for (auto& v : b.vertices) v = surface(v);
   s.meshes.push_back(std::move(b));
-  seeds_around(s, static_cast<int>(p.integer("seeds")), 0.0f, 0.0f, r * 1.25f, 0.02f);
+  // Seeds at the rock's foot, 3 cm out from where its surface is 2 cm above the ground (found by bisecting
+  // the elevation below the equator, where the height rises with it): a climber starts at what it climbs.
+  // They lean out (56 degrees from the vertical), so that a free-growing shoot rising from the seed passes
+  // the bulge above it rather than growing into it.
+  const int n = static_cast<int>(p.integer("seeds"));
+  for (int i = 0; i < n; ++i) {
+    const float a = 0.3f + 2.0f * std::numbers::pi_v<float> * static_cast<float>(i) / static_cast<float>(n);
+    const glm::vec3 out(std::cos(a), 0.0f, std::sin(a));
+    float lo = -0.5f * std::numbers::pi_v<float>, hi = 0.0f;
+    for (int k = 0; k < 40; ++k) {
+      const float mid = 0.5f * (lo + hi);
+      (surface(std::cos(mid) * out + glm::vec3(0.0f, std::sin(mid), 0.0f)).y < 0.02f ? lo : hi) = mid;
+    }
+    const glm::vec3 foot = surface(std::cos(hi) * out + glm::vec3(0.0f, std::sin(hi), 0.0f));
+    s.seeds.push_back({{foot.x + 0.03f * out.x, 0.02f, foot.z + 0.03f * out.z},
+                       glm::normalize(glm::vec3(0.0f, 1.0f, 0.0f) + 1.5f * out),
+                       0});
+  }
   s.envelope = ellipsoid_shape(centre, glm::vec3(1.4f * r));
   s.camera = {{0.0f, 1.6f * r + 0.5f, 4.5f * r + 1.0f}, {0.0f, 0.6f * r, 0.0f}, 45.0f};
   return s;

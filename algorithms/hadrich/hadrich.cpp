@@ -202,7 +202,13 @@ class HadrichAlgorithm final : public GrowthAlgorithm {
   void start(const Scene& scene, const SceneQuery& query, const Params& params, std::uint64_t seed) override {
     if (!query.has_sdf()) throw InputError("hadrich: the scene query has no distance field (collision needs one)");
     sim_ = std::make_unique<hadrich::Simulator>(scene, query, hadrich::make_setup(params), seed);
+    not_applicable_ = scene.has_climbable() ? ""
+                                            : fmt::format(
+                                                  "nothing to climb: scene '{}' has no climbable surface, "
+                                                  "and a climbing plant without support lies on the ground",
+                                                  scene.name);
   }
+  OwnVerdict own_verdict() const override { return {not_applicable_, {}}; }
   bool step() override { return sim_->step(); }
   const Plant& plant() const override { return sim_ ? sim_->plant() : empty_; }
   std::size_t node_count() const override { return sim_ ? sim_->node_count() : 0; }
@@ -211,6 +217,7 @@ class HadrichAlgorithm final : public GrowthAlgorithm {
 
  private:
   std::unique_ptr<hadrich::Simulator> sim_;
+  std::string not_applicable_;
   Plant empty_;
 };
 

@@ -305,7 +305,12 @@ class IvyAlgorithm final : public GrowthAlgorithm {
     const ivy::Config cfg = ivy::make_config(params, scene);
     geometry_ = ivy::make_embree_geometry(query, *table_, cfg);
     grower_ = std::make_unique<ivy::Grower>(scene, *geometry_, *table_, cfg, seed);
+    not_applicable_ =
+        scene.has_climbable()
+            ? ""
+            : fmt::format("nothing to climb: scene '{}' has no climbable surface, only ground", scene.name);
   }
+  OwnVerdict own_verdict() const override { return {not_applicable_, {}}; }
   bool step() override { return grower_->step(); }
   const Plant& plant() const override { return grower_ ? grower_->plant() : empty_; }
   void finish() override { grower_->finish(); }
@@ -315,6 +320,7 @@ class IvyAlgorithm final : public GrowthAlgorithm {
   std::unique_ptr<ivy::TriangleTable> table_;
   std::unique_ptr<ivy::Geometry> geometry_;
   std::unique_ptr<ivy::Grower> grower_;
+  std::string not_applicable_;
   Plant empty_;
 };
 

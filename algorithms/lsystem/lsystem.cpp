@@ -39,7 +39,7 @@ const AlgorithmInfo kInfo = {
     .name = "lsystem",
     .summary =
         "L-system, Houdini dialect: parametric, stochastic, context-sensitive rules, 3D turtle, J/K/M organs, "
-        "in(), wrap",
+        "in(), wrap, avoid",
     .params =
         {
             param::text("grammar").doc(
@@ -94,8 +94,9 @@ const AlgorithmInfo kInfo = {
                 .range(-1e6, 1e6)
                 .unit("m")
                 .doc("where the turtle starts when start=origin"),
-            param::choice("surface", "free", {"free", "wrap"})
-                .doc("free: the turtle moves in space; wrap: every move is mapped onto the nearest scene surface"),
+            param::choice("surface", "free", {"free", "wrap", "avoid"})
+                .doc("free: the turtle moves in space; wrap: every move is mapped onto the nearest scene surface; "
+                     "avoid: a branch ends before a step that would enter a solid"),
             param::real("wrap_offset", 0.01).range(0, 10).unit("m").doc("distance kept from the surface when wrapping"),
             param::choice("in_test", "auto", {"auto", "envelope", "solids"})
                 .doc("what in(x,y,z) tests: the scene envelope, the scene's solids, or auto (envelope if any, else "
@@ -339,7 +340,8 @@ Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* quer
   env[lsys::kVarWidth] = p.real("thickness");
   for (std::size_t k = 0; k < user_values.size(); ++k) env[lsys::kUserVar0 + k] = user_values[k];
 
-  if (p.text("surface") == "wrap" && !query) throw InputError("surface=wrap needs a scene with surfaces");
+  if (p.text("surface") != "free" && !query)
+    throw InputError(fmt::format("surface={} needs a scene with surfaces", p.text("surface")));
   for (const char c : p.text("group_prefix"))
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_'))
       throw InputError(
@@ -368,6 +370,7 @@ Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* quer
       .heading = glm::dvec3(0.0, 1.0, 0.0),
       .wrap = p.text("surface") == "wrap" ? query : nullptr,
       .wrap_offset = p.real("wrap_offset"),
+      .avoid = p.text("surface") == "avoid" ? query : nullptr,
       .birth_step = 0,
       .organ_kind = {},
       .organ_shape = {},
@@ -396,6 +399,9 @@ class LSystem final : public GrowthAlgorithm {
 
   void start(const Scene& scene, const SceneQuery& query, const Params& params, std::uint64_t seed) override {
     setup_ = make_setup(params, seed, &query);
+    not_applicable_.clear();
+    if (params.text("surface") == "wrap" && !scene.has_climbable())
+      not_applicable_ = fmt::format("surface=wrap: scene '{}' has no climbable surface to wrap onto", scene.name);
     deriver_ = std::make_unique<lsys::Deriver>(setup_.grammar, setup_.derive);
     plants_.clear();
     if (setup_.params.text("start") == "origin" || scene.seeds.empty()) {
@@ -455,6 +461,8 @@ class LSystem final : public GrowthAlgorithm {
     }
   }
 
+  OwnVerdict own_verdict() const override { return {not_applicable_, {}}; }
+
   static StringRewriting string_rewriting() { return {derive_lsystem, lsystem_examples}; }
 
   std::vector<std::pair<std::string, double>> stats() const override {
@@ -504,6 +512,7 @@ class LSystem final : public GrowthAlgorithm {
   }
 
   Setup setup_;
+  std::string not_applicable_;  // OwnVerdict
   std::unique_ptr<lsys::Deriver> deriver_;
   std::vector<Plantlet> plants_;
   Plant plant_;

@@ -162,6 +162,7 @@ void BM_LsysTurtle(benchmark::State& state) {
                              .heading = glm::dvec3(0.0, 1.0, 0.0),
                              .wrap = nullptr,
                              .wrap_offset = 0.0,
+                             .avoid = nullptr,
                              .birth_step = 0,
                              .organ_kind = {OrganKind::Leaf, OrganKind::Flower, OrganKind::Bud},
                              .organ_shape = {kKindShape, kKindShape, kKindShape}};

@@ -522,6 +522,37 @@ TEST_F(LSystemTurtle, SurfaceWrapKeepsNodesOnTheSurface) {
   }
 }
 
+TEST_F(LSystemTurtle, SurfaceAvoidEndsABranchBeforeASolid) {
+  // Two straight branches from 0.62 m in front of the wall (its faces at z = +-0.1): '&' heads one at the
+  // wall (-Z) and '^' the other away (+Z), 30 steps of 5 cm each.
+  const Scene wall = load_scene("wall");
+  const SceneQuery q(wall);
+  const std::vector<std::string> params = {"start=origin", "start_position=0,1,0.62", "premise=[&(90)A][^(90)A]",
+                                           "rules=A = F(0.05)A", "generations=30"};
+  auto z_range = [](const Plant& p, bool toward) {
+    float nearest = 1e9f, farthest = -1e9f;
+    std::size_t n = 0;
+    for (const auto& nd : p.nodes)
+      if ((nd.position.z < 0.6f) == toward) {
+        nearest = std::min(nearest, nd.position.z), farthest = std::max(farthest, nd.position.z), ++n;
+      }
+    return std::tuple{nearest, farthest, n};
+  };
+  auto free = params, avoid = params;
+  free.push_back("surface=free");
+  avoid.push_back("surface=avoid");
+  const Plant through = test::grow("lsystem", wall, q, free);
+  const Plant stopped = test::grow("lsystem", wall, q, avoid);
+  EXPECT_LT(std::get<0>(z_range(through, true)), -0.5f) << "a free turtle passes through the wall";
+  const auto [near_z, far_z, n] = z_range(stopped, true);
+  EXPECT_GT(near_z, 0.1f) << "no node in or behind the wall";
+  EXPECT_LE(near_z, 0.1f + 0.05f + 1e-4f) << "the branch goes on until the step that would enter it";
+  EXPECT_EQ(n, 10u) << "ten steps of 5 cm from z = 0.62 end at z = 0.12; the eleventh would end in the wall";
+  EXPECT_EQ(std::get<2>(z_range(stopped, false)), std::get<2>(z_range(through, false)))
+      << "the branch heading away is untouched";
+  for (const auto& nd : stopped.nodes) EXPECT_FALSE(q.inside(nd.position));
+}
+
 TEST(LSystemExamples, EveryExampleGrows) {
   const auto names = lsystem_examples();
   ASSERT_GE(names.size(), 6u);

@@ -119,6 +119,11 @@ class Interpreter {
                             "within +-{:g}",
                             m, c, len, t.pos.x, t.pos.y, t.pos.z, std::numeric_limits<float>::max()));
           if (s_.wrap) snap(t);
+          if (s_.avoid && enters_solid(before, t.pos)) {  // the branch ends before the solid
+            t.pos = before;
+            skip_branch(t, m, p);
+            break;
+          }
           if (c == 'F' || c == 'H' || c == 'G') t.arc += glm::length(t.pos - before);
           if (draw)
             t.node = add_node(t.pos, width, t.node, t, k > 2 ? tube_shape(a, k) : TubeShape{});
@@ -234,20 +239,9 @@ class Interpreter {
         case '#':
           t.v += k > 0 ? a[0] : s_.uv_increment.y;
           break;
-        case '%': {  // skip to the end of this branch; its ']' then pops as usual
-          int depth = 0;
-          while (m + 1 < n) {
-            const std::uint16_t w2 = sym[m + 1];
-            const char c2 = symbol_of(w2);
-            if (c2 == ']' && depth == 0) break;
-            if (c2 == '[') ++depth;
-            if (c2 == ']') --depth;
-            ++m;
-            p += static_cast<std::size_t>(count_of(w2));
-            if (states_) record(t, m);
-          }
+        case '%':  // skip to the end of this branch; its ']' then pops as usual
+          skip_branch(t, m, p);
           break;
-        }
         case '$': {
           if (k >= 3) {
             const glm::dvec3 d = glm::dvec3(a[0], a[1], a[2]) - t.pos;
@@ -379,7 +373,30 @@ class Interpreter {
     return static_cast<std::int32_t>(plant_.nodes.size() - 1);
   }
   void snap_start(State& t) { snap(t); }
-  // Maps the position onto the nearest surface, offset along the direction away from it, and turns the
+
+  // Moves the module cursor (m, p) to the last module of the current branch, so that its ']' pops next;
+  // the skipped modules see the turtle as it stands.
+  void skip_branch(const State& t, std::size_t& m, std::size_t& p) {
+    const std::uint16_t* sym = str_.symbols.data();
+    const std::size_t n = str_.size();
+    int depth = 0;
+    while (m + 1 < n) {
+      const std::uint16_t w2 = sym[m + 1];
+      const char c2 = symbol_of(w2);
+      if (c2 == ']' && depth == 0) break;
+      if (c2 == '[') ++depth;
+      if (c2 == ']') --depth;
+      ++m;
+      p += static_cast<std::size_t>(count_of(w2));
+      if (states_) record(t, m);
+    }
+  }
+
+  // Whether a step from `a` to `b` ends in a solid or passes through one at its midpoint (a thin wall).
+  bool enters_solid(const glm::dvec3& a, const glm::dvec3& b) const {
+    return s_.avoid->inside(glm::vec3(b)) || s_.avoid->inside(glm::vec3(0.5 * (a + b)));
+  }
+  // Maps the position onto the nearest climbable surface, offset along the direction away from it, and turns the
   // frame so the heading is tangent there (the minimal rotation, so the turtle keeps its roll). The
   // projection repeats (up to 6 times; a point inside a solid first leaves it along the SDF gradient) until the point
   // is wrap_offset from its nearest surface, which settles points in concave corners, where the offset from one face
@@ -393,7 +410,9 @@ class Interpreter {
         t.pos += glm::dvec3(s_.wrap->gradient(glm::vec3(t.pos))) * (static_cast<double>(-sd) + s_.wrap_offset);
         continue;
       }
-      const ClosestHit hit = s_.wrap->closest_point(glm::vec3(t.pos));
+      // The climbable surfaces only: a wrap follows what the plant climbs, never the ground slab.
+      const ClosestHit hit =
+          s_.wrap->closest_point(glm::vec3(t.pos), std::numeric_limits<float>::infinity(), /*climbable_only=*/true);
       if (!hit.found) break;
       const glm::dvec3 cp(hit.point), nrm(hit.normal);
       const glm::dvec3 v = t.pos - cp;

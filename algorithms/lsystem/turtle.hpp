@@ -11,7 +11,8 @@
 // without recording one; f and h move without drawing. Node radius = width / 2. J, K, M place the organs
 // their kinds and shapes name, by default a leaf, a flower and a bud (blade +Z along H, +Y along U), scaled by their
 // first parameter (default: the current step length) and stamped with their third to fifth parameters. '%' skips to the
-// end of the branch (the reference's "cut off remainder of branch", applied when drawing).
+// end of the branch (the reference's "cut off remainder of branch", applied when drawing); with surface=avoid, so does
+// a step that would end in a solid or cross one at its midpoint, and the step is not taken.
 #pragma once
 
 #include <array>
@@ -53,6 +54,7 @@ struct TurtleSettings {
   glm::dvec3 heading;
   const SceneQuery* wrap;  // when set: every move is mapped onto the nearest surface
   double wrap_offset;
+  const SceneQuery* avoid;  // when set: a step into a solid cuts the rest of its branch, as '%' does
   std::uint32_t birth_step;
   std::array<OrganKind, 3> organ_kind;       // what J, K and M place
   std::array<std::uint16_t, 3> organ_shape;  // their shapes: Plant::organ_shapes indices, or kKindShape

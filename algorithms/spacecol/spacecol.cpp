@@ -161,6 +161,7 @@ class SpaceColonization final : public PortableGrowthAlgorithm {
     scene_ = &scene;
     query_ = &query;
     seed_ = seed;
+    not_applicable_.clear();
     cfg_ = spacecol::make_config(p);
     if (cfg_.kill >= cfg_.influence)
       throw InputError(fmt::format("algorithm 'spacecol': kill ({}) must be smaller than influence ({})", cfg_.kill,
@@ -207,6 +208,13 @@ class SpaceColonization final : public PortableGrowthAlgorithm {
 
   const Plant& plant() const override { return plant_; }
 
+  OwnVerdict own_verdict() const override {
+    OwnVerdict v{not_applicable_, {}};
+    if (!pts_.empty() && alive_count_ == pts_.size())
+      v.degenerate.push_back(fmt::format("attraction: none of the {} attraction points was reached", pts_.size()));
+    return v;
+  }
+
   std::vector<std::pair<std::string, double>> stats() const override {
     return {{"attraction_points", static_cast<double>(pts_.size())},
             {"attraction_points_left", static_cast<double>(alive_count_)},
@@ -240,11 +248,14 @@ class SpaceColonization final : public PortableGrowthAlgorithm {
         if (ok[i]) pts_.push_back(cand[i]);
       next += batch;
     }
-    if (pts_.empty())
-      throw InputError(
-          fmt::format("algorithm 'spacecol': no attraction point could be placed {} of scene '{}' "
-                      "(all candidates fell inside solids or outside the include zones)",
-                      what, scene_->name));
+    // A point is never kept inside a solid; when most of the region is solid, the few points left would
+    // grow a plant that answers none of what was asked (a lone stalk toward the last point).
+    if (2 * pts_.size() < count)
+      throw InputError(fmt::format(
+          "algorithm 'spacecol': only {} of {} attraction points could be placed {} of scene '{}' in {} tries: the "
+          "other candidates fell inside solids or outside the include zones; keep the region clear of solid meshes, "
+          "or ask for fewer points",
+          pts_.size(), count, what, scene_->name, next));
   }
 
   void sample_points(const std::string& points_file) {
@@ -278,6 +289,10 @@ class SpaceColonization final : public PortableGrowthAlgorithm {
       pts_.erase(std::remove_if(pts_.begin(), pts_.end(), [](const glm::vec3& v) { return std::isnan(v.x); }),
                  pts_.end());
     } else if (mode == Points::Surface) {
+      // With no climbable mesh, the samples would lie on the ground: a carpet, not what surface points mean.
+      if (!scene_->has_climbable())
+        not_applicable_ =
+            fmt::format("points on the surfaces: scene '{}' has no climbable surface, only ground", scene_->name);
       const float off = cfg_.surface_offset;
       sample_accepted(
           count,
@@ -780,6 +795,7 @@ class SpaceColonization final : public PortableGrowthAlgorithm {
   bool ever_influenced_ = false;
 
   std::vector<glm::vec3> pts_;
+  std::string not_applicable_;  // why this scene is not one it can grow on (OwnVerdict)
   // The points file as load_inputs() read it, until start_with() takes it.
   bool loaded_ = false;
   std::string loaded_path_;

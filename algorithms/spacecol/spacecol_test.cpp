@@ -224,6 +224,29 @@ TEST(SpaceColonization, BadParameterCombinationsAreInputErrors) {
   }
 }
 
+// An envelope that is also a solid mesh of the scene: almost every candidate point is inside the solid, and
+// the few left would grow a stalk toward nothing asked for. The run is refused and says why.
+TEST(SpaceColonization, PointsInsideASolidAreRefusedNotKept) {
+  Scene s = open_space({{0, -0.5f, 0}});
+  s.meshes.push_back(geom::make_box("block", {-1, 0, -1}, {1, 2, 1}));
+  Shape env;
+  env.kind = Shape::Kind::Box;
+  env.min = {-1, 0, -1};
+  env.max = {1, 2, 1};
+  s.envelope = env;
+  const SceneQuery q(s);
+  try {
+    grow("spacecol", s, q, {"points=envelope", "point_count=5000"});
+    FAIL() << "expected an error";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("of 5000 attraction points could be placed in the envelope of scene 'space'"),
+              std::string::npos)
+        << what;
+    EXPECT_NE(what.find("fell inside solids"), std::string::npos) << what;
+  }
+}
+
 // The harness calls load_inputs() in the scene_load phase: after it, growth reads no file (this one is
 // gone by then) and grows the plant that reading the file in start() grows.
 TEST(SpaceColonization, PointsFileIsReadBeforeGrowth) {

@@ -258,6 +258,14 @@ class Vines final : public GrowthAlgorithm {
   std::size_t node_count() const override { return growers_.size(); }
   std::size_t organ_count() const override { return finished_ ? plant().organs.size() : 0; }
 
+  OwnVerdict own_verdict() const override {
+    if (mesh_ != kNone || climbable_) return {};
+    return {fmt::format("a canvas needs a climbable surface to lie on, and scene '{}' has none: the vines would be "
+                        "drawn on a card standing free",
+                        scene_->name),
+            {}};
+  }
+
   std::vector<std::pair<std::string, double>> stats() const override {
     std::size_t tips = 0, stopped = 0;
     for (std::size_t g = 0; g < growers_.size(); ++g) {
@@ -321,7 +329,7 @@ class Vines final : public GrowthAlgorithm {
       plant_.decals.push_back({"texture.png", mesh_, {}, {}, {}});
     } else {
       canvas_ = canvas_of(*scene_);
-      climbable_ = std::any_of(scene_->meshes.begin(), scene_->meshes.end(), [](const auto& m) { return m.climbable; });
+      climbable_ = scene_->has_climbable();
       surface_ =
           std::make_unique<vines::Surface>(vines::Surface::canvas(canvas_.origin, canvas_.u_axis, canvas_.v_axis));
       plant_.decals.push_back({"texture.png", kPlanarDecal, canvas_.origin, canvas_.u_axis, canvas_.v_axis});

@@ -132,6 +132,7 @@ const GatedField kBehaviour[] = {
     {"geometry_hash", [](const BaselineCell& c) { return json_of(c.geometry_hash); }},
     {"counts", [](const BaselineCell& c) { return json_of(c.counts); }},
     {"metrics", [](const BaselineCell& c) { return json_of(c.metrics); }},
+    {"verdict", [](const BaselineCell& c) { return json_of(c.verdict); }},
 };
 const GatedField kOutputBytes = {"output_bytes", [](const BaselineCell& c) { return json_of(c.output_bytes); }};
 const GatedField kAlloc = {"alloc", [](const BaselineCell& c) { return json_of(c.alloc); }};

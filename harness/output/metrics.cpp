@@ -24,6 +24,11 @@ float point_segment_distance(const glm::vec3& p, const glm::vec3& a, const glm::
   return glm::length(p - (a + t * ab));
 }
 
+// A fraction of `of`, or null (not applicable) when there is nothing to take a fraction of.
+nlohmann::json ratio(std::size_t count, std::size_t of) {
+  return of == 0 ? nlohmann::json() : nlohmann::json(static_cast<double>(count) / static_cast<double>(of));
+}
+
 double quantile(std::vector<float> v, double q) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -150,7 +155,8 @@ class MetricsPass {
 
   void coverage() {
     // Coverage.
-    const int ns = query.sampled_area() > 0.0 ? o.coverage_samples : 0;
+    // Of the climbable surfaces only: a scene with none (the ground alone) has nothing to cover.
+    const int ns = query.scene().has_climbable() && query.sampled_area() > 0.0 ? o.coverage_samples : 0;
     covered.assign(static_cast<std::size_t>(ns), 0);
     if (tree) {
       tbb::parallel_for(0, ns, [&](int i) {
@@ -164,7 +170,7 @@ class MetricsPass {
     }
     std::size_t cov = 0;
     for (const auto c : covered) cov += c;
-    m["coverage"] = ns > 0 ? static_cast<double>(cov) / ns : 0.0;
+    m["coverage"] = ratio(cov, static_cast<std::size_t>(ns));  // n/a in a scene with nothing to cover
   }
 
   void adhesion_and_penetration() {
@@ -183,11 +189,11 @@ class MetricsPass {
       sum += dist[i];
     }
     const double n = std::max<double>(1.0, static_cast<double>(nodes.size()));
-    m["adhesion_mean_m"] = nodes.empty() ? 0.0 : sum / n;
-    m["adhesion_median_m"] = quantile(dist, 0.5);
-    m["adhesion_p90_m"] = quantile(dist, 0.9);
-    m["attached_fraction"] = nodes.empty() ? 0.0 : static_cast<double>(attached) / n;
-    m["penetration_nodes"] = nodes.empty() ? 0.0 : static_cast<double>(inside_nodes) / n;
+    m["adhesion_mean_m"] = nodes.empty() ? nlohmann::json() : nlohmann::json(sum / n);
+    m["adhesion_median_m"] = nodes.empty() ? nlohmann::json() : nlohmann::json(quantile(dist, 0.5));
+    m["adhesion_p90_m"] = nodes.empty() ? nlohmann::json() : nlohmann::json(quantile(dist, 0.9));
+    m["attached_fraction"] = ratio(attached, nodes.size());
+    m["penetration_nodes"] = ratio(inside_nodes, nodes.size());
     const auto ss = static_cast<std::size_t>(std::max(0, o.segment_samples));
     sample_inside.assign(seg.size() * ss, 0);
     tbb::parallel_for(std::size_t{0}, seg.size(), [&](std::size_t k) {
@@ -199,8 +205,7 @@ class MetricsPass {
     });
     std::size_t inside_samples = 0;
     for (const auto c : sample_inside) inside_samples += c;
-    const double total_samples = static_cast<double>(sample_inside.size());
-    m["penetration_samples"] = total_samples > 0 ? static_cast<double>(inside_samples) / total_samples : 0.0;
+    m["penetration_samples"] = ratio(inside_samples, sample_inside.size());
   }
 
   void self_intersection() {
@@ -250,7 +255,7 @@ class MetricsPass {
       inv += involved[k].load(std::memory_order_relaxed);
     }
     m["self_intersections"] = pairs;
-    m["self_intersection_fraction"] = seg.empty() ? 0.0 : static_cast<double>(inv) / static_cast<double>(seg.size());
+    m["self_intersection_fraction"] = ratio(inv, seg.size());
   }
 
   void leaf_metrics() {
@@ -343,10 +348,9 @@ class MetricsPass {
       li += lit[i];
       ls += lit_scene[i];
     }
-    const double nl = static_cast<double>(leaf.size());
-    m["leaf_overlap"] = leaf.empty() ? 0.0 : static_cast<double>(ov) / nl;
-    m["leaf_light_exposure"] = leaf.empty() ? 0.0 : static_cast<double>(li) / nl;
-    m["leaf_light_exposure_scene"] = leaf.empty() ? 0.0 : static_cast<double>(ls) / nl;
+    m["leaf_overlap"] = ratio(ov, leaf.size());  // n/a without leaves: no overlap is not the best overlap
+    m["leaf_light_exposure"] = ratio(li, leaf.size());
+    m["leaf_light_exposure_scene"] = ratio(ls, leaf.size());
   }
 
   void keep(MetricDetails& d) {

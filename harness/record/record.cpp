@@ -421,11 +421,14 @@ std::string csv_scalar(const json& j) {
   return j.is_string() ? j.get<std::string>() : j.dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
-// Each scalar reachable from `v` as a column named by its dotted path; arrays are not columns.
+// Each scalar reachable from `v` as a column named by its dotted path; arrays are not columns, but for a
+// list of strings, joined.
 template <class T>
 void csv_cells(const T& v, const std::string& name, CsvRow& out) {
   if constexpr (is_optional<T>::value) {
     if (v) csv_cells(*v, name, out);
+  } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+    if (!v.empty()) out.emplace_back(name, fmt::format("{}", fmt::join(v, "; ")));  // a list of reasons, say
   } else if constexpr (is_vector<T>::value || is_std_array<T>::value) {
   } else if constexpr (is_string_map<T>::value) {
     for (const auto& [k, x] : v) csv_cells(x, name + "." + k, out);
@@ -484,6 +487,7 @@ GROWBENCH_RECORD_TYPE(RenderRecord)
 GROWBENCH_RECORD_TYPE(AnimationRecord)
 GROWBENCH_RECORD_TYPE(Media)
 GROWBENCH_RECORD_TYPE(OrganPassRecord)
+GROWBENCH_RECORD_TYPE(Verdict)
 GROWBENCH_RECORD_TYPE(TrialResults)
 GROWBENCH_RECORD_TYPE(TrialRecord)
 GROWBENCH_RECORD_TYPE(AllocCount)

@@ -208,6 +208,12 @@ struct RunContext {
   std::optional<bool> mixed_machines;  // merged shards that ran on different machines or builds
   // Every plugin loaded: a result says exactly what ran (absent when there were none).
   std::vector<PluginOrigin> plugins;
+  // The machine's state, where it can be read: the load averages (1, 5, 15 minutes) when the run began and
+  // when it ended, the first core's clock and frequency governor. A loaded machine's timings are not a quiet
+  // one's, and `summary` and the report say so.
+  std::optional<std::array<double, 3>> load_average_start, load_average_end;
+  std::optional<double> cpu_mhz;
+  std::optional<std::string> cpu_governor;
 
   static constexpr std::string_view kSchemaName = "context";
   static constexpr auto fields() {
@@ -229,7 +235,11 @@ struct RunContext {
         field("suite_file_hash", &R::suite_file_hash).refine(kHashSchema),
         field("parent_threads_at_fork", &R::parent_threads_at_fork),
         field("mixed_machines", &R::mixed_machines),
-        field("plugins", &R::plugins).with(kOmitEmpty)};
+        field("plugins", &R::plugins).with(kOmitEmpty),
+        field("load_average_start", &R::load_average_start).in(0, kNoBound),
+        field("load_average_end", &R::load_average_end).in(0, kNoBound),
+        field("cpu_mhz", &R::cpu_mhz).in(0, kNoBound),
+        field("cpu_governor", &R::cpu_governor)};
   }
 };
 
@@ -322,6 +332,23 @@ struct OrganPassRecord {
   }
 };
 
+// Whether the plant a trial grew is one its numbers may stand for (harness/output/validity.hpp; the checks
+// and their thresholds are in docs/metrics.md): valid, degenerate (a plant that failed: flat, inside a solid,
+// never reached its surface), or not_applicable (the algorithm cannot grow on this scene, by its own word).
+// Only valid plants enter comparisons across cells: medians over seeds, fits, figures.
+inline constexpr std::array<std::string_view, 3> kVerdicts = {"valid", "degenerate", "not_applicable"};
+struct Verdict {
+  std::string status = "valid";
+  std::vector<std::string> reasons;  // each failed check, or why the scene is not applicable
+
+  [[nodiscard]] bool valid() const { return status == "valid"; }
+  static constexpr std::string_view kSchemaName = "verdict";
+  static constexpr auto fields() {
+    return std::tuple{field("status", &Verdict::status).one_of(kVerdicts),
+                      field("reasons", &Verdict::reasons).with(kOmitEmpty)};
+  }
+};
+
 // What a trial grew and what the plant measures: the same for every successful repetition of a cell, so a
 // suite keeps it once per cell. A trial's record and a cell's results both hold it, field for field.
 struct TrialResults {
@@ -337,6 +364,7 @@ struct TrialResults {
   std::map<std::string, double> algorithm_stats;
   std::uint64_t threads = 0;              // the threads it ran with
   std::optional<OrganPassRecord> organs;  // only when the pass ran (an organ option was given)
+  std::optional<Verdict> verdict;         // absent in files written before plants were judged
 
   static constexpr std::string_view kSchemaName = "trial_results";
   static constexpr auto fields() {
@@ -352,7 +380,8 @@ struct TrialResults {
                       field("params", &T::params).with(kNoCsv),
                       field("algorithm_stats", &T::algorithm_stats),
                       field("threads", &T::threads),
-                      field("organs", &T::organs)};
+                      field("organs", &T::organs),
+                      field("verdict", &T::verdict)};
   }
 };
 
@@ -635,7 +664,7 @@ struct ResultsSummary {
   static constexpr auto fields() {
     return std::tuple{field("growth_s_over_seeds", &ResultsSummary::growth_s_over_seeds)
                           .describe("Per algorithm entry (and sweep point) and scene: the growth time of every ok "
-                                    "repetition of its ok cells (one per seed), pooled.")};
+                                    "repetition of its ok cells (one per seed) whose plants are valid, pooled.")};
   }
 };
 
@@ -701,6 +730,7 @@ struct BaselineCell {
   std::optional<std::string> geometry_hash;
   std::optional<Counts> counts;
   std::optional<nlohmann::json> metrics;
+  std::optional<Verdict> verdict;
   std::optional<OutputBytes> output_bytes;
   std::optional<AllocByPhase> alloc;
   std::optional<InstructionCounts> instructions;
@@ -718,6 +748,7 @@ struct BaselineCell {
                       field("geometry_hash", &B::geometry_hash).refine(kHashSchema),
                       field("counts", &B::counts),
                       field("metrics", &B::metrics),
+                      field("verdict", &B::verdict),
                       field("output_bytes", &B::output_bytes),
                       field("alloc", &B::alloc),
                       field("instructions", &B::instructions)};

@@ -914,6 +914,20 @@ void draw_missing(cairo_t* c, const std::string& note, double x0, double y0, int
   centred_text(c, note, x0 + w / 2.0, y0 + h / 2.0, 13, w - 12);
 }
 
+// A band across the top of a cell's image with `text` in white: red for a degenerate plant, dark grey for
+// one otherwise left out (not applicable).
+void draw_badge(cairo_t* c, const std::string& text, double x0, double y0, int w) {
+  const double band = 22.0;
+  if (text.rfind("degenerate", 0) == 0)
+    cairo_set_source_rgba(c, 0.78, 0.1, 0.1, 0.9);
+  else
+    cairo_set_source_rgba(c, 0.25, 0.25, 0.25, 0.85);
+  cairo_rectangle(c, x0, y0, w, band);
+  cairo_fill(c);
+  cairo_set_source_rgb(c, 1, 1, 1);
+  centred_text(c, text, x0 + w / 2.0, y0 + band / 2.0, 13, w - 8);
+}
+
 void write_png(cairo_surface_t* surface, const std::string& png_path) {
   cairo_surface_flush(surface);
   AtomicFile png(png_path);
@@ -936,7 +950,8 @@ std::string at(const std::vector<std::vector<std::string>>& table, int i, int j)
 
 void write_grid(const std::string& png_path, const std::string& title, const std::vector<std::string>& row_labels,
                 const std::vector<std::string>& col_labels, const std::vector<std::vector<std::string>>& cells,
-                const std::vector<std::vector<std::string>>& notes, int cell_width) {
+                const std::vector<std::vector<std::string>>& notes, const std::vector<std::vector<std::string>>& badges,
+                int cell_width) {
   const int rows = static_cast<int>(row_labels.size()), cols = static_cast<int>(col_labels.size());
   const double aspect = image_aspect(cells);
   const int cw = cell_width, ch = static_cast<int>(std::lround(cell_width * aspect));
@@ -960,7 +975,10 @@ void write_grid(const std::string& png_path, const std::string& title, const std
     centred_text(c, row_labels[static_cast<std::size_t>(i)], label_w / 2.0, y0 + ch / 2.0, 15, label_w - 12);
     for (int j = 0; j < cols; ++j) {
       const double x0 = label_w + pad + j * (cw + pad);
-      if (draw_image(c, at(cells, i, j), x0, y0, cw, ch)) continue;
+      if (draw_image(c, at(cells, i, j), x0, y0, cw, ch)) {
+        if (const std::string badge = at(badges, i, j); !badge.empty()) draw_badge(c, badge, x0, y0, cw);
+        continue;
+      }
       const std::string note = at(notes, i, j);
       draw_missing(c, note.empty() ? "no render" : note, x0, y0, cw, ch);
     }

@@ -126,9 +126,12 @@ RenderResult render_plant(const Scene& scene, const Plant& plant, const std::str
                           const std::string& png_path, const RenderOptions& options, const std::string& work_dir = "");
 
 // One labelled image: `cells` is rows x cols PNG paths (an empty path or a missing file draws a grey
-// box with `notes[r][c]`, if given). Throws std::runtime_error naming the file it cannot write.
+// box with `notes[r][c]`, if given). A non-empty `badges[r][c]` is written in a band across the top of that
+// cell's image (a plant left out of comparisons: "degenerate" in red, anything else in grey). Throws
+// std::runtime_error naming the file it cannot write.
 void write_grid(const std::string& png_path, const std::string& title, const std::vector<std::string>& row_labels,
                 const std::vector<std::string>& col_labels, const std::vector<std::vector<std::string>>& cells,
-                const std::vector<std::vector<std::string>>& notes = {}, int cell_width = 320);
+                const std::vector<std::vector<std::string>>& notes = {},
+                const std::vector<std::vector<std::string>>& badges = {}, int cell_width = 320);
 
 }  // namespace growbench

@@ -385,25 +385,36 @@ void write_grids(const ResultsFile& doc, const fs::path& dir, const RenderOption
       return (dir / t.media.render->png).string();
     return std::string();
   };
+  // A plant left out of comparisons says so on its image (docs/metrics.md, "Validity").
+  auto badge = [&](const std::string& r, const std::string& c) {
+    const auto it = pick.find({r, c});
+    if (it == pick.end() || !it->second->results.plant || !it->second->results.plant->verdict) return std::string();
+    const std::string& v = it->second->results.plant->verdict->status;
+    return v == "valid" ? std::string() : v == "not_applicable" ? std::string("not applicable") : v;
+  };
   std::vector<std::vector<std::string>> cells(rows.size(), std::vector<std::string>(cols.size()));
-  std::vector<std::vector<std::string>> notes = cells;
+  std::vector<std::vector<std::string>> notes = cells, badges = cells;
   for (std::size_t i = 0; i < rows.size(); ++i)
-    for (std::size_t k = 0; k < cols.size(); ++k) cells[i][k] = cell(rows[i], cols[k], notes[i][k]);
+    for (std::size_t k = 0; k < cols.size(); ++k) {
+      cells[i][k] = cell(rows[i], cols[k], notes[i][k]);
+      badges[i][k] = badge(rows[i], cols[k]);
+    }
   const std::string title = fmt::format("growbench suite '{}': algorithm x scene (lowest seed), POV-Ray {}",
                                         doc.suite.name, to_string(ro.quality));
   try {
-    write_grid((dir / "grid.png").string(), title, rows, cols, cells, notes);
+    write_grid((dir / "grid.png").string(), title, rows, cols, cells, notes, badges);
     summary.grid = "grid.png";
     std::map<std::string, std::string> per_scene;
     for (std::size_t k = 0; k < cols.size(); ++k) {
-      std::vector<std::vector<std::string>> col_cells(1), col_notes(1);
+      std::vector<std::vector<std::string>> col_cells(1), col_notes(1), col_badges(1);
       for (std::size_t i = 0; i < rows.size(); ++i) {
         col_cells[0].push_back(cells[i][k]);
         col_notes[0].push_back(notes[i][k]);
+        col_badges[0].push_back(badges[i][k]);
       }
       const std::string name = "grid-" + safe_name(cols[k]) + ".png";
-      write_grid((dir / name).string(), fmt::format("{} (lowest seed)", cols[k]), {cols[k]}, rows, col_cells,
-                 col_notes);
+      write_grid((dir / name).string(), fmt::format("{} (lowest seed)", cols[k]), {cols[k]}, rows, col_cells, col_notes,
+                 col_badges);
       per_scene[cols[k]] = name;
     }
     summary.grid_per_scene = per_scene;

@@ -30,9 +30,39 @@ std::string si_bytes(double b) {
   return fmt::format("{:.1f} {}", b, u[i]);
 }
 
+// A cell's growth times as what they are: one trial, or the median of repetitions with the range of all
+// of them (fewer than 6) or the distribution-free 95% interval of the median (6 or more).
+std::string growth_text(const std::vector<double>& growth) {
+  if (growth.empty()) return "-";
+  if (growth.size() == 1) return fmt::format("{} (1 trial)", format_seconds(growth[0]));
+  bool exact = false;
+  const auto [lo, hi] = median_interval(growth, exact);
+  return fmt::format("{} {} {}, {}", format_seconds(median(growth)), exact ? "CI" : "range", format_seconds(lo),
+                     format_seconds(hi));
+}
+
 }  // namespace
 
 namespace {
+
+// A line on the machine's state when it may have slowed the run: a load average over a quarter of the
+// hardware threads before the first trial (another process was working), and the clock and governor.
+std::string machine_note(const RunContext& ctx) {
+  std::string out;
+  if (ctx.load_average_start && ctx.hardware_threads > 0 &&
+      (*ctx.load_average_start)[0] > 0.25 * static_cast<double>(ctx.hardware_threads))
+    out += fmt::format(
+        "Note: the machine was busy when the run began (load average {:.2f} over the last minute, on {} hardware "
+        "threads): its timings may be slower and noisier than a quiet machine's.\n",
+        (*ctx.load_average_start)[0], ctx.hardware_threads);
+  if (ctx.cpu_mhz || ctx.cpu_governor)
+    out += fmt::format("Machine: {}{}{}; load average at the start {}, at the end {}.\n",
+                       ctx.cpu_mhz ? fmt::format("{:.0f} MHz", *ctx.cpu_mhz) : "",
+                       ctx.cpu_mhz && ctx.cpu_governor ? ", governor " : "", ctx.cpu_governor.value_or(""),
+                       ctx.load_average_start ? fmt::format("{:.2f}", (*ctx.load_average_start)[0]) : "unknown",
+                       ctx.load_average_end ? fmt::format("{:.2f}", (*ctx.load_average_end)[0]) : "unknown");
+  return out;
+}
 
 // One cell's row of its scene's table; warnings about its repetitions go to `warnings`.
 std::string cell_row(const SuiteCell& t, std::vector<std::string>& warnings) {
@@ -52,24 +82,27 @@ std::string cell_row(const SuiteCell& t, std::vector<std::string>& warnings) {
     total.push_back(tot);
     rss.push_back(static_cast<double>(g.peak_rss_bytes));
   }
-  bool exact = false;
-  const auto [lo, hi] = median_interval(growth, exact);
   const double med = median(growth);
-  const std::string ci = growth.empty() ? "-"
-                                        : fmt::format("{} [{}{}, {}]", format_seconds(med), exact ? "" : "~",
-                                                      format_seconds(lo), format_seconds(hi));
   const std::optional<TrialResults>& r = t.results.plant;
   const json m = r && r->metrics ? *r->metrics : json::object();
   auto metric = [&](const char* k) {
-    // Metrics are open-ended in the file: a value that is not a number (a hand-edited file) shows as such.
-    return !m.contains(k) ? std::string("-") : m[k].is_number() ? fmt::format("{:.3f}", m[k].get<double>()) : "?";
+    // Open-ended in the file: null is a metric that does not apply; anything but a number (a hand-edited
+    // file) shows as such.
+    if (!m.contains(k)) return std::string("-");
+    return m[k].is_null() ? std::string("n/a") : m[k].is_number() ? fmt::format("{:.3f}", m[k].get<double>()) : "?";
   };
+  const std::string verdict = !r || !r->verdict                        ? "-"
+                              : r->verdict->status == "not_applicable" ? "n/a"
+                                                                       : r->verdict->status;
   std::string row =
-      fmt::format("{:<40} {:>6} {:>30} {:>10} {:>11} {:>8} {:>9} {:>10} {:>8} {:>8} {:>8}\n", cell.substr(0, 40),
-                  t.status, ci, format_seconds(median(total)), si_bytes(median(rss)),
+      fmt::format("{:<40} {:>6} {:>10} {:>30} {:>10} {:>11} {:>8} {:>9} {:>10} {:>8} {:>8} {:>8}\n", cell.substr(0, 40),
+                  t.status, verdict, growth_text(growth), format_seconds(median(total)), si_bytes(median(rss)),
                   r ? std::to_string(r->counts.nodes) : "-", r ? fmt::format("{:.2f}", r->total_length_m) : "-",
                   r && r->output_bytes.ply ? si_bytes(static_cast<double>(*r->output_bytes.ply)) : "-",
                   metric("coverage"), metric("attached_fraction"), metric("penetration_nodes"));
+  if (r && r->verdict && !r->verdict->valid())
+    warnings.push_back(fmt::format("{} on {}: {} ({}): left out of comparisons", cell, sc, verdict,
+                                   fmt::join(r->verdict->reasons, "; ")));
   if (growth.size() >= 2) {
     double mean = 0.0, var = 0.0;
     for (const double g : growth) mean += g;
@@ -126,18 +159,30 @@ std::string summarize_results(const ResultsFile& results) {
     if (!by_scene.count(t.scene)) scene_order.push_back(t.scene);
     by_scene[t.scene].push_back(&t);
   }
+  out += machine_note(ctx);
   std::vector<std::string> warnings;
   for (const auto& sc : scene_order) {
     out += fmt::format("\n== scene {}\n", sc);
-    out += fmt::format("{:<40} {:>6} {:>30} {:>10} {:>11} {:>8} {:>9} {:>10} {:>8} {:>8} {:>8}\n", "cell", "status",
-                       "growth median [95% CI]", "total", "peak RSS", "nodes", "length m", "PLY", "cover", "attach",
-                       "inside");
+    out += fmt::format("{:<40} {:>6} {:>10} {:>30} {:>10} {:>11} {:>8} {:>9} {:>10} {:>8} {:>8} {:>8}\n", "cell",
+                       "status", "verdict", "growth time", "total", "growth RSS", "nodes", "length m", "PLY", "cover",
+                       "attach", "inside");
     for (const SuiteCell* t : by_scene[sc]) out += cell_row(*t, warnings);
   }
   out +=
-      "\nIntervals: distribution-free 95% CI of the median from order statistics ('~': fewer than 6 repetitions, full "
-      "range shown).\n";
+      "\nGrowth time: over a cell's repetitions, the median with the distribution-free 95% interval of the median "
+      "('CI', from order statistics, 6 repetitions or more) or the range of all of them ('range', fewer); one "
+      "trial is shown alone. Growth RSS: the growth phase's own peak resident memory (median). Verdicts other than "
+      "valid are left out of comparisons across cells (docs/metrics.md, \"Validity\"); n/a: a metric that does "
+      "not apply.\n";
   out += overhead_line(results);
+  const auto noisy = static_cast<std::size_t>(std::count_if(warnings.begin(), warnings.end(), [](const std::string& w) {
+    return w.find("growth time CV") != std::string::npos;
+  }));
+  if (4 * noisy > results.trials.size())
+    out += fmt::format(
+        "\nNote: the growth times of {} of {} cells varied by more than 10% over their repetitions: this run's timings "
+        "are noisy.\n",
+        noisy, results.trials.size());
   if (!warnings.empty()) {
     out += "\nWarnings:\n";
     for (const auto& w : warnings) out += "  ! " + w + "\n";

@@ -39,6 +39,7 @@
 #include "harness/run/alloc_counter.hpp"
 #include "harness/output/exporters.hpp"
 #include "harness/output/metrics.hpp"
+#include "harness/output/validity.hpp"
 #include "scenes/scene_library.hpp"
 #include "scenes/scene_query.hpp"
 
@@ -135,6 +136,31 @@ class PhaseTimer {
     }
   }
 };
+
+// The first core's clock in MHz: cpufreq's current frequency, else /proc/cpuinfo's (VMs often have only that).
+std::optional<double> cpu_mhz() {
+  std::ifstream freq("/sys/devices/system/cpu/cpu0/cpufreq/scaling_cur_freq");
+  if (double khz = 0.0; freq >> khz && khz > 0.0) return khz / 1000.0;
+  std::ifstream in("/proc/cpuinfo");
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("cpu MHz", 0) == 0) {
+      const auto colon = line.find(':');
+      if (colon == std::string::npos) break;
+      try {
+        return std::stod(line.substr(colon + 1));
+      } catch (const std::exception&) {
+        break;
+      }
+    }
+  return std::nullopt;
+}
+
+std::optional<std::string> cpu_governor() {
+  std::ifstream in("/sys/devices/system/cpu/cpu0/cpufreq/scaling_governor");
+  std::string g;
+  if (in >> g) return g;
+  return std::nullopt;
+}
 
 std::string cpu_model() {
   std::ifstream in("/proc/cpuinfo");
@@ -236,6 +262,13 @@ std::string binary_hash() {
   return file_hash("/proc/self/exe");
 }
 
+std::optional<std::array<double, 3>> load_average() {
+  std::ifstream in("/proc/loadavg");
+  std::array<double, 3> l{};
+  if (in >> l[0] >> l[1] >> l[2]) return l;
+  return std::nullopt;
+}
+
 RunContext run_context_record() {
   const std::time_t now = std::time(nullptr);
   char date[32];
@@ -267,6 +300,9 @@ RunContext run_context_record() {
   c.hardware_threads = std::thread::hardware_concurrency();
   c.date = date;
   c.alloc_counting = alloc_counting_enabled();
+  c.load_average_start = load_average();
+  c.cpu_mhz = cpu_mhz();
+  c.cpu_governor = cpu_governor();
   c.plugins = loaded_plugins();
   c.dependencies = {{"embree", fmt::format("{}.{}.{}", RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH)},
                     {"openvdb", OPENVDB_LIBRARY_VERSION_STRING},
@@ -480,6 +516,7 @@ void mesh_export_measure(const TrialSpec& spec, const MesherOptions& mesher, Tri
   out.total_length_m = plant.total_length();
   out.geometry_hash = plant.geometry_hash();
   for (const auto& [k, v] : st.algo->stats()) out.algorithm_stats[k] = v;
+  out.verdict = judge_plant(plant, st.scene, out.metrics ? &*out.metrics : nullptr, st.algo->own_verdict());
 }
 
 // The organ pass (variation, then placement) on a copy of the grown plant, when an option asks for it.
@@ -518,6 +555,7 @@ TrialRecord run_trial_record(const TrialSpec& spec, const std::function<void(con
     threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                     static_cast<std::size_t>(spec.threads));
 
+  const auto load_at_start = load_average();
   TrialRecord rec;
   rec.algorithm = spec.algorithm;
   rec.seed = spec.seed;
@@ -545,7 +583,11 @@ TrialRecord run_trial_record(const TrialSpec& spec, const std::function<void(con
   getrusage(RUSAGE_SELF, &ru);
   rec.peak_rss_bytes = static_cast<std::uint64_t>(ru.ru_maxrss) * 1024u;  // whole process, never reset
   rec.status = "ok";
-  if (spec.context) rec.context = run_context_record();
+  if (spec.context) {
+    rec.context = run_context_record();
+    rec.context->load_average_end = rec.context->load_average_start;
+    rec.context->load_average_start = load_at_start;
+  }
 
   if (!spec.out_dir.empty()) {
     const std::string path = (std::filesystem::path(spec.out_dir) / "record.json").string();

@@ -2,7 +2,9 @@
 // phase cost. The same code path serves `growbench run`, the tests and (later) suites.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <optional>
 #include <functional>
 #include <string>
 #include <vector>
@@ -39,6 +41,8 @@ Outcome outcome_of(const std::exception& e);
 // The build and machine this binary runs on (commit and dirty flag, compiler, flags, build type,
 // dependency versions, CPU model, cores, date).
 RunContext run_context_record();
+// /proc/loadavg's 1, 5 and 15 minute load averages, when readable.
+std::optional<std::array<double, 3>> load_average();
 nlohmann::json run_context();  // to_json of the above
 
 // A trial spec as a suite hands it to a trial's process (harness/record/trial_spec.hpp): InputError naming the JSON

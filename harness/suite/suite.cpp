@@ -471,13 +471,15 @@ void apply_sample(SuiteCell& t, const SuiteSample& sample, const std::optional<C
 }
 
 // The growth time over the seeds of each algorithm entry (and sweep point) on each scene: every ok cell's
-// ok repetitions pooled, as the report's table shows them.
+// ok repetitions pooled, as the report's table shows them. A plant judged degenerate or not applicable
+// stands for nothing across cells, and is left out.
 ResultsSummary results_summary(const std::vector<SuiteCell>& trials) {
   ResultsSummary out;
   std::vector<std::vector<double>> times;
   for (const auto& t : trials) {
     const std::vector<double> growth = growth_times(t);
-    if (t.status != "ok" || growth.empty()) continue;
+    const auto& plant = t.results.plant;
+    if (t.status != "ok" || growth.empty() || (plant && plant->verdict && !plant->verdict->valid())) continue;
     std::size_t g = 0;
     while (g < out.growth_s_over_seeds.size() &&
            !(out.growth_s_over_seeds[g].label == t.label && out.growth_s_over_seeds[g].scene == t.scene &&
@@ -779,6 +781,7 @@ class SuiteRun {
         last_snapshot = std::chrono::steady_clock::now();
       }
     }
+    results_.context.load_average_end = load_average();
     write_snapshot();
     if (tty) fmt::print(stderr, "\r{:<100}\r", "");
     return results_path_.string();

@@ -20,6 +20,7 @@ json cell(const std::string& id, int threads = 1) {
           {"geometry_hash", "0123456789abcdef"},
           {"counts", {{"nodes", 100}, {"leaves", 10}}},
           {"metrics", {{"coverage", 0.25}, {"attached_fraction", 0.5}}},
+          {"verdict", {{"status", "valid"}}},
           {"output_bytes", {{"obj", 1000}, {"glb", 400}}},
           {"alloc", {{"growth", {{"count", 50}, {"bytes", 4096}}}}},
           {"instructions", {{"growth", 10000000}, {"query_build", 5000000}}},
@@ -44,7 +45,8 @@ TEST(Compare, AnyBehaviourChangeFails) {
   for (const auto& [path, value] : std::vector<std::pair<std::string, json>>{{"/geometry_hash", "fedcba9876543210"},
                                                                              {"/counts/nodes", 101},
                                                                              {"/metrics/coverage", 0.2500001},
-                                                                             {"/status", "timeout"}}) {
+                                                                             {"/status", "timeout"},
+                                                                             {"/verdict/status", "degenerate"}}) {
     json b = a;
     b["trials"][0][json::json_pointer(path)] = value;
     const auto r = compare_results(a, b);

@@ -227,17 +227,22 @@ struct Reference {
   }
 
   void means() {
-    // The figures are the means of the verdicts.
-    auto mean = [](const std::vector<std::uint8_t>& v) {
-      return v.empty() ? 0.0 : static_cast<double>(std::count(v.begin(), v.end(), 1)) / static_cast<double>(v.size());
+    // The figures are the means of the verdicts; with no verdicts the figure does not apply and is null.
+    auto expect_mean = [this](const char* key, const std::vector<std::uint8_t>& v) {
+      if (v.empty()) {
+        EXPECT_TRUE(m[key].is_null()) << key << " has nothing to judge and must be n/a";
+        return;
+      }
+      const double mean = static_cast<double>(std::count(v.begin(), v.end(), 1)) / static_cast<double>(v.size());
+      EXPECT_DOUBLE_EQ(m[key].get<double>(), mean) << key;
     };
-    EXPECT_DOUBLE_EQ(m["coverage"].get<double>(), mean(d.covered));
-    EXPECT_DOUBLE_EQ(m["penetration_nodes"].get<double>(), mean(d.node_inside));
-    EXPECT_DOUBLE_EQ(m["penetration_samples"].get<double>(), mean(d.sample_inside));
-    EXPECT_DOUBLE_EQ(m["self_intersection_fraction"].get<double>(), mean(d.segment_crossed));
-    EXPECT_DOUBLE_EQ(m["leaf_overlap"].get<double>(), mean(d.leaf_overlaps));
-    EXPECT_DOUBLE_EQ(m["leaf_light_exposure"].get<double>(), mean(d.leaf_lit));
-    EXPECT_DOUBLE_EQ(m["leaf_light_exposure_scene"].get<double>(), mean(d.leaf_lit_scene));
+    expect_mean("coverage", d.covered);
+    expect_mean("penetration_nodes", d.node_inside);
+    expect_mean("penetration_samples", d.sample_inside);
+    expect_mean("self_intersection_fraction", d.segment_crossed);
+    expect_mean("leaf_overlap", d.leaf_overlaps);
+    expect_mean("leaf_light_exposure", d.leaf_lit);
+    expect_mean("leaf_light_exposure_scene", d.leaf_lit_scene);
     for (std::size_t i = 0; i < d.leaf_lit.size(); ++i)
       EXPECT_LE(d.leaf_lit[i], d.leaf_lit_scene[i]) << "the plant only adds shade";
   }

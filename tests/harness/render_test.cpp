@@ -746,11 +746,19 @@ TEST(RenderGrid, LabelsCellsAndMarksMissingOnes) {
       render_plant(tiny_scene(), tiny_plant(), (dir / "a.pov").string(), (dir / "a.png").string(), o);
   ASSERT_TRUE(r.ok()) << r.message;
   write_grid((dir / "grid.png").string(), "title", {"alpha", "beta"}, {"s1", "s2", "s3"},
-             {{r.png, r.png, ""}, {r.png, "", (dir / "missing.png").string()}}, {{"", "", "timeout"}}, 100);
+             {{r.png, r.png, ""}, {r.png, "", (dir / "missing.png").string()}}, {{"", "", "timeout"}},
+             {{"", "degenerate"}}, 100);
   const Image g = load_png((dir / "grid.png").string());
   EXPECT_EQ(g.w, 170 + 3 * 106 + 6);           // row labels, three cells with padding
   EXPECT_EQ(g.h, 40 + 30 + 2 * (75 + 6) + 6);  // title, column labels, two rows of 4:3 cells
   EXPECT_GT(luminance_variance(g), 100.0);
+  // The degenerate plant's cell (row 0, column 1) carries a red band at its top; its neighbour does not.
+  auto pixel = [&](int x, int y) { return g.rgb[static_cast<std::size_t>(3 * (y * g.w + x))]; };
+  auto greenish = [&](int x, int y) { return g.rgb[static_cast<std::size_t>(3 * (y * g.w + x) + 1)]; };
+  const int y = 40 + 30 + 3, x_badged = 170 + 6 + 106 + 3, x_plain = 170 + 6 + 3;
+  EXPECT_GT(pixel(x_badged, y), 150);
+  EXPECT_LT(greenish(x_badged, y), 80);
+  EXPECT_FALSE(pixel(x_plain, y) > 150 && greenish(x_plain, y) < 80);
 }
 
 TEST(RenderCli, RunRendersThePlantAndItsGrowthFrames) {

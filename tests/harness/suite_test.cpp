@@ -405,8 +405,13 @@ TEST(Suite, QuickSuiteEndToEndAndSummary) {
         }
       }
     EXPECT_EQ(t["status"], "ok") << t["id"];
-    for (const char* k : {"geometry_hash", "metrics", "output_bytes", "alloc", "curve", "scene_hash"})
+    for (const char* k : {"geometry_hash", "metrics", "output_bytes", "alloc", "curve", "scene_hash", "verdict"})
       EXPECT_TRUE(t.contains(k)) << k;
+    // Every plant of the quick suite is a real one, or a scene its algorithm says it cannot grow on.
+    EXPECT_NE(t["verdict"]["status"], "degenerate") << t["id"] << ": " << t["verdict"].dump();
+    if (t["verdict"]["status"] == "not_applicable") {
+      EXPECT_EQ(t["scene"], "envelope") << t["id"];
+    }
     for (const char* f : {"obj", "ply", "glb", "skeleton_obj", "skeleton_ply"})
       EXPECT_GT(t["output_bytes"][f].get<long>(), 0) << f;
   }
@@ -419,7 +424,8 @@ TEST(Suite, QuickSuiteEndToEndAndSummary) {
   const auto s = growbench("summary " + out + "/results.json");
   EXPECT_EQ(s.status, 0);
   EXPECT_NE(s.out.find("== scene wall"), std::string::npos) << s.out;
-  EXPECT_NE(s.out.find("growth median [95% CI]"), std::string::npos) << s.out;
+  EXPECT_NE(s.out.find("growth time"), std::string::npos) << s.out;
+  EXPECT_NE(s.out.find(" range "), std::string::npos) << "two repetitions give a range, not an interval: " << s.out;
   EXPECT_EQ(growbench("summary /nonexistent.json").status, 2);
 }
 
