@@ -13,13 +13,25 @@ The file is checked against harness/record/results.schema.json first (python3-js
 schema whose version the C++ writes: a renamed or mistyped field is an error naming the file and the
 JSON path.
 
+Verdicts: each cell's plant is valid, degenerate or not_applicable ("verdict" of the cell; absent in files
+written before plants were judged, which counts as valid with nothing to mark). Only valid plants enter
+what compares cells: the table rows' pooled numbers, the scaling fits and every figure. The others are
+marked in the table's verdict column and listed with their reasons under the tables and in the page's
+"Plants left out of comparisons". A metric that does not apply is null in the file: "n/a" in the
+tables, absent from the figures, never part of a median.
+
+Memory: the growth phase's own peak resident memory (phases.growth.peak_rss_bytes) and the query
+structure's (phases.query_build.peak_rss_bytes); the whole process's peak stays in the record only.
+
 Statistics:
-- growth times: the medians and distribution-free 95% intervals the suite wrote into results.json
-  ("summary" of each cell, and "summary.growth_s_over_seeds" for the table's rows, whose seeds are
-  pooled), computed by the same C++ as `growbench summary` (harness/stats/stats.hpp); a results file
-  written before the suite wrote them shows medians without intervals;
-- scaling exponents: least squares of log(time) on log(nodes) over an algorithm's cells (their median
-  times), with a 95% interval from Student's t on the slope's standard error.
+- growth times: the medians and intervals the suite wrote into results.json ("summary" of each cell,
+  and "summary.growth_s_over_seeds" for the table's rows, whose valid seeds are pooled), computed by the
+  same C++ as `growbench summary` (harness/stats/stats.hpp): with "exact" (6 samples or more) the
+  distribution-free 95% CI of the median, otherwise the full range of the samples; one sample has no
+  interval. A results file written before the suite wrote them shows medians without intervals;
+- scaling exponents: least squares of log(time) on log(nodes) over an algorithm's valid cells (their
+  median times), with a 95% interval from Student's t on the slope's standard error; fitted only for an
+  entry with at least 3 distinct sizes spanning a factor of 2.
 """
 
 import argparse
@@ -172,8 +184,12 @@ class Cell:
         self.growth = [s["phases"]["growth"]["wall_s"] for s in ok]
         self.growth_cpu = [s["phases"]["growth"]["cpu_s"] for s in ok]
         self.total = [sum(p["wall_s"] for p in s["phases"].values()) for s in ok]
+        # The whole process's peak (kept in the record; never shown as the algorithm's memory), and the
+        # growth phase's and the query structure's own peaks (reset at each phase's start where the kernel
+        # allows: *_reset False when it did not, and the peak is the process's so far).
         self.rss = [s.get("child_max_rss_bytes", 0) for s in ok]
-        self.growth_rss = [s["phases"]["growth"].get("peak_rss_bytes", 0) for s in ok]
+        self.growth_rss, self.growth_rss_reset = phase_peaks(ok, "growth")
+        self.query_rss, self.query_rss_reset = phase_peaks(ok, "query_build")
         counts = t.get("counts", {})
         self.nodes = counts.get("nodes", 0)
         self.leaves = counts.get("leaves", 0)
@@ -183,11 +199,82 @@ class Cell:
         self.alloc_bytes = alloc.get("bytes", 0)
         self.alloc_count = alloc.get("count", 0)
         self.ok = self.status == "ok" and len(self.growth) > 0
-        # The suite's median and 95% interval of the growth time (None in files written before it did).
+        # The plant's verdict: None when the file was written before plants were judged (counted as valid).
+        verdict = t.get("verdict")
+        self.verdict = verdict.get("status") if isinstance(verdict, dict) else None
+        self.reasons = list(verdict.get("reasons") or []) if isinstance(verdict, dict) else []
+        # Whether the cell enters comparisons across cells (pooled medians, fits, figures).
+        self.valid = self.ok and self.verdict in (None, "valid")
+        # The suite's median and interval of the growth time (None in files written before it did).
         self.growth_summary = t.get("summary", {}).get("growth_s")
+
+    def id(self):
+        return self.t.get("id") or f"{self.row}/{self.scene}/s{self.seed}"
 
     def growth_median(self):
         return self.growth_summary["median"] if self.growth_summary else median(self.growth)
+
+    def growth_interval(self):
+        """(lo, hi) of the median growth time: the 95% CI (exact) or the range; None with one sample or no
+        summary in the file."""
+        s = self.growth_summary
+        if not s or s.get("n", len(self.growth)) < 2:
+            return None
+        return s["lo"], s["hi"]
+
+    def growth_cv(self):
+        """The coefficient of variation of the growth times (sample standard deviation over the mean), or None
+        under 2 repetitions."""
+        g = self.growth
+        if len(g) < 2:
+            return None
+        mean = sum(g) / len(g)
+        if mean <= 0:
+            return None
+        return math.sqrt(sum((x - mean) ** 2 for x in g) / (len(g) - 1)) / mean
+
+
+def phase_peaks(samples, phase):
+    """The phase's own peak RSS over these samples, and whether every one was reset at the phase's start."""
+    ps = [s["phases"][phase] for s in samples if isinstance(s["phases"].get(phase), dict)
+          and s["phases"][phase].get("peak_rss_bytes") is not None]
+    return [p["peak_rss_bytes"] for p in ps], all(p.get("peak_rss_reset", True) for p in ps)
+
+
+VERDICT_WORDS = {"valid": "valid", "degenerate": "degenerate", "not_applicable": "not applicable"}
+VERDICT_SHORT = {"degenerate": "degenerate", "not_applicable": "n/a"}
+
+
+def excluded_cells(cells):
+    """The cells whose plants were judged other than valid: kept, marked, left out of comparisons."""
+    return [c for c in cells if c.verdict not in (None, "valid")]
+
+
+def excluded_note(c):
+    """'spacecol/envelope/s1: degenerate: flat; stunted'."""
+    words = VERDICT_WORDS.get(c.verdict, c.verdict)
+    return f"{c.id()}: {words}" + (f": {'; '.join(c.reasons)}" if c.reasons else "")
+
+
+def machine_warnings(doc, cells):
+    """The banners of a run whose timings the machine may have disturbed: a load average over a quarter of the
+    hardware threads when it began, or more than a quarter of the repeated cells with a growth-time coefficient
+    of variation over 10%."""
+    ctx = doc.get("context", {})
+    out = []
+    load = ctx.get("load_average_start")
+    threads = ctx.get("hardware_threads") or 0
+    if isinstance(load, list) and load and isinstance(load[0], (int, float)) and threads > 0 \
+            and load[0] > 0.25 * threads:
+        out.append(f"The machine was busy when this run began (load {load[0]:.2f} over the last minute, on {threads} "
+                   f"hardware thread{'s' if threads != 1 else ''}): timings may be slower and noisier than a quiet "
+                   f"machine's.")
+    repeated = [c for c in cells if c.ok and len(c.growth) >= 2]
+    noisy = [c for c in repeated if (c.growth_cv() or 0) > 0.10]
+    if repeated and 4 * len(noisy) > len(repeated):
+        out.append(f"The growth times of {len(noisy)} of {len(repeated)} cells with 2 or more repetitions varied by "
+                   f"more than 10% over repetitions (coefficient of variation): timings are noisy.")
+    return out
 
 
 def ordered(values):
@@ -223,26 +310,91 @@ def fmt_frac(x):
     return "-" if x is None else f"{x:.3f}"
 
 
-def time_with_ci(summary, times):
-    """'median [lo, hi]' from a summary the suite wrote ('~': the full range, under 6 samples); without one, the
-    median of `times` alone."""
+def growth_time_text(summary, times):
+    """The growth time as what it is: 'median CI [lo, hi]' (the distribution-free 95% CI of the median, 6 samples or
+    more), 'median range [lo, hi]' (the smallest and largest sample, 2 to 5), 'time (1 trial)'; from the summary the
+    suite wrote, or without one the median of `times` alone."""
     if summary:
-        lo, hi = summary["lo"], summary["hi"]
-        return f"{fmt_seconds(summary['median'])} [{'' if summary['exact'] else '~'}{fmt_seconds(lo)}, {fmt_seconds(hi)}]"
+        if summary.get("n", 2) <= 1:
+            return f"{fmt_seconds(summary['median'])} (1 trial)"
+        kind = "CI" if summary["exact"] else "range"
+        return f"{fmt_seconds(summary['median'])} {kind} [{fmt_seconds(summary['lo'])}, {fmt_seconds(summary['hi'])}]"
     if not times:
         return "-"
+    if len(times) == 1:
+        return f"{fmt_seconds(times[0])} (1 trial)"
     return f"{fmt_seconds(median(times))} [no interval in this file]"
+
+
+def metric_values(cells, key):
+    """The non-null numbers of metric `key` over these cells (null: the metric does not apply to that plant)."""
+    return [c.metrics[key] for c in cells
+            if isinstance(c.metrics.get(key), (int, float)) and not isinstance(c.metrics.get(key), bool)]
+
+
+def metric_text(cells, key):
+    """Median over the cells that have the metric: '-' when no cell records it, 'n/a' when it is null in each."""
+    if not any(key in c.metrics for c in cells):
+        return "-"
+    v = metric_values(cells, key)
+    return fmt_frac(median(v)) if v else "n/a"
+
+
+def memory_text(values, reset):
+    """The median of a phase's own peaks; '*' when a peak could not be reset (it is the process's so far)."""
+    return "-" if not values else fmt_bytes(median(values)) + ("" if reset else " *")
+
+
+def pooled_text(valid, failed):
+    """'3 seeds x 2 reps': what the row's numbers pool, and the cells that did not finish."""
+    reps = [len(c.growth) for c in valid]
+    plural = lambda n, w: f"{n} {w}{'' if n == 1 else 's'}"
+    if not valid:
+        text = "none"
+    elif len(set(reps)) == 1:
+        text = f"{plural(len(valid), 'seed')} x {plural(reps[0], 'rep')}"
+    else:
+        text = f"{plural(sum(reps), 'trial')} over {plural(len(valid), 'seed')}"
+    if failed:
+        text += f" ({len(failed)} failed: {', '.join(sorted({c.status for c in failed}))})"
+    return text
+
+
+def verdict_text(group):
+    """'valid', or how many of the row's seeds were judged otherwise: 'degenerate (2 of 3 seeds)'; '-' when no cell
+    of the row was judged (a file written before plants were)."""
+    if not any(c.verdict is not None for c in group):
+        return "-"
+    counts = {}
+    for c in excluded_cells(group):
+        counts[c.verdict] = counts.get(c.verdict, 0) + 1
+    if not counts:
+        return "valid"
+    n = len(group)
+    return ", ".join(f"{VERDICT_SHORT.get(v, v)} ({k} of {n} seed{'' if n == 1 else 's'})" for v, k in counts.items())
 
 
 # ---------------------------------------------------------------- tables
 
-TABLE_HEAD = ["algorithm", "scene", "seeds", "growth time median [95% CI]", "peak memory", "GLB size", "nodes",
-              "coverage", "attached", "penetration", "leaf overlap", "leaf light"]
+GROWTH_HEAD = "growth time (median; 95% CI or range)"
+TABLE_HEAD = ["algorithm", "scene", "trials pooled", "verdict", GROWTH_HEAD, "growth peak RSS", "query peak RSS",
+              "GLB size", "nodes", "coverage", "attached", "penetration", "leaf overlap", "leaf light"]
+TABLE_LEFT = 4  # the columns aligned left: algorithm, scene, trials pooled, verdict
+CAPTION = ("Growth time: the median wall time over the repetitions of the row's valid seeds pooled ('trials "
+           "pooled'), with the distribution-free 95% CI of the median ('CI', 6 trials or more) or the range of the "
+           "trials ('range', 2 to 5); '1 trial': one trial, no interval. Growth peak RSS and query peak RSS: the "
+           "growth phase's and the query structure build's own peak resident memory (median over those trials; "
+           "'*': the peak could not be reset at the phase's start and is the process's up to then). GLB size, "
+           "nodes and the quality metrics: medians over the valid seeds; n/a: a metric that does not apply to the "
+           "plant. Verdict: valid, or how many seeds' plants were degenerate or not applicable (n/a); those are "
+           "left out of every number of the row and of every figure, and listed with their reasons; '-': not "
+           "judged (a file written before plants were).")
 
 
 def table_rows(cells, pooled=None):
-    """One row per algorithm entry x scene (seeds pooled): repetition times of every seed together, with the
-    interval the suite computed over them (`pooled`: pooled_summaries of the results file)."""
+    """One row per algorithm entry x scene (seeds pooled): repetition times of every valid seed together, with the
+    interval the suite computed over them (`pooled`: pooled_summaries of the results file). Seeds whose plants are
+    not valid are counted in the verdict column and enter no number; a row without a valid seed shows none."""
     pooled = pooled or {}
     rows = []
     for scene in ordered(c.scene for c in cells):
@@ -250,34 +402,50 @@ def table_rows(cells, pooled=None):
             group = [c for c in cells if c.scene == scene and c.row == label]
             if not group:
                 continue
-            good = [c for c in group if c.ok]
-            bad = [c for c in group if not c.ok]
-            if not good:
-                rows.append([label, scene, str(len(group)), ", ".join(sorted({c.status for c in bad})), "-", "-", "-",
-                             "-", "-", "-"])
+            failed = [c for c in group if not c.ok]
+            valid = [c for c in group if c.valid]
+            head = [label, scene, pooled_text(valid, failed), verdict_text(group)]
+            if not valid:
+                # Nothing to show as a result: the statuses of cells that did not finish, else (plants that were
+                # not valid) no numbers at all.
+                first = ", ".join(sorted({c.status for c in failed})) if len(failed) == len(group) else "-"
+                rows.append(head + [first] + ["-"] * (len(TABLE_HEAD) - len(head) - 1))
                 continue
-            times = [x for c in good for x in c.growth]
-            rss = median([x for c in good for x in c.rss])
-            glb = median([c.bytes.get("glb", 0) for c in good])
-            nodes = median([c.nodes for c in good])
-            m = lambda k: median([c.metrics[k] for c in good if k in c.metrics]) if any(k in c.metrics for c in good) else None
-            seeds = f"{len(good)}" + (f" ({len(bad)} failed: {', '.join(sorted({c.status for c in bad}))})" if bad else "")
-            summary = pooled.get(frozenset(c.t.get("id") for c in good))
-            rows.append([label, scene, seeds, time_with_ci(summary, times), fmt_bytes(rss), fmt_bytes(glb), f"{nodes:.0f}",
-                         fmt_frac(m("coverage")), fmt_frac(m("attached_fraction")), fmt_frac(m("penetration_samples")),
-                         fmt_frac(m("leaf_overlap")), fmt_frac(m("leaf_light_exposure"))])
+            times = [x for c in valid for x in c.growth]
+            summary = pooled.get(frozenset(c.id() for c in valid))
+            glb = [c.bytes["glb"] for c in valid if c.bytes.get("glb") is not None]
+            rows.append(head + [
+                growth_time_text(summary, times),
+                memory_text([x for c in valid for x in c.growth_rss], all(c.growth_rss_reset for c in valid)),
+                memory_text([x for c in valid for x in c.query_rss], all(c.query_rss_reset for c in valid)),
+                fmt_bytes(median(glb)) if glb else "-", f"{median([c.nodes for c in valid]):.0f}",
+                metric_text(valid, "coverage"), metric_text(valid, "attached_fraction"),
+                metric_text(valid, "penetration_samples"), metric_text(valid, "leaf_overlap"),
+                metric_text(valid, "leaf_light_exposure")])
     return rows
 
 
+def table_notes(cells):
+    """The lines under the tables: each plant left out of comparisons, with its reasons."""
+    ex = excluded_cells(cells)
+    if not ex:
+        return []
+    return ["Left out of comparisons (verdict not valid):"] + [excluded_note(c) for c in ex]
+
+
+LATEX_SPECIAL = {"\\": "\\textbackslash{}", "&": "\\&", "%": "\\%", "_": "\\_", "#": "\\#", "~": "$\\sim$",
+                 "[": "{[}", "]": "{]}", "$": "\\$", "{": "\\{", "}": "\\}", "^": "\\^{}"}
+
+
 def latex_escape(s):
-    return (s.replace("\\", "\\textbackslash{}").replace("&", "\\&").replace("%", "\\%").replace("_", "\\_")
-            .replace("#", "\\#").replace("~", "$\\sim$").replace("[", "{[}").replace("]", "{]}"))
+    """Text for LaTeX: each special character replaced once (a verdict's reasons are free text)."""
+    return re.sub(r"[\\&%_#~\[\]$\{\}^]", lambda m: LATEX_SPECIAL[m.group(0)], s)
 
 
-def write_latex(path, rows, caption):
+def write_latex(path, rows, caption, notes=()):
     lines = ["% growbench report table; needs \\usepackage{booktabs}",
              "\\begin{table}[t]", "\\centering", "\\small",
-             "\\begin{tabular}{ll" + "r" * (len(TABLE_HEAD) - 2) + "}", "\\toprule",
+             "\\begin{tabular}{" + "l" * TABLE_LEFT + "r" * (len(TABLE_HEAD) - TABLE_LEFT) + "}", "\\toprule",
              " & ".join(latex_escape(h) for h in TABLE_HEAD) + " \\\\", "\\midrule"]
     prev_scene = None
     for r in rows:
@@ -285,27 +453,75 @@ def write_latex(path, rows, caption):
             lines.append("\\midrule")
         prev_scene = r[1]
         lines.append(" & ".join(latex_escape(x) for x in r) + " \\\\")
-    lines += ["\\bottomrule", "\\end{tabular}", f"\\caption{{{latex_escape(caption)}}}", "\\end{table}", ""]
+    lines += ["\\bottomrule", "\\end{tabular}"]
+    if notes:  # the plants left out of comparisons, under the table
+        lines += ["", "\\smallskip", "{\\footnotesize\\raggedright " + latex_escape(notes[0])]
+        lines += ["\\\\ " + latex_escape(n) for n in notes[1:]]
+        lines += ["\\par}"]
+    lines += [f"\\caption{{{latex_escape(caption)}}}", "\\end{table}", ""]
     with open(path, "w") as f:
         f.write("\n".join(lines))
 
 
-def write_markdown(path, rows, caption):
-    lines = ["| " + " | ".join(TABLE_HEAD) + " |", "|" + "|".join(["---"] * 2 + ["---:"] * (len(TABLE_HEAD) - 2)) + "|"]
+def write_markdown(path, rows, caption, notes=()):
+    lines = ["| " + " | ".join(TABLE_HEAD) + " |",
+             "|" + "|".join(["---"] * TABLE_LEFT + ["---:"] * (len(TABLE_HEAD) - TABLE_LEFT)) + "|"]
     for r in rows:
         lines.append("| " + " | ".join(x.replace("|", "\\|") for x in r) + " |")
     lines += ["", caption, ""]
+    if notes:
+        lines += [notes[0], ""] + [f"- {n}" for n in notes[1:]] + [""]
     with open(path, "w") as f:
         f.write("\n".join(lines))
 
 
 # ---------------------------------------------------------------- figures
 
+def scaling_fit(xs, ys):
+    """fig-time-vs-size's fit of one entry: (the number of distinct sizes, fit_exponent or None). None unless there
+    are at least 3 distinct sizes (node counts) spanning a factor of 2: two sizes fix a line and test nothing."""
+    sizes = sorted({x for x in xs if x > 0})
+    if len(sizes) < 3 or sizes[-1] < 2 * sizes[0]:
+        return len(sizes), None
+    return len(sizes), fit_exponent(xs, ys)
+
+
+def scaling_legend(label, sizes, fit):
+    """'spacecol: 4 sizes, k = 1.12 [0.98, 1.25]' or 'ivy: 2 sizes, no fit'."""
+    text = f"{label}: {sizes} size{'' if sizes == 1 else 's'}"
+    if fit is None:
+        return text + (" within 2x, no fit" if sizes >= 3 else ", no fit")
+    b, ci, _ = fit
+    return text + f", k = {b:.2f}" + (f" [{ci[0]:.2f}, {ci[1]:.2f}]" if ci else "")
+
+
+def time_axis_label(pts):
+    """The y label of a growth-time figure, saying what its points and bars are."""
+    if any(c.growth_interval() for c in pts):
+        return "growth wall time (s)\npoints: median over repetitions;\nbars: 95% CI (6+ repetitions) or range"
+    if all(len(c.growth) <= 1 for c in pts):
+        return "growth wall time (s)\none trial per point (no interval)"
+    return "growth wall time (s)\npoints: median over repetitions\n(no intervals in this file)"
+
+
+def time_points(ax, pts, x, fmt, colour, label, **style):
+    """Draws one series of a growth-time figure: the medians as points (joined when `style` has a line style), and
+    interval bars only at the points that have an interval (none for one trial)."""
+    med = [c.growth_median() for c in pts]
+    ax.plot(x, med, marker=fmt, color=colour, ms=4, label=label, **({"ls": "none"} | style))
+    bars = [(xi, m, c.growth_interval()) for xi, m, c in zip(x, med, pts) if c.growth_interval()]
+    if bars:
+        ax.errorbar([p[0] for p in bars], [p[1] for p in bars],
+                    yerr=[[max(p[1] - p[2][0], 0) for p in bars], [max(p[2][1] - p[1], 0) for p in bars]],
+                    fmt="none", ecolor=colour, capsize=2, lw=1)
+
+
 def figures(cells, out, formats):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import numpy as np
+    from matplotlib.patches import Patch
 
     plt.rcParams.update({"font.size": 9, "axes.grid": True, "grid.alpha": 0.3, "figure.dpi": 110,
                          "savefig.bbox": "tight", "pdf.fonttype": 42})
@@ -320,7 +536,13 @@ def figures(cells, out, formats):
         plt.close(fig)
         written.append((name, caption))
 
-    good = [c for c in cells if c.ok and c.nodes > 0]
+    def legend(ax, **kw):
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(**kw)
+
+    # Only valid plants (or unjudged, in older files) enter the figures: they compare cells.
+    good = [c for c in cells if c.valid and c.nodes > 0]
+    left_out = " Plants judged degenerate or not applicable are left out (listed under the table)."
 
     # 1. Growth time vs output size, log-log, with fitted exponents.
     fig, ax = plt.subplots(figsize=(6.4, 4.6))
@@ -330,31 +552,26 @@ def figures(cells, out, formats):
             continue
         x = np.array([c.nodes for c in pts], dtype=float)
         med = np.array([c.growth_median() for c in pts])
-        # Bars: the suite's interval of each median (none in files written before it wrote them).
-        lo = med - np.array([c.growth_summary["lo"] if c.growth_summary else m for c, m in zip(pts, med)])
-        hi = np.array([c.growth_summary["hi"] if c.growth_summary else m for c, m in zip(pts, med)]) - med
-        fit = fit_exponent(x, med)
-        name = label
+        sizes, fit = scaling_fit(x, med)
         if fit:
             b, ci, a = fit
-            name += f": exponent {b:.2f}" + (f" [{ci[0]:.2f}, {ci[1]:.2f}]" if ci else " (2 sizes, no interval)")
             xs = np.geomspace(x.min(), x.max(), 20)
             ax.plot(xs, np.exp(a) * xs ** b, "-", color=colours[label], alpha=0.6, lw=1)
-        else:
-            name += ": sizes within 2x, no fit"
-        ax.errorbar(x, med, yerr=[lo, hi], fmt=markers[i % len(markers)], color=colours[label], ms=4, capsize=2,
-                    label=name)
+        time_points(ax, pts, x, markers[i % len(markers)], colours[label], scaling_legend(label, sizes, fit))
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("plant nodes (output size)")
-    ax.set_ylabel("growth wall time (s), median and 95% interval")
+    ax.set_ylabel(time_axis_label(good))
     ax.set_title("Growth time against output size")
-    ax.legend(fontsize=7, loc="best")
-    save(fig, "fig-time-vs-size", "Growth wall time against plant size, log-log: one point per cell (median over "
-         "repetitions, bars: distribution-free 95% interval of the median), lines: least-squares fits with the "
-         "exponent and its 95% interval in the legend. The fit spans every cell of an algorithm entry in this "
-         "suite, so where cells differ in scene as well as size it mixes both; the scaling suite "
-         "(bench/suites/scaling.json) varies only the size, on one scene.")
+    legend(ax, fontsize=7, loc="best")
+    save(fig, "fig-time-vs-size", "Growth wall time against plant size, log-log: one point per valid cell (the median "
+         "over its repetitions); bars where a cell has an interval: the distribution-free 95% CI of the median (6 "
+         "repetitions or more) or the range of its repetitions (2 to 5); a single trial has none. Lines: "
+         "least-squares fits, drawn only for an entry with at least 3 distinct sizes (node counts) spanning a factor "
+         "of 2; the legend gives each entry's number of distinct sizes and its exponent k with the 95% interval "
+         "(Student's t). The fit spans every valid cell of an algorithm entry in this suite, so where cells differ "
+         "in scene as well as size it mixes both; the scaling suite (bench/suites/scaling.json) varies only the "
+         "size, on one scene." + left_out)
 
     # 2. Memory and allocations vs size.
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
@@ -362,44 +579,49 @@ def figures(cells, out, formats):
         pts = [c for c in good if c.label == label]
         if not pts:
             continue
-        x = [c.nodes for c in pts]
-        axes[0].plot(x, [median(c.rss) / 2 ** 20 for c in pts], markers[i % len(markers)], color=colours[label], ms=4,
-                     label=label)
-        axes[1].plot(x, [max(c.alloc_bytes, 1) / 2 ** 20 for c in pts], markers[i % len(markers)], color=colours[label],
-                     ms=4, label=label)
-    for a, t in zip(axes, ["peak resident memory of the trial process (MiB)", "bytes allocated during growth (MiB)"]):
+        mem = [c for c in pts if c.growth_rss]
+        if mem:
+            axes[0].plot([c.nodes for c in mem], [median(c.growth_rss) / 2 ** 20 for c in mem],
+                         markers[i % len(markers)], color=colours[label], ms=4, label=label)
+        axes[1].plot([c.nodes for c in pts], [max(c.alloc_bytes, 1) / 2 ** 20 for c in pts], markers[i % len(markers)],
+                     color=colours[label], ms=4, label=label)
+    for a, t in zip(axes, ["growth peak RSS (MiB), median over repetitions", "bytes allocated during growth (MiB)"]):
         a.set_xscale("log")
         a.set_yscale("log")
         a.set_xlabel("plant nodes")
         a.set_ylabel(t)
-    axes[0].legend(fontsize=7)
+    legend(axes[0], fontsize=7)
     fig.suptitle("Memory against output size")
-    save(fig, "fig-memory-vs-size", "Peak resident memory (wait4's ru_maxrss of each trial's own process, median over "
-         "repetitions) and bytes allocated in the growth phase (counted by a replaced operator new), against plant size.")
+    save(fig, "fig-memory-vs-size", "Growth peak RSS (the growth phase's own peak resident memory, reset at its start; "
+         "median over repetitions) and bytes allocated in the growth phase (counted by a replaced operator new), "
+         "against plant size." + left_out)
 
     # 3. Output file size per format.
     fig, ax = plt.subplots(figsize=(7, 4))
     width = 0.8 / len(FORMATS)
     for k, (fmt, fmt_label) in enumerate(FORMATS):
-        meds, los, his = [], [], []
-        for label in labels:
-            v = [c.bytes.get(fmt, 0) / 2 ** 20 for c in good if c.label == label and fmt in c.bytes]
-            m = median(v) if v else 0
+        xs, meds, los, his = [], [], [], []
+        for j, label in enumerate(labels):
+            v = [c.bytes[fmt] / 2 ** 20 for c in good if c.label == label and c.bytes.get(fmt) is not None]
+            if not v:  # no bar: this entry has no such file (or no valid plant)
+                continue
+            m = median(v)
+            xs.append(j)
             meds.append(m)
-            los.append(m - (min(v) if v else 0))
-            his.append((max(v) if v else 0) - m)
-        ax.bar(np.arange(len(labels)) + (k - (len(FORMATS) - 1) / 2) * width, meds, width, yerr=[los, his], capsize=2,
-               label=fmt_label)
+            los.append(m - min(v))
+            his.append(max(v) - m)
+        ax.bar(np.array(xs, dtype=float) + (k - (len(FORMATS) - 1) / 2) * width, meds, width, yerr=[los, his],
+               capsize=2, label=fmt_label)
     ax.set_xticks(np.arange(len(labels)))
     ax.set_xticklabels(labels, rotation=20, ha="right")
     ax.set_yscale("log")
     ax.set_ylabel("file size (MiB), median over cells, bars: range")
     ax.set_title("Output file size per format")
-    ax.legend()
+    legend(ax)
     save(fig, "fig-file-size", "Output file size per format (OBJ with MTL, binary PLY, binary glTF in the plain layout "
          "and as written: compact unless the run chose another `--glb` layout), median over every scene and seed of each "
-         "algorithm entry; bars span the smallest to the largest. Runs recorded before the plain size was kept have "
-         "no GLB plain bar.")
+         "algorithm entry with a valid plant; bars span the smallest to the largest. Runs recorded before the plain "
+         "size was kept have no GLB plain bar." + left_out)
 
     # 4. Boxplots across seeds, per scene.
     scenes = ordered(c.scene for c in cells)
@@ -427,10 +649,10 @@ def figures(cells, out, formats):
         axes[idx // ncol][idx % ncol].axis("off")
     fig.suptitle("Growth time across seeds (each point: one seed's median over repetitions)")
     fig.tight_layout()
-    save(fig, "fig-seeds-boxplot", "Growth time across seeds for each algorithm entry and scene: boxes over the seeds' "
-         "medians, points are the seeds.")
+    save(fig, "fig-seeds-boxplot", "Growth time across seeds for each algorithm entry and scene: boxes over the valid "
+         "seeds' medians, points are the seeds." + left_out)
 
-    # 5. Quality metrics side by side.
+    # 5. Quality metrics side by side; a metric that does not apply (null) has no bar, never a bar at 0.
     qcols = (len(QUALITY) + 1) // 2
     fig, axes = plt.subplots(2, qcols, figsize=(4.3 * qcols, 7), squeeze=False)
     width = 0.8 / max(1, len(labels))
@@ -439,26 +661,31 @@ def figures(cells, out, formats):
     for idx, (key, title, _) in enumerate(QUALITY):
         a = axes[idx // qcols][idx % qcols]
         for i, label in enumerate(labels):
-            vals = []
-            for scene in scenes:
-                v = [c.metrics[key] for c in good if c.scene == scene and c.label == label and key in c.metrics]
-                vals.append(median(v) if v else 0.0)
-            a.bar(np.arange(len(scenes)) + (i - (len(labels) - 1) / 2) * width, vals, width, color=colours[label],
-                  label=label)
+            xs, vals = [], []
+            for j, scene in enumerate(scenes):
+                v = metric_values([c for c in good if c.scene == scene and c.label == label], key)
+                if v:
+                    xs.append(j)
+                    vals.append(median(v))
+            if xs:
+                a.bar(np.array(xs, dtype=float) + (i - (len(labels) - 1) / 2) * width, vals, width,
+                      color=colours[label], label=label)
         a.set_xticks(np.arange(len(scenes)))
         a.set_xticklabels(scenes, rotation=30, ha="right", fontsize=7)
         a.set_title(title)
         a.set_ylim(0, 1.05)
+    handles = [Patch(color=colours[l], label=l) for l in labels]
     if len(QUALITY) < 2 * qcols:  # the spare panel holds the legend, clear of the bars
-        spare = axes[1][qcols - 1]
-        spare.legend(*axes[0][0].get_legend_handles_labels(), loc="center", fontsize=9, frameon=False)
+        axes[1][qcols - 1].legend(handles=handles, loc="center", fontsize=9, frameon=False)
     else:
-        axes[0][0].legend(fontsize=7)
-    fig.suptitle("Quality metrics (median over seeds; the same definitions for every algorithm)")
+        axes[0][0].legend(handles=handles, fontsize=7)
+    fig.suptitle("Quality metrics (median over valid seeds; no bar: does not apply)")
     fig.tight_layout()
     save(fig, "fig-quality", "Quality metrics computed identically for every algorithm (harness/output/metrics.hpp): "
          "coverage of the climbable surface, fraction of nodes attached, penetration into solids, self-intersection, "
-         "leaf overlap and leaf light exposure with and without the plant's own shade; median over seeds.")
+         "leaf overlap and leaf light exposure with and without the plant's own shade; median over the valid seeds "
+         "where the metric applies. A metric that does not apply (no climbable surface, no leaves, no segments) has "
+         "no bar: it is not 0." + left_out)
 
     # 6. Growth curves: nodes against step, one panel per scene, the lowest seed.
     fig, axes = plt.subplots(nrow, ncol, figsize=(4.2 * ncol, 3.0 * nrow), squeeze=False)
@@ -475,9 +702,10 @@ def figures(cells, out, formats):
         a.set_ylabel("nodes")
     for idx in range(len(scenes), nrow * ncol):
         axes[idx // ncol][idx % ncol].axis("off")
-    axes[0][0].legend(fontsize=7)
+    legend(axes[0][0], fontsize=7)
     fig.tight_layout()
-    save(fig, "fig-growth-curves", "Growth curves: plant nodes after each step (lowest seed of each cell).")
+    save(fig, "fig-growth-curves", "Growth curves: plant nodes after each step (lowest valid seed of each cell)." +
+         left_out)
     sweep_figures(good, labels, colours, markers, plt, np, save)
     return written
 
@@ -498,7 +726,7 @@ def sweep_figures(good, labels, colours, markers, plt, np, save):
     seed's Figure 16 for the vines' resolution, and any other sweep)."""
     for key in swept_numbers(good):
         fig, ax = plt.subplots(figsize=(6.4, 4.4))
-        spans = []
+        spans, drawn = [], []
         scenes = ordered(c.scene for c in good)
         for i, label in enumerate(labels):
             for scene in ordered(c.scene for c in good if c.label == label):
@@ -514,11 +742,9 @@ def sweep_figures(good, labels, colours, markers, plt, np, save):
                     continue
                 x = np.array(sorted(by_value))
                 pts = [by_value[v] for v in x]
-                med = np.array([c.growth_median() for c in pts])
-                lo = med - np.array([c.growth_summary["lo"] if c.growth_summary else m for c, m in zip(pts, med)])
-                hi = np.array([c.growth_summary["hi"] if c.growth_summary else m for c, m in zip(pts, med)]) - med
-                ax.errorbar(x, med, yerr=[lo, hi], fmt=markers[j % len(markers)], ls=["-", "--", ":", "-."][j % 4],
-                            color=colours[label], ms=4, capsize=2, lw=1, label=f"{label} on {scene}")
+                time_points(ax, pts, x, markers[j % len(markers)], colours[label], f"{label} on {scene}",
+                            ls=["-", "--", ":", "-."][j % 4], lw=1)
+                drawn += pts
                 spans.append(x.max() / max(x.min(), 1e-300))
         if not spans:
             plt.close(fig)
@@ -527,12 +753,14 @@ def sweep_figures(good, labels, colours, markers, plt, np, save):
             ax.set_xscale("log")
             ax.set_yscale("log")
         ax.set_xlabel(key)
-        ax.set_ylabel("growth wall time (s), median and 95% interval")
+        ax.set_ylabel(time_axis_label(drawn))
         ax.set_title(f"Growth time against {key}")
         ax.legend(fontsize=7, loc="best")
         save(fig, f"fig-sweep-{re.sub(r'[^A-Za-z0-9_]+', '-', key)}",
              f"Growth wall time against the swept parameter {key}: one line per algorithm entry and scene (its lowest "
-             f"seed), points are the median over repetitions, bars its distribution-free 95% interval.")
+             f"valid seed); points are the median over repetitions, bars (where a cell has 2 or more) the "
+             f"distribution-free 95% CI of the median (6 repetitions or more) or the range of the repetitions. Plants "
+             f"judged degenerate or not applicable are left out.")
 
 
 # ---------------------------------------------------------------- HTML
@@ -542,7 +770,7 @@ body { font-family: DejaVu Sans, sans-serif; margin: 2em auto; padding: 0 2em; m
 h1 { font-size: 1.5em; } h2 { font-size: 1.2em; border-bottom: 1px solid #ccc; margin-top: 2em; }
 table { border-collapse: collapse; font-size: 0.85em; }
 th, td { padding: 3px 8px; border-bottom: 1px solid #ddd; text-align: right; }
-th:nth-child(-n+2), td:nth-child(-n+2) { text-align: left; }
+th:nth-child(-n+4), td:nth-child(-n+4) { text-align: left; }
 th { border-bottom: 2px solid #555; }
 tr.scene-start td { border-top: 2px solid #999; }
 .context td, .context th { text-align: left; }
@@ -551,6 +779,10 @@ img { max-width: 100%; border: 1px solid #ddd; }
 .missing { outline: 4px solid #c00; }
 #image-check { font-weight: bold; }
 .note { color: #555; font-size: 0.9em; }
+.banner { background: #fff3b0; border: 1px solid #d9b300; padding: 0.6em 1em; margin: 1em 0; }
+.banner p { margin: 0.3em 0; }
+.left-out li { font-size: 0.9em; }
+.wide { overflow-x: auto; } table.results { font-size: 0.8em; } table.results td { white-space: nowrap; }
 """
 
 # Marks any image that did not load, and records the count on <body> (a headless browser test reads it).
@@ -587,7 +819,23 @@ def write_metrics_doc(out):
     return "metrics.html"
 
 
-def write_html(path, doc, results_path, rows, figs, grids, failed, caption, metrics_doc=None, peers=()):
+def machine_state_rows(ctx):
+    """The context rows of the machine's state, where the run recorded it: the load averages (1, 5, 15 minutes)
+    when it began and ended, the CPU clock and its frequency governor."""
+    rows = []
+    loads = [f"{when} {', '.join(f'{x:.2f}' for x in ctx[k])}"
+             for when, k in (("at the start", "load_average_start"), ("at the end", "load_average_end"))
+             if isinstance(ctx.get(k), list)]
+    if loads:
+        rows.append(("load average (1, 5, 15 min)", "; ".join(loads)))
+    clock = ([f"{ctx['cpu_mhz']:.0f} MHz"] if isinstance(ctx.get("cpu_mhz"), (int, float)) else []) + \
+            ([f"governor {ctx['cpu_governor']}"] if ctx.get("cpu_governor") else [])
+    if clock:
+        rows.append(("CPU clock", ", ".join(clock)))
+    return rows
+
+
+def write_html(path, doc, results_path, rows, figs, grids, failed, caption, metrics_doc=None, peers=(), cells=()):
     e = html.escape
     how = (f" <a href='{e(metrics_doc)}'>How each quality metric is defined, and its error bound</a>."
            if metrics_doc else "")
@@ -597,14 +845,19 @@ def write_html(path, doc, results_path, rows, figs, grids, failed, caption, metr
     parts = ["<!DOCTYPE html>", "<html lang='en'><head><meta charset='utf-8'>",
              f"<title>growbench report: {e(suite.get('name', ''))}</title>", f"<style>{CSS}</style>",
              f"<script>{CHECK_SCRIPT}</script></head><body>",
-             f"<h1>growbench report: suite '{e(suite.get('name', '?'))}'</h1>",
-             f"<p>{e(suite.get('description', ''))}</p>", "<p id='image-check'>Checking images...</p>"]
+             f"<h1>growbench report: suite '{e(suite.get('name', '?'))}'</h1>"]
+    warnings = machine_warnings(doc, cells)
+    if warnings:  # the machine's state may have disturbed the timings: said before anything else
+        parts.append("<div class='banner' id='machine-banner'>" + "".join(f"<p>{e(w)}</p>" for w in warnings) +
+                     "</div>")
+    parts += [f"<p>{e(suite.get('description', ''))}</p>", "<p id='image-check'>Checking images...</p>"]
     parts.append("<h2>Context</h2><table class='context'>")
     deps = ctx.get("dependencies", {})
     for k, v in [("results file", os.path.abspath(results_path)),
                  ("commit", f"{ctx.get('growbench_commit', '?')} (uncommitted changes: {ctx.get('dirty', '?')})"),
                  ("date (UTC)", ctx.get("date", "?")),
                  ("machine", f"{ctx.get('cpu_model', '?')}, {ctx.get('hardware_threads', '?')} hardware threads"),
+                 *machine_state_rows(ctx),
                  ("build", f"{ctx.get('compiler', '?')}, {ctx.get('build_type', '?')}, flags '{ctx.get('cxx_flags', '').strip()}'"),
                  ("libraries", ", ".join(f"{k} {v}" for k, v in deps.items())),
                  ("repetitions", f"{doc.get('repetitions', '?')} per cell, each trial in its own process"),
@@ -631,24 +884,41 @@ def write_html(path, doc, results_path, rows, figs, grids, failed, caption, metr
                      "results directory, then the report again.</p>")
 
     parts.append("<h2>Table</h2>")
-    parts.append("<table><tr>" + "".join(f"<th>{e(h)}</th>" for h in TABLE_HEAD) + "</tr>")
+    parts.append("<div class='wide'><table class='results'><tr>" + "".join(f"<th>{e(h)}</th>" for h in TABLE_HEAD) +
+                 "</tr>")
     prev = None
     for r in rows:
         cls = " class='scene-start'" if prev is not None and r[1] != prev else ""
         prev = r[1]
         parts.append(f"<tr{cls}>" + "".join(f"<td>{e(x)}</td>" for x in r) + "</tr>")
-    parts.append("</table>")
+    parts.append("</table></div>")
     parts.append(f"<p class='note'>{e(caption)} Also as <a href='table.tex'>LaTeX (booktabs)</a> and "
                  f"<a href='table.md'>Markdown</a>.{how}</p>")
+
+    # Every plant judged other than valid, with its reasons: kept and shown, never silently dropped.
+    parts.append("<h2 id='left-out'>Plants left out of comparisons</h2>")
+    ex = excluded_cells(cells)
+    if ex:
+        parts.append("<p>These plants were judged degenerate or not applicable (docs/metrics.md, \"Validity\"): the "
+                     "table marks them in its verdict column, and they enter no pooled number, fit or figure.</p>")
+        parts.append("<ul class='left-out'>" + "".join(f"<li>{e(excluded_note(c))}</li>" for c in ex) + "</ul>")
+    elif any(c.verdict is not None for c in cells):
+        parts.append("<p>None: every plant that grew was judged valid.</p>")
+    else:
+        parts.append("<p>None marked: this results file has no verdicts (written before growbench judged its "
+                     "plants), so every plant that grew is compared.</p>")
 
     parts.append("<h2>Figures</h2>")
     for name, cap in figs:
         parts.append(f"<figure><img src='{e(name)}.png' alt='{e(name)}'><figcaption>{e(cap)} "
                      f"<a href='{e(name)}.pdf'>PDF</a>{how if name == 'fig-quality' else ''}</figcaption></figure>")
     parts += peers  # the "versus peers" section, when a peers.json was given or found
-    parts.append("<p class='note'>Generated by reports/report.py from the results file alone. Intervals: "
-                 "distribution-free 95% intervals of the median from order statistics ('~': fewer than 6 repetitions, "
-                 "the full range). Exponents: least squares on log-log medians, 95% interval from Student's t.</p>")
+    parts.append("<p class='note'>Generated by reports/report.py from the results file alone. Growth-time "
+                 "intervals: 'CI', the distribution-free 95% interval of the median from order statistics (6 trials "
+                 "or more); 'range', the smallest to the largest trial (2 to 5); one trial has none. Exponents k: "
+                 "least squares on log-log medians, fitted only over 3 or more distinct sizes spanning a factor of 2, "
+                 "with a 95% interval from Student's t. Memory: each phase's own peak resident memory; the trial "
+                 "process's peak stays in the results file.</p>")
     parts.append("</body></html>")
     with open(path, "w") as f:
         f.write("\n".join(parts) + "\n")
@@ -771,6 +1041,49 @@ def write_peers_only(path, out, formats):
 
 # ---------------------------------------------------------------- main
 
+def write_report(doc, results_path, out, formats, peers_path=None):
+    """Figures, tables and index.html in `out` from a results document already read and checked (load_results)."""
+    cells = [Cell(t) for t in doc["trials"]]
+    if not cells:
+        raise ReportError(f"{results_path}: no trials to report")
+    os.makedirs(out, exist_ok=True)
+    formats = list(formats)
+    if "png" not in formats:
+        formats.insert(0, "png")  # the HTML page shows the PNGs
+    print(f"report: {len(cells)} cells from {results_path}", file=sys.stderr)
+    figs = figures(cells, out, formats)
+
+    rows = table_rows(cells, pooled_summaries(doc))
+    notes = table_notes(cells)
+    write_latex(os.path.join(out, "table.tex"), rows, CAPTION, notes)
+    write_markdown(os.path.join(out, "table.md"), rows, CAPTION, notes)
+
+    # Renders: the grids named in the results file, copied beside the page so it stands alone.
+    grids = []
+    renders = doc.get("renders", {})
+    base = os.path.dirname(os.path.abspath(results_path))
+    names = ([(renders["grid"], "Every algorithm entry (rows) on every scene (columns), the lowest seed, rendered "
+                                "the same way (POV-Ray, shared materials, the scene's camera and light).")]
+             if renders.get("grid") else []) + \
+            [(f, f"{scene}: every algorithm entry") for scene, f in renders.get("grid_per_scene", {}).items()]
+    for name, title in names:
+        src = os.path.join(base, name)
+        if os.path.exists(src):
+            os.makedirs(os.path.join(out, "renders"), exist_ok=True)
+            shutil.copyfile(src, os.path.join(out, "renders", os.path.basename(name)))
+            grids.append(("renders/" + os.path.basename(name), title))
+        else:
+            print(f"report: warning: render grid {src} is missing", file=sys.stderr)
+    failed = [c for c in cells if not c.ok]
+    peers_path = peers_path or os.path.join(base, "peers.json")
+    peers = peers_html(load_peers(peers_path), peers_path, out, formats) if os.path.exists(peers_path) else []
+    write_html(os.path.join(out, "index.html"), doc, results_path, rows, figs, grids, failed, CAPTION,
+               write_metrics_doc(out), peers, cells)
+    print(f"report: wrote {len(figs)} figures ({', '.join(formats)}), table.tex, table.md and index.html "
+          f"in {out}", file=sys.stderr)
+    return figs
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("results", nargs="?", help="results.json written by `growbench suite`")
@@ -787,46 +1100,7 @@ def main(argv=None):
             print(f"report: wrote the versus-peers page {os.path.join(args.out, 'index.html')}", file=sys.stderr)
             return 0
         doc = load_results(args.results)
-        cells = [Cell(t) for t in doc["trials"]]
-        if not cells:
-            raise ReportError(f"{args.results}: no trials to report")
-        os.makedirs(args.out, exist_ok=True)
-        formats = [f for f in args.formats.split(",") if f]
-        if "png" not in formats:
-            formats.insert(0, "png")  # the HTML page shows the PNGs
-        print(f"report: {len(cells)} cells from {args.results}", file=sys.stderr)
-        figs = figures(cells, args.out, formats)
-
-        rows = table_rows(cells, pooled_summaries(doc))
-        caption = ("Median growth wall time over all repetitions of all seeds [distribution-free 95% interval; '~': "
-                   "the full range, fewer than 6 samples], peak memory of the trial process, GLB file size, nodes, and "
-                   "quality metrics (median over seeds).")
-        write_latex(os.path.join(args.out, "table.tex"), rows, caption)
-        write_markdown(os.path.join(args.out, "table.md"), rows, caption)
-
-        # Renders: the grids named in the results file, copied beside the page so it stands alone.
-        grids = []
-        renders = doc.get("renders", {})
-        base = os.path.dirname(os.path.abspath(args.results))
-        names = ([(renders["grid"], "Every algorithm entry (rows) on every scene (columns), the lowest seed, rendered "
-                                    "the same way (POV-Ray, shared materials, the scene's camera and light).")]
-                 if renders.get("grid") else []) + \
-                [(f, f"{scene}: every algorithm entry") for scene, f in renders.get("grid_per_scene", {}).items()]
-        for name, title in names:
-            src = os.path.join(base, name)
-            if os.path.exists(src):
-                os.makedirs(os.path.join(args.out, "renders"), exist_ok=True)
-                shutil.copyfile(src, os.path.join(args.out, "renders", os.path.basename(name)))
-                grids.append(("renders/" + os.path.basename(name), title))
-            else:
-                print(f"report: warning: render grid {src} is missing", file=sys.stderr)
-        failed = [c for c in cells if not c.ok]
-        peers_path = args.peers or os.path.join(base, "peers.json")
-        peers = peers_html(load_peers(peers_path), peers_path, args.out, formats) if os.path.exists(peers_path) else []
-        write_html(os.path.join(args.out, "index.html"), doc, args.results, rows, figs, grids, failed, caption,
-                   write_metrics_doc(args.out), peers)
-        print(f"report: wrote {len(figs)} figures ({', '.join(formats)}), table.tex, table.md and index.html "
-              f"in {args.out}", file=sys.stderr)
+        write_report(doc, args.results, args.out, [f for f in args.formats.split(",") if f], args.peers)
     except ReportError as e:
         print(f"report: error: {e}", file=sys.stderr)
         return 2
