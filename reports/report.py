@@ -43,6 +43,8 @@ import re
 import shutil
 import sys
 
+import paper_tables
+
 # The t quantiles t_{0.975, df} for df = 1..30 (beyond: 1.96).
 T975 = [12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160, 2.145, 2.131,
         2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056, 2.052, 2.048, 2.045, 2.042]
@@ -332,19 +334,6 @@ def metric_values(cells, key):
             if isinstance(c.metrics.get(key), (int, float)) and not isinstance(c.metrics.get(key), bool)]
 
 
-def metric_text(cells, key):
-    """Median over the cells that have the metric: '-' when no cell records it, 'n/a' when it is null in each."""
-    if not any(key in c.metrics for c in cells):
-        return "-"
-    v = metric_values(cells, key)
-    return fmt_frac(median(v)) if v else "n/a"
-
-
-def memory_text(values, reset):
-    """The median of a phase's own peaks; '*' when a peak could not be reset (it is the process's so far)."""
-    return "-" if not values else fmt_bytes(median(values)) + ("" if reset else " *")
-
-
 def pooled_text(valid, failed):
     """'3 seeds x 2 reps': what the row's numbers pool, and the cells that did not finish."""
     reps = [len(c.growth) for c in valid]
@@ -380,6 +369,8 @@ GROWTH_HEAD = "growth time (median; 95% CI or range)"
 TABLE_HEAD = ["algorithm", "scene", "trials pooled", "verdict", GROWTH_HEAD, "growth peak RSS", "query peak RSS",
               "GLB size", "nodes", "coverage", "attached", "penetration", "leaf overlap", "leaf light"]
 TABLE_LEFT = 4  # the columns aligned left: algorithm, scene, trials pooled, verdict
+# The quality metrics the tables show, in TABLE_HEAD's order.
+TABLE_METRICS = ["coverage", "attached_fraction", "penetration_samples", "leaf_overlap", "leaf_light_exposure"]
 CAPTION = ("Growth time: the median wall time over the repetitions of the row's valid seeds pooled ('trials "
            "pooled'), with the distribution-free 95% CI of the median ('CI', 6 trials or more) or the range of the "
            "trials ('range', 2 to 5); '1 trial': one trial, no interval. Growth peak RSS and query peak RSS: the "
@@ -391,37 +382,66 @@ CAPTION = ("Growth time: the median wall time over the repetitions of the row's 
            "judged (a file written before plants were).")
 
 
+def table_groups(cells):
+    """(label, scene, cells) per algorithm entry x scene, in the order the results file first names each."""
+    for scene in ordered(c.scene for c in cells):
+        for label in ordered(c.row for c in cells):
+            group = [c for c in cells if c.scene == scene and c.row == label]
+            if group:
+                yield label, scene, group
+
+
+def row_numbers(group, pooled=None):
+    """The numbers of one table row (an entry on a scene, seeds pooled), before any formatting: what the HTML,
+    Markdown and LaTeX tables print. Only valid seeds enter a number; `time` is the suite's summary over them
+    (n, median, lo, hi, exact) or, without one, {"median", "n"} of their trials; a metric is None where it does not
+    apply to any valid seed and absent where no cell records it."""
+    pooled = pooled or {}
+    valid = [c for c in group if c.valid]
+    r = {"group": group, "valid": valid, "failed": [c for c in group if not c.ok]}
+    if not valid:
+        return r
+    times = [x for c in valid for x in c.growth]
+    r["time"] = pooled.get(frozenset(c.id() for c in valid)) or {"median": median(times), "n": len(times)}
+    r["times"] = times
+    for key in ("growth_rss", "query_rss"):
+        values = [x for c in valid for x in getattr(c, key)]
+        if values:
+            r[key] = (median(values), all(getattr(c, key + "_reset") for c in valid))
+    glb = [c.bytes["glb"] for c in valid if c.bytes.get("glb") is not None]
+    if glb:
+        r["glb"] = median(glb)
+    r["nodes"] = median([c.nodes for c in valid])
+    r["metrics"] = {}
+    for key, *_ in QUALITY:
+        if any(key in c.metrics for c in valid):
+            v = metric_values(valid, key)
+            r["metrics"][key] = median(v) if v else None
+    return r
+
+
 def table_rows(cells, pooled=None):
     """One row per algorithm entry x scene (seeds pooled): repetition times of every valid seed together, with the
     interval the suite computed over them (`pooled`: pooled_summaries of the results file). Seeds whose plants are
     not valid are counted in the verdict column and enter no number; a row without a valid seed shows none."""
-    pooled = pooled or {}
     rows = []
-    for scene in ordered(c.scene for c in cells):
-        for label in ordered(c.row for c in cells):
-            group = [c for c in cells if c.scene == scene and c.row == label]
-            if not group:
-                continue
-            failed = [c for c in group if not c.ok]
-            valid = [c for c in group if c.valid]
-            head = [label, scene, pooled_text(valid, failed), verdict_text(group)]
-            if not valid:
-                # Nothing to show as a result: the statuses of cells that did not finish, else (plants that were
-                # not valid) no numbers at all.
-                first = ", ".join(sorted({c.status for c in failed})) if len(failed) == len(group) else "-"
-                rows.append(head + [first] + ["-"] * (len(TABLE_HEAD) - len(head) - 1))
-                continue
-            times = [x for c in valid for x in c.growth]
-            summary = pooled.get(frozenset(c.id() for c in valid))
-            glb = [c.bytes["glb"] for c in valid if c.bytes.get("glb") is not None]
-            rows.append(head + [
-                growth_time_text(summary, times),
-                memory_text([x for c in valid for x in c.growth_rss], all(c.growth_rss_reset for c in valid)),
-                memory_text([x for c in valid for x in c.query_rss], all(c.query_rss_reset for c in valid)),
-                fmt_bytes(median(glb)) if glb else "-", f"{median([c.nodes for c in valid]):.0f}",
-                metric_text(valid, "coverage"), metric_text(valid, "attached_fraction"),
-                metric_text(valid, "penetration_samples"), metric_text(valid, "leaf_overlap"),
-                metric_text(valid, "leaf_light_exposure")])
+    for label, scene, group in table_groups(cells):
+        r = row_numbers(group, pooled)
+        failed = r["failed"]
+        head = [label, scene, pooled_text(r["valid"], failed), verdict_text(group)]
+        if not r["valid"]:
+            # Nothing to show as a result: the statuses of cells that did not finish, else (plants that were not
+            # valid) no numbers at all.
+            first = ", ".join(sorted({c.status for c in failed})) if len(failed) == len(group) else "-"
+            rows.append(head + [first] + ["-"] * (len(TABLE_HEAD) - len(head) - 1))
+            continue
+        summary = r["time"] if "lo" in r["time"] else None
+        memory = lambda k: "-" if k not in r else fmt_bytes(r[k][0]) + ("" if r[k][1] else " *")
+        metric = lambda k: "-" if k not in r["metrics"] else ("n/a" if r["metrics"][k] is None else
+                                                              fmt_frac(r["metrics"][k]))
+        rows.append(head + [growth_time_text(summary, r["times"]), memory("growth_rss"), memory("query_rss"),
+                            fmt_bytes(r["glb"]) if "glb" in r else "-", f"{r['nodes']:.0f}",
+                            *(metric(k) for k in TABLE_METRICS)])
     return rows
 
 
@@ -431,36 +451,6 @@ def table_notes(cells):
     if not ex:
         return []
     return ["Left out of comparisons (verdict not valid):"] + [excluded_note(c) for c in ex]
-
-
-LATEX_SPECIAL = {"\\": "\\textbackslash{}", "&": "\\&", "%": "\\%", "_": "\\_", "#": "\\#", "~": "$\\sim$",
-                 "[": "{[}", "]": "{]}", "$": "\\$", "{": "\\{", "}": "\\}", "^": "\\^{}"}
-
-
-def latex_escape(s):
-    """Text for LaTeX: each special character replaced once (a verdict's reasons are free text)."""
-    return re.sub(r"[\\&%_#~\[\]$\{\}^]", lambda m: LATEX_SPECIAL[m.group(0)], s)
-
-
-def write_latex(path, rows, caption, notes=()):
-    lines = ["% growbench report table; needs \\usepackage{booktabs}",
-             "\\begin{table}[t]", "\\centering", "\\small",
-             "\\begin{tabular}{" + "l" * TABLE_LEFT + "r" * (len(TABLE_HEAD) - TABLE_LEFT) + "}", "\\toprule",
-             " & ".join(latex_escape(h) for h in TABLE_HEAD) + " \\\\", "\\midrule"]
-    prev_scene = None
-    for r in rows:
-        if prev_scene is not None and r[1] != prev_scene:
-            lines.append("\\midrule")
-        prev_scene = r[1]
-        lines.append(" & ".join(latex_escape(x) for x in r) + " \\\\")
-    lines += ["\\bottomrule", "\\end{tabular}"]
-    if notes:  # the plants left out of comparisons, under the table
-        lines += ["", "\\smallskip", "{\\footnotesize\\raggedright " + latex_escape(notes[0])]
-        lines += ["\\\\ " + latex_escape(n) for n in notes[1:]]
-        lines += ["\\par}"]
-    lines += [f"\\caption{{{latex_escape(caption)}}}", "\\end{table}", ""]
-    with open(path, "w") as f:
-        f.write("\n".join(lines))
 
 
 def write_markdown(path, rows, caption, notes=()):
@@ -1053,9 +1043,12 @@ def write_report(doc, results_path, out, formats, peers_path=None):
     print(f"report: {len(cells)} cells from {results_path}", file=sys.stderr)
     figs = figures(cells, out, formats)
 
-    rows = table_rows(cells, pooled_summaries(doc))
+    pooled = pooled_summaries(doc)
+    rows = table_rows(cells, pooled)
     notes = table_notes(cells)
-    write_latex(os.path.join(out, "table.tex"), rows, CAPTION, notes)
+    paper_tables.write_tex(os.path.join(out, "table.tex"),
+                           {(label, scene): row_numbers(group, pooled) for label, scene, group in table_groups(cells)},
+                           ordered(c.row for c in cells), ordered(c.scene for c in cells), QUALITY, notes)
     write_markdown(os.path.join(out, "table.md"), rows, CAPTION, notes)
 
     # Renders: the grids named in the results file, copied beside the page so it stands alone.

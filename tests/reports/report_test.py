@@ -145,12 +145,13 @@ class Tables(unittest.TestCase):
         pooled = {frozenset(["ivy_luft/wall/s1"]): {"n": 2, "median": 0.55, "lo": 0.5, "hi": 0.6, "exact": False}}
         rows = report.table_rows(cells, pooled)
         with tempfile.TemporaryDirectory() as d:
-            report.write_latex(os.path.join(d, "t.tex"), rows, "50% of it")
+            report.paper_tables.write_tex(os.path.join(d, "t.tex"), {("ivy_luft", "wall"): report.row_numbers(
+                cells, pooled)}, ["ivy_luft"], ["wall"], report.QUALITY)
             tex = read(os.path.join(d, "t.tex"))
             self.assertIn("\\toprule", tex)
-            self.assertIn("ivy\\_luft & wall", tex)
-            self.assertIn("50\\% of it", tex)
-            self.assertIn("550.0 ms range {[}500.0 ms, 600.0 ms{]}", tex)  # '[' and ']' escaped
+            self.assertIn("\\caption{Growth time (ms): the median", tex)
+            self.assertIn("ivy\\_luft & 550 [500, 600] \\\\", tex)  # the unit in the caption, not the cell
+            self.assertNotIn("Leaf overlap", tex)  # no cell records it: no table
             report.write_markdown(os.path.join(d, "t.md"), rows, "c")
             md = read(os.path.join(d, "t.md")).splitlines()
             self.assertEqual(md[0].count("|"), len(report.TABLE_HEAD) + 1)
@@ -250,10 +251,13 @@ class Verdicts(unittest.TestCase):
             md = read(os.path.join(d, "t.md"))
             self.assertIn("caption\n\nLeft out of comparisons (verdict not valid):\n\n- a/wall/s3: degenerate: flat; "
                           "stunted\n- b/wall/s1: not applicable", md)
-            report.write_latex(os.path.join(d, "t.tex"), rows, "caption", notes)
+            report.paper_tables.write_tex(os.path.join(d, "t.tex"), {(l, s): report.row_numbers(g) for l, s, g in
+                                                                      report.table_groups(cells)}, ["a", "b"],
+                                          ["wall"], report.QUALITY, notes)
             tex = read(os.path.join(d, "t.tex"))
-            self.assertIn("\\\\ a/wall/s3: degenerate: flat; stunted", tex)
-            self.assertLess(tex.index("\\end{tabular}"), tex.index("a/wall/s3: degenerate"))
+            self.assertIn("a/wall/s3: degenerate: flat; stunted\\\\", tex)
+            self.assertIn("b & not appl. \\\\", tex)
+            self.assertLess(tex.rindex("\\end{tabular}"), tex.index("a/wall/s3: degenerate"))
 
     def test_figures_and_the_fit_leave_out_a_degenerate_cell(self):
         cells = [report.Cell(t) for t in [
