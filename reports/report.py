@@ -506,38 +506,117 @@ def time_points(ax, pts, x, fmt, colour, label, **style):
                     fmt="none", ecolor=colour, capsize=2, lw=1)
 
 
-def figures(cells, out, formats):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    import numpy as np
-    from matplotlib.patches import Patch
+# The quality of the Pareto figures unless the report is asked for another (--pareto-metric), and the metrics for
+# which less is better (every other is better higher).
+PARETO_METRIC = "coverage"
+LOWER_IS_BETTER = {"penetration_nodes", "penetration_samples", "self_intersections", "self_intersection_fraction",
+                   "leaf_overlap", "adhesion_mean_m", "adhesion_median_m", "adhesion_p90_m"}
 
-    plt.rcParams.update({"font.size": 9, "axes.grid": True, "grid.alpha": 0.3, "figure.dpi": 110,
-                         "savefig.bbox": "tight", "pdf.fonttype": 42})
-    labels = ordered(c.label for c in cells)
-    colours = {l: plt.cm.tab10(i % 10) for i, l in enumerate(labels)}
-    markers = "osD^v<>ph*"
-    written = []
 
-    def save(fig, name, caption):
-        for ext in formats:
-            fig.savefig(os.path.join(out, f"{name}.{ext}"), metadata={"CreationDate": None} if ext == "pdf" else None)
-        plt.close(fig)
-        written.append((name, caption))
+# Every figure is drawn at the width it is printed at, a single column or the full text width of a two-column
+# paper, with no font under MIN_FONT_PT there (tests/reports/paper_figures_test.py reads the PDFs).
+COLUMN_IN, PAGE_IN, MIN_FONT_PT = 3.5, 7.0, 7
+STYLE = {"font.size": 8, "axes.titlesize": 8, "axes.labelsize": 8, "xtick.labelsize": 7, "ytick.labelsize": 7,
+         "legend.fontsize": 7, "figure.titlesize": 8, "axes.grid": True, "grid.alpha": 0.3, "grid.linewidth": 0.5,
+         "lines.markersize": 3.5, "lines.linewidth": 1.0, "axes.linewidth": 0.6, "pdf.fonttype": 42,
+         "savefig.dpi": 200, "legend.frameon": False}
+LEFT_OUT = " Plants judged degenerate or not applicable are left out (listed under the table)."
 
-    def legend(ax, **kw):
-        if ax.get_legend_handles_labels()[0]:
-            ax.legend(**kw)
 
-    # Only valid plants (or unjudged, in older files) enter the figures: they compare cells.
-    good = [c for c in cells if c.valid and c.nodes > 0]
-    left_out = " Plants judged degenerate or not applicable are left out (listed under the table)."
+def tick_text(v, _pos=None):
+    """A log axis's tick as plain text (10k, 0.01): matplotlib's 10^n sets the exponent at 70% of the tick size."""
+    if v <= 0:
+        return ""
+    for f, suffix in ((1e9, "G"), (1e6, "M"), (1e3, "k")):
+        if v >= f:
+            return f"{v / f:g}{suffix}"
+    return f"{v:g}"
 
-    # 1. Growth time vs output size, log-log, with fitted exponents.
-    fig, ax = plt.subplots(figsize=(6.4, 4.6))
-    for i, label in enumerate(labels):
-        pts = [c for c in good if c.label == label]
+
+def plain_log_ticks(ax):
+    """Plain tick labels on the log axes of `ax`; where the axis spans under two decades the minor ticks at 2 and 5
+    times a power of ten are labelled too, so that it has more than one label."""
+    from matplotlib.ticker import FuncFormatter, NullFormatter
+
+    def minor(v, pos=None):
+        mantissa = v / 10 ** math.floor(math.log10(v) + 1e-9) if v > 0 else 0
+        return tick_text(v) if any(math.isclose(mantissa, m, rel_tol=1e-6) for m in (2, 5)) else ""
+    for axis, (lo, hi) in ((ax.xaxis, ax.get_xlim()), (ax.yaxis, ax.get_ylim())):
+        if axis.get_scale() != "log":
+            continue
+        axis.set_major_formatter(FuncFormatter(tick_text))
+        lo, hi = min(lo, hi), max(lo, hi)
+        axis.set_minor_formatter(FuncFormatter(minor) if lo > 0 and hi / lo < 100 else NullFormatter())
+
+
+class Canvas:
+    """What every figure shares: pyplot, the entries' colours and markers, the valid cells, and what was written."""
+
+    def __init__(self, cells, out, formats):
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        import numpy as np
+        plt.rcParams.update(STYLE)
+        self.plt, self.np, self.out, self.formats = plt, np, out, formats
+        self.cells = cells
+        self.labels = ordered(c.label for c in cells)
+        self.scenes = ordered(c.scene for c in cells)
+        self.colours = {l: plt.cm.tab10(i % 10) for i, l in enumerate(self.labels)}
+        self.markers = "osD^v<>ph*"
+        self.marker = {l: self.markers[i % len(self.markers)] for i, l in enumerate(self.labels)}
+        # Only valid plants (or unjudged, in older files) enter the figures: they compare cells.
+        self.good = [c for c in cells if c.valid and c.nodes > 0]
+        self.written = []
+
+    def figure(self, width, height):
+        return self.plt.figure(figsize=(width, height), layout="constrained")
+
+    def save(self, fig, name, caption):
+        """Writes the figure at its own size (no tight crop: the PDF is exactly as wide as the page asks)."""
+        width = fig.get_size_inches()[0]
+        for ax in fig.axes:
+            plain_log_ticks(ax)
+        for ext in self.formats:
+            fig.savefig(os.path.join(self.out, f"{name}.{ext}"), metadata={"CreationDate": None} if ext == "pdf" else None)
+        self.plt.close(fig)
+        self.written.append((name, caption + f" Drawn {width:g} in wide."))
+
+    def legend_panel(self, ax, handles=None, labels=None, **kw):
+        """An axes given over to the legend, beside the plots rather than over their data."""
+        ax.axis("off")
+        if handles is None:
+            handles, labels = [], []
+            for a in ax.figure.axes:
+                for h, l in zip(*a.get_legend_handles_labels()):
+                    if l not in labels:
+                        handles.append(h)
+                        labels.append(l)
+        if handles:
+            ax.legend(handles, labels, loc="upper left", borderaxespad=0, **kw)
+
+    def entry_handles(self, labels=None, markers=True):
+        from matplotlib.lines import Line2D
+        return [Line2D([], [], color=self.colours[l], marker=self.marker[l] if markers else None, ls="-", label=l)
+                for l in (labels or self.labels)], list(labels or self.labels)
+
+    def panels(self, n, ncol, panel_h, extra=0):
+        """A full-width figure of n panels in rows of ncol (and `extra` more slots, e.g. for a legend)."""
+        slots = n + extra
+        ncol = max(1, min(ncol, slots))
+        nrow = math.ceil(slots / ncol)
+        fig = self.figure(PAGE_IN, panel_h * nrow + 0.3)
+        axes = [fig.add_subplot(nrow, ncol, i + 1) for i in range(slots)]
+        return fig, axes
+
+
+def figure_time_vs_size(F):
+    np = F.np
+    fig = F.figure(PAGE_IN, 3.2)
+    gs = fig.add_gridspec(1, 2, width_ratios=[3, 2])
+    ax, lax = fig.add_subplot(gs[0]), fig.add_subplot(gs[1])
+    for label in F.labels:
+        pts = [c for c in F.good if c.label == label]
         if not pts:
             continue
         x = np.array([c.nodes for c in pts], dtype=float)
@@ -546,158 +625,213 @@ def figures(cells, out, formats):
         if fit:
             b, ci, a = fit
             xs = np.geomspace(x.min(), x.max(), 20)
-            ax.plot(xs, np.exp(a) * xs ** b, "-", color=colours[label], alpha=0.6, lw=1)
-        time_points(ax, pts, x, markers[i % len(markers)], colours[label], scaling_legend(label, sizes, fit))
+            ax.plot(xs, np.exp(a) * xs ** b, "-", color=F.colours[label], alpha=0.6, lw=1)
+        time_points(ax, pts, x, F.marker[label], F.colours[label], scaling_legend(label, sizes, fit))
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("plant nodes (output size)")
-    ax.set_ylabel(time_axis_label(good))
+    ax.set_ylabel(time_axis_label(F.good))
     ax.set_title("Growth time against output size")
-    legend(ax, fontsize=7, loc="best")
-    save(fig, "fig-time-vs-size", "Growth wall time against plant size, log-log: one point per valid cell (the median "
-         "over its repetitions); bars where a cell has an interval: the distribution-free 95% CI of the median (6 "
-         "repetitions or more) or the range of its repetitions (2 to 5); a single trial has none. Lines: "
-         "least-squares fits, drawn only for an entry with at least 3 distinct sizes (node counts) spanning a factor "
-         "of 2; the legend gives each entry's number of distinct sizes and its exponent k with the 95% interval "
-         "(Student's t). The fit spans every valid cell of an algorithm entry in this suite, so where cells differ "
-         "in scene as well as size it mixes both; the scaling suite (bench/suites/scaling.json) varies only the "
-         "size, on one scene." + left_out)
+    handles, names = ax.get_legend_handles_labels()
+    F.legend_panel(lax, handles, names)
+    F.save(fig, "fig-time-vs-size", "Growth wall time against plant size, log-log: one point per valid cell (the "
+           "median over its repetitions); bars where a cell has an interval: the distribution-free 95% CI of the "
+           "median (6 repetitions or more) or the range of its repetitions (2 to 5); a single trial has none. Lines: "
+           "least-squares fits, drawn only for an entry with at least 3 distinct sizes (node counts) spanning a factor "
+           "of 2; the legend gives each entry's number of distinct sizes and its exponent k with the 95% interval "
+           "(Student's t). The fit spans every valid cell of an algorithm entry in this suite, so where cells differ "
+           "in scene as well as size it mixes both; the scaling suite (bench/suites/scaling.json) varies only the "
+           "size, on one scene." + LEFT_OUT)
 
-    # 2. Memory and allocations vs size.
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
-    for i, label in enumerate(labels):
-        pts = [c for c in good if c.label == label]
-        if not pts:
-            continue
+
+def figure_memory(F):
+    fig = F.figure(PAGE_IN, 2.8)
+    gs = fig.add_gridspec(1, 3, width_ratios=[3, 3, 1.5])
+    axes = [fig.add_subplot(gs[0]), fig.add_subplot(gs[1])]
+    for label in F.labels:
+        pts = [c for c in F.good if c.label == label]
         mem = [c for c in pts if c.growth_rss]
         if mem:
-            axes[0].plot([c.nodes for c in mem], [median(c.growth_rss) / 2 ** 20 for c in mem],
-                         markers[i % len(markers)], color=colours[label], ms=4, label=label)
-        axes[1].plot([c.nodes for c in pts], [max(c.alloc_bytes, 1) / 2 ** 20 for c in pts], markers[i % len(markers)],
-                     color=colours[label], ms=4, label=label)
+            axes[0].plot([c.nodes for c in mem], [median(c.growth_rss) / 2 ** 20 for c in mem], F.marker[label],
+                         color=F.colours[label], label=label)
+        if pts:
+            axes[1].plot([c.nodes for c in pts], [max(c.alloc_bytes, 1) / 2 ** 20 for c in pts], F.marker[label],
+                         color=F.colours[label], label=label)
     for a, t in zip(axes, ["growth peak RSS (MiB), median over repetitions", "bytes allocated during growth (MiB)"]):
         a.set_xscale("log")
         a.set_yscale("log")
         a.set_xlabel("plant nodes")
         a.set_ylabel(t)
-    legend(axes[0], fontsize=7)
-    fig.suptitle("Memory against output size")
-    save(fig, "fig-memory-vs-size", "Growth peak RSS (the growth phase's own peak resident memory, reset at its start; "
-         "median over repetitions) and bytes allocated in the growth phase (counted by a replaced operator new), "
-         "against plant size." + left_out)
+    axes[0].set_title("Growth phase's peak memory")
+    axes[1].set_title("Allocated during growth")
+    F.legend_panel(fig.add_subplot(gs[2]), *F.entry_handles(ordered(c.label for c in F.good)))
+    F.save(fig, "fig-memory-vs-size", "Growth peak RSS (the growth phase's own peak resident memory, reset at its "
+           "start; median over repetitions) and bytes allocated in the growth phase (counted by a replaced operator "
+           "new), against plant size, log-log." + LEFT_OUT)
 
-    # 3. Output file size per format.
-    fig, ax = plt.subplots(figsize=(7, 4))
-    width = 0.8 / len(FORMATS)
+
+def figure_file_size(F):
+    """Points on a log axis (a bar's length means nothing there), with the range over cells."""
+    np = F.np
+    fig = F.figure(PAGE_IN, 2.8)
+    gs = fig.add_gridspec(1, 2, width_ratios=[5, 1.2])
+    ax = fig.add_subplot(gs[0])
+    labels = ordered(c.label for c in F.good)
+    width = 0.7 / len(FORMATS)
     for k, (fmt, fmt_label) in enumerate(FORMATS):
         xs, meds, los, his = [], [], [], []
         for j, label in enumerate(labels):
-            v = [c.bytes[fmt] / 2 ** 20 for c in good if c.label == label and c.bytes.get(fmt) is not None]
-            if not v:  # no bar: this entry has no such file (or no valid plant)
-                continue
-            m = median(v)
-            xs.append(j)
-            meds.append(m)
-            los.append(m - min(v))
-            his.append(max(v) - m)
-        ax.bar(np.array(xs, dtype=float) + (k - (len(FORMATS) - 1) / 2) * width, meds, width, yerr=[los, his],
-               capsize=2, label=fmt_label)
+            v = [c.bytes[fmt] / 2 ** 20 for c in F.good if c.label == label and c.bytes.get(fmt) is not None]
+            if v:  # no point: this entry has no such file
+                m = median(v)
+                xs.append(j + (k - (len(FORMATS) - 1) / 2) * width)
+                meds.append(m)
+                los.append(m - min(v))
+                his.append(max(v) - m)
+        if xs:
+            ax.errorbar(xs, meds, yerr=[los, his], fmt=F.markers[k], capsize=1.5, lw=0.8, label=fmt_label)
     ax.set_xticks(np.arange(len(labels)))
-    ax.set_xticklabels(labels, rotation=20, ha="right")
+    ax.set_xticklabels(labels, rotation=25, ha="right")
     ax.set_yscale("log")
-    ax.set_ylabel("file size (MiB), median over cells, bars: range")
+    ax.set_ylabel("file size (MiB)\nmedian over cells, bars: range")
     ax.set_title("Output file size per format")
-    legend(ax)
-    save(fig, "fig-file-size", "Output file size per format (OBJ with MTL, binary PLY, binary glTF in the plain layout "
-         "and as written: compact unless the run chose another `--glb` layout), median over every scene and seed of each "
-         "algorithm entry with a valid plant; bars span the smallest to the largest. Runs recorded before the plain "
-         "size was kept have no GLB plain bar." + left_out)
+    F.legend_panel(fig.add_subplot(gs[1]), *ax.get_legend_handles_labels())
+    F.save(fig, "fig-file-size", "Output file size per format (OBJ with MTL, binary PLY, binary glTF in the plain "
+           "layout and as written: compact unless the run chose another `--glb` layout), log scale: points are the "
+           "median over every scene and seed of each algorithm entry with a valid plant, bars span the smallest to "
+           "the largest. Runs recorded before the plain size was kept have no GLB plain point." + LEFT_OUT)
 
-    # 4. Boxplots across seeds, per scene.
-    scenes = ordered(c.scene for c in cells)
-    ncol = min(3, len(scenes))
-    nrow = math.ceil(len(scenes) / ncol)
-    fig, axes = plt.subplots(nrow, ncol, figsize=(4.2 * ncol, 3.2 * nrow), squeeze=False)
-    for idx, scene in enumerate(scenes):
-        a = axes[idx // ncol][idx % ncol]
-        data, names = [], []
-        for label in labels:
-            v = [c.growth_median() for c in good if c.scene == scene and c.label == label]
-            if v:
-                data.append(v)
-                names.append(label)
-        if data:
-            a.boxplot(data, showfliers=False)
-            for j, v in enumerate(data):
-                a.plot(np.full(len(v), j + 1.0), v, ".", color="k", ms=3, alpha=0.6)
-            a.set_xticks(range(1, len(names) + 1))
-            a.set_xticklabels(names, rotation=30, ha="right", fontsize=7)
-            a.set_yscale("log")
+
+def entry_axis(F, ax, labels, first):
+    """Algorithm entries down the y axis, the first at the top; named only on the first panel of a row."""
+    ax.set_yticks(range(len(labels)))
+    ax.set_yticklabels(labels if first else [])
+    ax.set_ylim(len(labels) - 0.5, -0.5)
+    ax.grid(axis="y", visible=False)
+
+
+def figure_seeds(F):
+    """Per scene: each entry's seeds as points (drawn over the box), a box only over 5 seeds or more."""
+    np = F.np
+    rows = ordered(c.row for c in F.good)
+    labels = rows
+    if not labels:
+        return
+    ncol = 4
+    fig, axes = F.panels(len(F.scenes), ncol, 0.45 + 0.14 * len(labels))
+    for idx, scene in enumerate(F.scenes):
+        a = axes[idx]
+        for j, label in enumerate(labels):
+            cs = [c for c in F.good if c.scene == scene and c.row == label]
+            v = sorted(c.growth_median() for c in cs)
+            if not v:
+                continue
+            entry = cs[0].label
+            if len(v) >= 5:
+                a.boxplot([v], positions=[j], vert=False, widths=0.6, showfliers=False, manage_ticks=False,
+                          medianprops={"color": "k"})
+            else:
+                a.plot([median(v)], [j], "|", color="k", ms=8)
+            jitter = np.linspace(-0.2, 0.2, len(v)) if len(v) > 1 else [0.0]
+            a.plot(v, [j + d for d in jitter], F.marker[entry], color=F.colours[entry], zorder=3, ms=3)
+        a.set_xscale("log")
         a.set_title(scene)
-        a.set_ylabel("growth time (s)")
-    for idx in range(len(scenes), nrow * ncol):
-        axes[idx // ncol][idx % ncol].axis("off")
-    fig.suptitle("Growth time across seeds (each point: one seed's median over repetitions)")
-    fig.tight_layout()
-    save(fig, "fig-seeds-boxplot", "Growth time across seeds for each algorithm entry and scene: boxes over the valid "
-         "seeds' medians, points are the seeds." + left_out)
+        entry_axis(F, a, labels, idx % ncol == 0)
+        if idx >= len(F.scenes) - ncol:
+            a.set_xlabel("growth time (s)")
+    for a in axes[len(F.scenes):]:
+        a.axis("off")
+    F.save(fig, "fig-seeds", "Growth time across seeds, per scene: each point is one valid seed's median over its "
+           "repetitions; the black tick is their median, and a box (quartiles, whiskers to the extremes) is drawn only "
+           "over 5 seeds or more." + LEFT_OUT)
 
-    # 5. Quality metrics side by side; a metric that does not apply (null) has no bar, never a bar at 0.
-    qcols = (len(QUALITY) + 1) // 2
-    fig, axes = plt.subplots(2, qcols, figsize=(4.3 * qcols, 7), squeeze=False)
-    width = 0.8 / max(1, len(labels))
-    for idx in range(len(QUALITY), 2 * qcols):
-        axes[idx // qcols][idx % qcols].axis("off")
-    for idx, (key, title, _) in enumerate(QUALITY):
-        a = axes[idx // qcols][idx % qcols]
-        for i, label in enumerate(labels):
-            xs, vals = [], []
-            for j, scene in enumerate(scenes):
-                v = metric_values([c for c in good if c.scene == scene and c.label == label], key)
-                if v:
-                    xs.append(j)
-                    vals.append(median(v))
-            if xs:
-                a.bar(np.array(xs, dtype=float) + (i - (len(labels) - 1) / 2) * width, vals, width,
-                      color=colours[label], label=label)
-        a.set_xticks(np.arange(len(scenes)))
-        a.set_xticklabels(scenes, rotation=30, ha="right", fontsize=7)
+
+def figure_quality(F):
+    """Per metric: each entry's median over seeds per scene, a line over the seeds' range; n/a draws nothing."""
+    import textwrap
+    keys = [(k, "\n".join(textwrap.wrap(t, 26))) for k, t, _ in QUALITY if metric_values(F.good, k)]
+    labels = ordered(c.row for c in F.good)  # a sweep's values are rows of their own
+    if not keys or not labels:
+        return
+    ncol = 4
+    fig, axes = F.panels(len(keys), ncol, 0.5 + 0.16 * len(labels), extra=1 + (-(len(keys) + 1)) % ncol)
+    scene_colour = {s: F.plt.cm.Dark2(i % 8) for i, s in enumerate(F.scenes)}
+    scene_marker = {s: "os^Dv<>ph*"[i % 10] for i, s in enumerate(F.scenes)}
+    step = 0.7 / max(1, len(F.scenes))
+    for idx, (key, title) in enumerate(keys):
+        a = axes[idx]
+        for j, label in enumerate(labels):
+            for i, scene in enumerate(F.scenes):
+                v = metric_values([c for c in F.good if c.scene == scene and c.row == label], key)
+                if not v:
+                    continue
+                y = j + (i - (len(F.scenes) - 1) / 2) * step
+                if len(v) > 1:
+                    a.plot([min(v), max(v)], [y, y], "-", color=scene_colour[scene], lw=0.8)
+                a.plot([median(v)], [y], scene_marker[scene], color=scene_colour[scene], ms=3)
+        a.set_xlim(-0.03, 1.03)
         a.set_title(title)
-        a.set_ylim(0, 1.05)
-    handles = [Patch(color=colours[l], label=l) for l in labels]
-    if len(QUALITY) < 2 * qcols:  # the spare panel holds the legend, clear of the bars
-        axes[1][qcols - 1].legend(handles=handles, loc="center", fontsize=9, frameon=False)
-    else:
-        axes[0][0].legend(handles=handles, fontsize=7)
-    fig.suptitle("Quality metrics (median over valid seeds; no bar: does not apply)")
-    fig.tight_layout()
-    save(fig, "fig-quality", "Quality metrics computed identically for every algorithm (harness/output/metrics.hpp): "
-         "coverage of the climbable surface, fraction of nodes attached, penetration into solids, self-intersection, "
-         "leaf overlap and leaf light exposure with and without the plant's own shade; median over the valid seeds "
-         "where the metric applies. A metric that does not apply (no climbable surface, no leaves, no segments) has "
-         "no bar: it is not 0." + left_out)
+        a.set_xlabel("fraction")
+        entry_axis(F, a, labels, idx % ncol == 0)
+    from matplotlib.lines import Line2D
+    handles = [Line2D([], [], color=scene_colour[s], marker=scene_marker[s], ls="-", label=s) for s in F.scenes]
+    for a in axes[len(keys):]:
+        a.axis("off")
+    F.legend_panel(axes[-1], handles, list(F.scenes), title="scene\n(line: range over seeds)")
+    F.save(fig, "fig-quality", "Quality metrics computed identically for every algorithm (harness/output/metrics.hpp): "
+           "coverage of the climbable surface, fraction of nodes attached, penetration into solids, self-intersection, "
+           "leaf overlap and leaf light exposure with and without the plant's own shade. Per algorithm entry (rows) "
+           "and scene (marker): the median over the valid seeds, and a line over their range where there are two or "
+           "more. A metric that does not apply (no climbable surface, no leaves, no segments) draws nothing: it is "
+           "not 0." + LEFT_OUT)
 
-    # 6. Growth curves: nodes against step, one panel per scene, the lowest seed.
-    fig, axes = plt.subplots(nrow, ncol, figsize=(4.2 * ncol, 3.0 * nrow), squeeze=False)
-    for idx, scene in enumerate(scenes):
-        a = axes[idx // ncol][idx % ncol]
+
+def curve_fractions(c):
+    """A cell's growth curve on common axes: (elapsed share of its growth time, share of its final nodes)."""
+    curve = c.t.get("curve") or {}
+    nodes = curve.get("nodes") or []
+    when = curve.get("wall_s") or curve.get("step") or []
+    if len(nodes) < 2 or len(when) != len(nodes) or nodes[-1] <= 0 or when[-1] <= 0:
+        return None
+    return [w / when[-1] for w in when], [n / nodes[-1] for n in nodes]
+
+
+def figure_growth_curves(F):
+    labels = ordered(c.label for c in F.good)
+    if not labels:
+        return
+    ncol = 4
+    fig, axes = F.panels(len(F.scenes), ncol, 1.55, extra=1)
+    for idx, scene in enumerate(F.scenes):
+        a = axes[idx]
         for label in labels:
-            pts = sorted((c for c in good if c.scene == scene and c.label == label), key=lambda c: c.seed)
-            curve = pts[0].t.get("curve") if pts else None
-            if curve and curve.get("step"):
-                a.plot(curve["step"], [max(n, 1) for n in curve["nodes"]], color=colours[label], label=label, lw=1.2)
-        a.set_yscale("log")
+            pts = sorted((c for c in F.good if c.scene == scene and c.label == label), key=lambda c: c.seed)
+            xy = curve_fractions(pts[0]) if pts else None
+            if xy:
+                a.plot(*xy, color=F.colours[label], label=label)
+        a.set_xlim(0, 1)
+        a.set_ylim(0, 1.02)
         a.set_title(scene)
-        a.set_xlabel("step")
-        a.set_ylabel("nodes")
-    for idx in range(len(scenes), nrow * ncol):
-        axes[idx // ncol][idx % ncol].axis("off")
-    legend(axes[0][0], fontsize=7)
-    fig.tight_layout()
-    save(fig, "fig-growth-curves", "Growth curves: plant nodes after each step (lowest valid seed of each cell)." +
-         left_out)
-    sweep_figures(good, labels, colours, markers, plt, np, save)
-    return written
+        if idx % ncol == 0:
+            a.set_ylabel("share of final nodes")
+        a.set_xlabel("share of growth time")
+    F.legend_panel(axes[len(F.scenes)], *F.entry_handles(labels, markers=False))
+    for a in axes[len(F.scenes) + 1:]:
+        a.axis("off")
+    F.save(fig, "fig-growth-curves", "Growth curves on common axes: the plant's nodes as a share of its final count "
+           "against the elapsed share of its growth phase's wall time (lowest valid seed of each cell). An algorithm "
+           "that builds its plant in one pass at the end (an L-system's interpretation) rises at the right; one that "
+           "grows a little every step rises steadily." + LEFT_OUT)
+
+
+def figures(cells, out, formats, pareto_metric=PARETO_METRIC):
+    """Every figure of the report, each at a paper width; returns [(name, caption)]."""
+    F = Canvas(cells, out, formats)
+    F.pareto_metric = pareto_metric
+    for draw in (figure_time_vs_size, figure_memory, figure_file_size, figure_seeds, figure_quality,
+                 figure_growth_curves, sweep_figures, pareto_figures):
+        draw(F)
+    return F.written
 
 
 def swept_numbers(cells):
@@ -711,14 +845,18 @@ def swept_numbers(cells):
     return out
 
 
-def sweep_figures(good, labels, colours, markers, plt, np, save):
+def sweep_figures(F):
     """One figure per swept numeric parameter: growth time against it, one line per entry and scene (the
     seed's Figure 16 for the vines' resolution, and any other sweep)."""
+    np = F.np
+    good = F.good
     for key in swept_numbers(good):
-        fig, ax = plt.subplots(figsize=(6.4, 4.4))
+        fig = F.figure(PAGE_IN, 3.0)
+        gs = fig.add_gridspec(1, 2, width_ratios=[3, 2])
+        ax = fig.add_subplot(gs[0])
         spans, drawn = [], []
         scenes = ordered(c.scene for c in good)
-        for i, label in enumerate(labels):
+        for label in F.labels:
             for scene in ordered(c.scene for c in good if c.label == label):
                 j = scenes.index(scene)  # the scene picks the marker and dash, the entry the colour
                 # Per value: the lowest seed's cell (several seeds would zigzag one line).
@@ -732,12 +870,12 @@ def sweep_figures(good, labels, colours, markers, plt, np, save):
                     continue
                 x = np.array(sorted(by_value))
                 pts = [by_value[v] for v in x]
-                time_points(ax, pts, x, markers[j % len(markers)], colours[label], f"{label} on {scene}",
+                time_points(ax, pts, x, F.markers[j % len(F.markers)], F.colours[label], f"{label} on {scene}",
                             ls=["-", "--", ":", "-."][j % 4], lw=1)
                 drawn += pts
                 spans.append(x.max() / max(x.min(), 1e-300))
         if not spans:
-            plt.close(fig)
+            F.plt.close(fig)
             continue
         if max(spans) >= 4:
             ax.set_xscale("log")
@@ -745,12 +883,86 @@ def sweep_figures(good, labels, colours, markers, plt, np, save):
         ax.set_xlabel(key)
         ax.set_ylabel(time_axis_label(drawn))
         ax.set_title(f"Growth time against {key}")
-        ax.legend(fontsize=7, loc="best")
-        save(fig, f"fig-sweep-{re.sub(r'[^A-Za-z0-9_]+', '-', key)}",
-             f"Growth wall time against the swept parameter {key}: one line per algorithm entry and scene (its lowest "
-             f"valid seed); points are the median over repetitions, bars (where a cell has 2 or more) the "
-             f"distribution-free 95% CI of the median (6 repetitions or more) or the range of the repetitions. Plants "
-             f"judged degenerate or not applicable are left out.")
+        F.legend_panel(fig.add_subplot(gs[1]), *ax.get_legend_handles_labels())
+        F.save(fig, f"fig-sweep-{re.sub(r'[^A-Za-z0-9_]+', '-', key)}",
+               f"Growth wall time against the swept parameter {key}: one line per algorithm entry and scene (its lowest "
+               f"valid seed); points are the median over repetitions, bars (where a cell has 2 or more) the "
+               f"distribution-free 95% CI of the median (6 repetitions or more) or the range of the repetitions." +
+               LEFT_OUT)
+
+
+def numeric_metrics(cells):
+    return sorted({k for c in cells for k, v in c.metrics.items()
+                   if isinstance(v, (int, float)) and not isinstance(v, bool)})
+
+
+def pareto_points(cells, scene, metric):
+    """Per algorithm entry on `scene`: one point per sweep value (table row), in the suite's order: (growth time, the
+    metric, row), each the median over the row's valid seeds (a seed's time: its median over repetitions). A row
+    whose metric applies to no valid seed has no point."""
+    out = {}
+    for label in ordered(c.label for c in cells):
+        pts = []
+        for row in ordered(c.row for c in cells if c.label == label and c.scene == scene):
+            group = [c for c in cells if c.row == row and c.scene == scene]
+            q = metric_values(group, metric)
+            if q:
+                pts.append((median([c.growth_median() for c in group]), median(q), row))
+        if pts:
+            out[label] = pts
+    return out
+
+
+def pareto_front(points, lower_is_better=False):
+    """The points no other beats: none is at least as fast and strictly better, or strictly faster and as good.
+    Sorted by time."""
+    sign = -1.0 if lower_is_better else 1.0
+    front, best = [], -math.inf
+    for p in sorted(points, key=lambda p: (p[0], -sign * p[1])):
+        if sign * p[1] > best:
+            front.append(p)
+            best = sign * p[1]
+    return front
+
+
+def pareto_figures(F):
+    """Per scene with a sweep: the chosen quality against growth time, one line per entry through its sweep, its
+    Pareto front marked, and the front over all entries."""
+    metric = F.pareto_metric
+    lower = metric in LOWER_IS_BETTER
+    title = next((t for k, t, _ in QUALITY if k == metric), metric)
+    for scene in F.scenes:
+        by_label = pareto_points([c for c in F.good if c.scene == scene], scene, metric)
+        if not any(len(p) >= 2 for p in by_label.values()):
+            continue  # no sweep here: a point per entry is the tables' business
+        fig = F.figure(COLUMN_IN, 2.5 + 0.14 * math.ceil(len(by_label) / 2) + 0.25)
+        gs = fig.add_gridspec(2, 1, height_ratios=[2.5, 0.14 * math.ceil(len(by_label) / 2) + 0.25])
+        ax = fig.add_subplot(gs[0])
+        everything = []
+        for label, pts in by_label.items():
+            colour = F.colours[label]
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], "-", color=colour, lw=0.6, alpha=0.5)
+            front = pareto_front(pts, lower)
+            ax.plot([p[0] for p in pts if p not in front], [p[1] for p in pts if p not in front], F.marker[label],
+                    mfc="none", color=colour, ms=3.5)
+            ax.plot([p[0] for p in front], [p[1] for p in front], F.marker[label], color=colour, ms=4,
+                    drawstyle="steps-post", ls="-", lw=1.4, label=label)
+            everything += pts
+        overall = pareto_front(everything, lower)
+        ax.plot([p[0] for p in overall], [p[1] for p in overall], "--", color="0.35", lw=0.8,
+                drawstyle="steps-post", label="front over all entries", zorder=0)
+        ax.set_xscale("log")
+        ax.set_xlabel("growth time (s), median over seeds")
+        ax.set_ylabel(f"{title}\n({'lower' if lower else 'higher'} is better)")
+        ax.set_title(f"Quality against cost: {scene}")
+        F.legend_panel(fig.add_subplot(gs[1]), *ax.get_legend_handles_labels(), ncol=2)
+        F.save(fig, f"fig-pareto-{re.sub(r'[^A-Za-z0-9_]+', '-', scene)}",
+               f"Quality against cost on {scene}: {title} ({'lower' if lower else 'higher'} is better; the median over "
+               f"a sweep value's valid seeds) against growth wall time (the median over those seeds of each seed's "
+               f"median over repetitions), log scale. One thin line per algorithm entry through its sweep values in "
+               f"the suite's order; filled markers joined by a step: that entry's Pareto front (no other of its points "
+               f"is both faster and better); hollow markers: dominated. Dashed grey: the front over all entries. An "
+               f"entry without a sweep is a single point." + LEFT_OUT)
 
 
 # ---------------------------------------------------------------- HTML
@@ -957,8 +1169,9 @@ def peers_figure(doc, out, formats):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    plt.rcParams.update(STYLE)
     cases = doc["cases"]
-    fig, ax = plt.subplots(figsize=(6.4, 0.55 * len(cases) + 1.2))
+    fig, ax = plt.subplots(figsize=(PAGE_IN, 0.4 * len(cases) + 1.0), layout="constrained")
     ys = list(range(len(cases)))[::-1]
     for y, c in zip(ys, cases):
         colour = "tab:green" if c["ratio"] >= c["target"] else "tab:orange"
@@ -978,11 +1191,10 @@ def peers_figure(doc, out, formats):
     ax.set_xlabel(f"peer time / growbench time (medians, {doc['interval']['level']:.0%} interval)")
     hi = max(max(c["ratio_high"], c["target"], c.get("whole", {}).get("ratio_high", 0)) for c in cases)
     ax.set_xlim(0.8, hi * 2)
-    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1), fontsize=8)
-    ax.grid(True, alpha=0.3)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1))
+    plain_log_ticks(ax)
     for ext in formats:
-        fig.savefig(os.path.join(out, f"fig-peers.{ext}"), bbox_inches="tight",
-                    metadata={"CreationDate": None} if ext == "pdf" else None)
+        fig.savefig(os.path.join(out, f"fig-peers.{ext}"), metadata={"CreationDate": None} if ext == "pdf" else None)
     plt.close(fig)
 
 
@@ -1031,7 +1243,7 @@ def write_peers_only(path, out, formats):
 
 # ---------------------------------------------------------------- main
 
-def write_report(doc, results_path, out, formats, peers_path=None):
+def write_report(doc, results_path, out, formats, peers_path=None, pareto_metric=None):
     """Figures, tables and index.html in `out` from a results document already read and checked (load_results)."""
     cells = [Cell(t) for t in doc["trials"]]
     if not cells:
@@ -1041,7 +1253,10 @@ def write_report(doc, results_path, out, formats, peers_path=None):
     if "png" not in formats:
         formats.insert(0, "png")  # the HTML page shows the PNGs
     print(f"report: {len(cells)} cells from {results_path}", file=sys.stderr)
-    figs = figures(cells, out, formats)
+    if pareto_metric and pareto_metric not in numeric_metrics(cells):
+        raise ReportError(f"--pareto-metric {pareto_metric}: no cell of {results_path} has it; its metrics: "
+                          f"{', '.join(numeric_metrics(cells)) or 'none'}")
+    figs = figures(cells, out, formats, pareto_metric or PARETO_METRIC)
 
     pooled = pooled_summaries(doc)
     rows = table_rows(cells, pooled)
@@ -1084,6 +1299,8 @@ def main(argv=None):
     ap.add_argument("--formats", default="png,pdf", help="figure formats (comma-separated; default png,pdf)")
     ap.add_argument("--peers", help="peers.json of `make peers`: adds the \"versus peers\" section (alone, without "
                                     "results); default: a peers.json beside the results file, if there is one")
+    ap.add_argument("--pareto-metric", help=f"the quality metric of the quality-against-cost (Pareto) figures, one "
+                                             f"per scene of a suite with sweeps (default {PARETO_METRIC})")
     args = ap.parse_args(argv)
     if args.results is None and args.peers is None:
         ap.error("give a results file, --peers, or both")
@@ -1093,7 +1310,8 @@ def main(argv=None):
             print(f"report: wrote the versus-peers page {os.path.join(args.out, 'index.html')}", file=sys.stderr)
             return 0
         doc = load_results(args.results)
-        write_report(doc, args.results, args.out, [f for f in args.formats.split(",") if f], args.peers)
+        write_report(doc, args.results, args.out, [f for f in args.formats.split(",") if f], args.peers,
+                     args.pareto_metric)
     except ReportError as e:
         print(f"report: error: {e}", file=sys.stderr)
         return 2

@@ -29,7 +29,7 @@ fail() { echo "report_e2e: FAIL: $*" >&2; exit 1; }
 [[ -f "$work/run/grid.png" ]] || fail "no grid.png"
 "$gb" report "$work/run/results.json" --out "$work/report" > "$work/report.log" 2>&1 || { cat "$work/report.log"; fail "report"; }
 for f in index.html table.tex table.md fig-time-vs-size.png fig-time-vs-size.pdf fig-memory-vs-size.png fig-file-size.png \
-         fig-seeds-boxplot.png fig-quality.png fig-growth-curves.png renders/grid.png; do
+         fig-seeds.png fig-quality.png fig-growth-curves.png renders/grid.png; do
   [[ -s "$work/report/$f" ]] || fail "report has no $f"
 done
 grep -q '\\toprule' "$work/report/table.tex" || fail "table.tex is not booktabs"

@@ -303,15 +303,16 @@ class Verdicts(unittest.TestCase):
         self.assertEqual(col(ground, "attached"), "-")  # not in the record at all
         with tempfile.TemporaryDirectory() as d, Drawn() as drawn:
             report.figures(cells, d, ["png"])
-        for title, heights in [("surface coverage", [0.4]), ("leaf overlap", [0.3])]:
-            bars = drawn.on(title, "bar")
-            self.assertEqual(len(bars), 1, title)
-            x, h = bars[0][0][:2]
-            self.assertEqual(len(x), 1, title)  # the wall's bar only: none, not 0, for the ground
-            self.assertAlmostEqual(x[0], 0.0)
-            self.assertEqual(len(h), len(heights), title)
-            for got, want in zip(h, heights):
-                self.assertAlmostEqual(got, want, msg=title)
+        # One marker at the wall's median and a line over its seeds' range; nothing, not 0, for the ground.
+        for title, med, spread in [("surface coverage", 0.4, (0.2, 0.9)), ("leaf overlap", 0.3, (0.2, 0.4))]:
+            calls = drawn.on(title, "plot")
+            points = [list(a[0]) for a, _, _ in calls if len(a[0]) == 1]
+            lines = [tuple(a[0]) for a, _, _ in calls if len(a[0]) == 2]
+            self.assertEqual(len(points), 1, title)
+            self.assertAlmostEqual(points[0][0], med, msg=title)
+            self.assertEqual(len(lines), 1, title)
+            self.assertAlmostEqual(lines[0][0], spread[0], msg=title)
+            self.assertAlmostEqual(lines[0][1], spread[1], msg=title)
 
 
 class Intervals(unittest.TestCase):
