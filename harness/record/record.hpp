@@ -260,6 +260,9 @@ struct RenderRecord {
   // had depth of field.
   std::optional<std::string> camera, backdrop;
   std::optional<double> scene_extent;
+  // The share of the plant's sampled points inside this camera's frame, and visible in it past the scene
+  // (ray casts against the scene meshes); the share of the image's pixels that show the plant.
+  std::optional<double> in_frame_share, visible_share, plant_pixel_share;
   std::optional<bool> dof;
 
   static constexpr std::string_view kSchemaName = "render";
@@ -282,6 +285,9 @@ struct RenderRecord {
                       field("threads", &R::threads),
                       field("camera", &R::camera).one_of(kCameraUsed),
                       field("scene_extent", &R::scene_extent).in(0, kNoBound),
+                      field("in_frame_share", &R::in_frame_share).in(0, 1),
+                      field("visible_share", &R::visible_share).in(0, 1),
+                      field("plant_pixel_share", &R::plant_pixel_share).in(0, 1),
                       field("backdrop", &R::backdrop).one_of(kBackdrops),
                       field("dof", &R::dof)};
   }
@@ -610,7 +616,10 @@ struct RenderSummary {
   double povray_s = 0.0, wall_s = 0.0;
   std::optional<std::string> grid, grid_error;
   std::optional<std::map<std::string, std::string>> grid_per_scene;  // scene -> image
-  std::optional<std::string> camera, backdrop;                       // as asked: auto | scene, scene | studio
+  // The grid split into pages of at most kGridPageScenes scenes, each readable at a page's width; beside
+  // each image (and each per-scene grid) IMAGE.map.json says which trial each cell shows and where.
+  std::optional<std::vector<std::string>> grid_pages;
+  std::optional<std::string> camera, backdrop;  // as asked: auto | scene, scene | studio
   std::optional<bool> dof;
   std::optional<std::uint64_t> turntable;  // frames per trial
 
@@ -634,6 +643,7 @@ struct RenderSummary {
                       field("grid", &R::grid),
                       field("grid_error", &R::grid_error),
                       field("grid_per_scene", &R::grid_per_scene),
+                      field("grid_pages", &R::grid_pages),
                       field("camera", &R::camera).one_of(kCameraAsked),
                       field("backdrop", &R::backdrop).one_of(kBackdrops),
                       field("dof", &R::dof),

@@ -119,12 +119,82 @@ Camera fit_camera(const Camera& camera, float aspect, const std::vector<glm::vec
   return out;
 }
 
-RenderCamera choose_camera(const Camera& scene_camera, float aspect, const Aabb& plant, CameraMode mode) {
-  RenderCamera rc{scene_camera, false, projected_extent(scene_camera, aspect, plant)};
-  if (mode == CameraMode::Scene || plant.empty() || rc.scene_extent >= kSmallPlantExtent) return rc;
-  rc.camera = fit_camera(scene_camera, aspect, corners(plant));
-  rc.fitted = true;
-  return rc;
+std::vector<glm::vec3> plant_points(const Scene& scene, const Plant& plant, std::size_t max_points) {
+  std::vector<glm::vec3> out;
+  if (!plant.decals.empty()) return corners(plant_bounds(scene, plant));
+  const std::size_t n = plant.nodes.size(),
+                    stride = std::max<std::size_t>(1, (n + max_points - 1) / std::max<std::size_t>(max_points, 1));
+  for (std::size_t i = 0; i < n; i += stride) out.push_back(plant.nodes[i].position);
+  if (n > 0 && (n - 1) % stride != 0) out.push_back(plant.nodes.back().position);  // the last tip too
+  for (const Organ& o : plant.organs) out.push_back(o.position);
+  for (const PlantPolygon& poly : plant.polygons)
+    for (const glm::vec3& v : poly.vertices) out.push_back(v);
+  return out;
+}
+
+Sight sight(const Camera& camera, float aspect, const std::vector<glm::vec3>& points, const SightBlocked& blocked) {
+  if (points.empty()) return {};
+  std::size_t in = 0, seen = 0;
+  for (const glm::vec3& p : points) {
+    const glm::vec3 q = project(camera, aspect, p);
+    if (!(q.z > 0.0f) || std::abs(q.x) > 1.0f || std::abs(q.y) > 1.0f) continue;
+    ++in;
+    if (!blocked || !blocked(camera.position, p)) ++seen;
+  }
+  const float n = static_cast<float>(points.size());
+  return {static_cast<float>(in) / n, static_cast<float>(seen) / n};
+}
+
+namespace {
+
+// The scene camera's view turned by `turn` radians about the vertical through `centre` and tilted down by
+// `raise` more radians (looking from higher up), aimed at `centre`; fitted to `points` and to a square of
+// `context` half-width across the view around the centre.
+Camera turned_fit(const Camera& scene_camera, float aspect, const std::vector<glm::vec3>& points,
+                  const glm::vec3& centre, float context, float turn, float raise) {
+  glm::vec3 d = scene_camera.look_at - scene_camera.position;
+  d = glm::length(d) > 0.0f ? glm::normalize(d) : glm::vec3(0.0f, 0.0f, -1.0f);
+  const float pitch = std::asin(std::clamp(d.y, -1.0f, 1.0f)) - raise;
+  const float yaw = std::atan2(d.x, -d.z) + turn;
+  const float p = std::clamp(pitch, -1.4f, 1.4f);
+  d = glm::vec3(std::cos(p) * std::sin(yaw), std::sin(p), -std::cos(p) * std::cos(yaw));
+  Camera c = scene_camera;
+  c.look_at = centre;
+  c.position = centre - d;
+  std::vector<glm::vec3> fit = points;
+  const CameraFrame f = camera_frame(c);
+  for (const float sx : {-1.0f, 1.0f})
+    for (const float sy : {-1.0f, 1.0f}) fit.push_back(centre + context * (sx * f.right + sy * f.up));
+  return fit_camera(c, aspect, fit);
+}
+
+}  // namespace
+
+RenderCamera choose_camera(const Camera& scene_camera, float aspect, const std::vector<glm::vec3>& plant,
+                           const Aabb& scene_bounds, CameraMode mode, const SightBlocked& blocked) {
+  Aabb box;
+  for (const glm::vec3& p : plant) box.extend(p);
+  RenderCamera rc{scene_camera, false, projected_extent(scene_camera, aspect, box),
+                  sight(scene_camera, aspect, plant, blocked)};
+  if (mode == CameraMode::Scene || plant.empty()) return rc;
+  if (rc.seen.in_frame >= 1.0f && rc.seen.visible >= kVisibleEnough && rc.scene_extent >= kSmallPlantExtent) return rc;
+  const float context = 0.5f * kContextShare * (scene_bounds.empty() ? 0.0f : glm::length(scene_bounds.size()));
+  const float floor_y = scene_bounds.empty() ? -INFINITY : scene_bounds.min.y;
+  // The ring: the scene camera's side first, then turns either way, then the same from higher up.
+  constexpr float kTurns[] = {0, 30, -30, 60, -60, 90, -90, 135, -135, 180};
+  constexpr float kRaises[] = {0, 25, 50};
+  RenderCamera best = rc;
+  best.seen.visible = -1.0f;
+  for (const float raise : kRaises)
+    for (const float turn : kTurns) {
+      const Camera c =
+          turned_fit(scene_camera, aspect, plant, box.center(), context, glm::radians(turn), glm::radians(raise));
+      if (c.position.y < floor_y) continue;  // under the ground
+      const Sight s = sight(c, aspect, plant, blocked);
+      if (s.visible > best.seen.visible) best = {c, true, rc.scene_extent, s, turn, raise};
+      if (s.visible >= kVisibleEnough) return best;
+    }
+  return best.seen.visible < 0.0f ? rc : best;  // every candidate under the ground: the scene's
 }
 
 glm::vec3 turn_about_vertical(const glm::vec3& p, const glm::vec3& axis_point, float angle) {

@@ -4,6 +4,7 @@
 // says (look_at, sky +Y, square pixels), so project() is where a point lands in the image.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -55,23 +56,42 @@ float projected_extent(const Camera& camera, float aspect, const Aabb& box);
 Camera fit_camera(const Camera& camera, float aspect, const std::vector<glm::vec3>& points,
                   float margin = kFrameMargin);
 
+// The plant as the points a camera must show: its nodes (at most `max_points`, evenly spaced in the node
+// order), organs and polygon vertices; a plant drawn by decals, the corners of plant_bounds. Empty for an
+// empty plant.
+std::vector<glm::vec3> plant_points(const Scene& scene, const Plant& plant, std::size_t max_points = 2048);
+
+// Whether a scene surface lies between the two points (the render's scene meshes; harness/render's
+// SceneQuery casts the ray). Null: nothing ever blocks the view.
+using SightBlocked = std::function<bool(const glm::vec3& eye, const glm::vec3& p)>;
+
+// What a camera shows of a set of points: the share in front of it and inside the frame, and the share
+// inside the frame with no scene surface in the way (visible). 1 and 1 for no points.
+struct Sight {
+  float in_frame = 1.0f, visible = 1.0f;
+};
+Sight sight(const Camera& camera, float aspect, const std::vector<glm::vec3>& points, const SightBlocked& blocked);
+
 // The camera a render uses, and why.
 struct RenderCamera {
   Camera camera;
-  bool fitted = false;       // moved to frame the plant
-  float scene_extent = 0.f;  // the plant's projected_extent with the scene camera
+  bool fitted = false;                      // moved to frame the plant
+  float scene_extent = 0.f;                 // the plant's projected_extent with the scene camera
+  Sight seen;                               // what this camera shows of the plant's points
+  float turn_deg = 0.0f, raise_deg = 0.0f;  // how far a fitted camera turned about the plant and rose
 };
 
-// The `auto` rule, in one place: the scene camera unless the plant is small in its frame, then a camera
-// fitted to the plant (fit_camera with kFrameMargin). Small: the plant's box spans less than
-// kSmallPlantExtent of the frame's width and of its height (or some of it lies behind the camera).
-// Why keep the scene camera otherwise: it frames its scene as the scene's author meant, with room around
-// it (a standard wall spans about half the frame), so a plant that covers its support spans a good part of
-// the frame and is best seen that way; grids stay comparable across algorithms, and renders that already
-// show the plant do not change. Below about a third of the frame, the plant is a twig in a large scene.
-// `scene` always keeps it; an empty `plant` box keeps it too.
-constexpr float kSmallPlantExtent = 0.35f;
-RenderCamera choose_camera(const Camera& scene_camera, float aspect, const Aabb& plant, CameraMode mode);
+// The `auto` rule, in one place. The scene camera, when it shows the whole plant (every point in frame),
+// sees at least kVisibleEnough of it past the scene, and the plant's box spans at least kSmallPlantExtent
+// of the frame: it frames its scene as the author meant, and grids stay comparable across algorithms.
+// Otherwise a camera fitted to the plant's points (fit_camera, never cropping), with some of the scene
+// around it for context (the frame at least kContextShare of the scene's diagonal across), looking from
+// the scene camera's side when enough is visible from there, else from the first of a ring of turns about
+// the plant and rises above it that sees kVisibleEnough, else the one that sees most. `scene` always keeps
+// the scene camera; no points keep it too.
+constexpr float kSmallPlantExtent = 0.65f, kVisibleEnough = 0.9f, kContextShare = 0.05f;
+RenderCamera choose_camera(const Camera& scene_camera, float aspect, const std::vector<glm::vec3>& plant,
+                           const Aabb& scene_bounds, CameraMode mode, const SightBlocked& blocked = {});
 
 // Turntable frame `frame` of `frames`: the scene camera turned by 2 pi frame / frames about the vertical
 // axis through the plant box's centre (so frame 0 looks as the scene camera does), at the distance from

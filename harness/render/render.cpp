@@ -4,6 +4,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <iterator>
+#include <cstdio>
+#include <thread>
+#include <mutex>
+#include <condition_variable>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -19,6 +25,7 @@
 #include "harness/record/files.hpp"
 #include "harness/run/process.hpp"
 #include "scenes/geometry.hpp"
+#include "scenes/scene_query.hpp"
 
 namespace growbench {
 namespace fs = std::filesystem;
@@ -75,25 +82,58 @@ void vec(Out out, const glm::vec3& v) {
 // Radii below this are drawn at it: a zero radius is a degenerate POV-Ray primitive.
 constexpr float kMinRadius = 1e-4f;
 
-// Per-vertex normals when the mesh is smooth everywhere (every vertex's faces within 60 degrees of
-// their average, as on the bunny or the boulder); empty otherwise (boxes and capped cylinders are
-// drawn flat, so their edges stay sharp).
-std::vector<glm::vec3> smooth_normals(const TriangleMesh& m) {
-  std::vector<glm::vec3> n = geom::vertex_normal_sums(m);
-  for (auto& v : n) {
-    const float l = glm::length(v);
-    if (!(l > 0.0f)) return {};
-    v /= l;
+// Scene meshes are drawn with smooth shading except across creases: two faces at a vertex share a normal
+// when they meet at less than this angle. Tessellated curves (a column's sides, the bunny) turn by much less
+// from face to face; a box's faces meet at 90 degrees and keep their edges.
+constexpr float kCreaseDeg = 40.0f;
+
+// A mesh ready for smooth shading with creases kept: each triangle corner's normal is the area-weighted
+// mean of the faces around its vertex within kCreaseDeg of the corner's own face, and a vertex whose
+// corners get different normals is split (the triangles keep their order, so texture coordinates indexed by
+// triangle still apply).
+struct ShadedMesh {
+  std::vector<glm::vec3> vertices, normals;
+  std::vector<glm::uvec3> triangles;
+};
+
+ShadedMesh crease_shaded(const TriangleMesh& m) {
+  const std::size_t nv = m.vertices.size(), nt = m.triangles.size();
+  std::vector<glm::vec3> face(nt);  // area-weighted normals
+  std::vector<std::vector<std::uint32_t>> around(nv);
+  for (std::size_t t = 0; t < nt; ++t) {
+    const glm::uvec3 tri = m.triangles[t];
+    face[t] = glm::cross(m.vertices[tri.y] - m.vertices[tri.x], m.vertices[tri.z] - m.vertices[tri.x]);
+    for (int k = 0; k < 3; ++k) around[tri[k]].push_back(static_cast<std::uint32_t>(t));
   }
-  const float cos60 = 0.5f;
-  for (const auto& tri : m.triangles) {
-    const glm::vec3 face = glm::cross(m.vertices[tri.y] - m.vertices[tri.x], m.vertices[tri.z] - m.vertices[tri.x]);
-    const float l = glm::length(face);
-    if (!(l > 0.0f)) continue;
-    for (int k = 0; k < 3; ++k)
-      if (glm::dot(face / l, n[tri[k]]) < cos60) return {};
+  const float cos_crease = std::cos(glm::radians(kCreaseDeg));
+  ShadedMesh out;
+  out.triangles.resize(nt);
+  // Per original vertex, the split copies made so far: (new index); a corner reuses a copy whose normal
+  // matches its own.
+  std::vector<std::vector<std::uint32_t>> copies(nv);
+  for (std::size_t t = 0; t < nt; ++t) {
+    const float lt = glm::length(face[t]);
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t v = m.triangles[t][k];
+      glm::vec3 n(0.0f);
+      for (const std::uint32_t f : around[v]) {
+        const float lf = glm::length(face[f]);
+        if (lf > 0.0f && lt > 0.0f && glm::dot(face[f] / lf, face[t] / lt) >= cos_crease) n += face[f];
+      }
+      n = glm::length(n) > 0.0f ? glm::normalize(n) : glm::vec3(0.0f, 1.0f, 0.0f);
+      std::uint32_t id = UINT32_MAX;
+      for (const std::uint32_t c : copies[v])
+        if (glm::dot(out.normals[c], n) > 0.9999f) id = c;
+      if (id == UINT32_MAX) {
+        id = static_cast<std::uint32_t>(out.vertices.size());
+        out.vertices.push_back(m.vertices[v]);
+        out.normals.push_back(n);
+        copies[v].push_back(id);
+      }
+      out.triangles[t][k] = id;
+    }
   }
-  return n;
+  return out;
 }
 
 // Texture coordinates for write_mesh2: corner k of triangle t has uvs[triangles[t][k]] (TriangleMesh's).
@@ -186,8 +226,27 @@ glm::vec3 any_perpendicular(const glm::vec3& d) {
   return glm::normalize(glm::cross(d, a));
 }
 
+// The plant-pixel mask (plant_pixel_share): the same file rendered with GB_Mask declared draws the plant
+// glowing in its colours and everything else black, without lights, so a pixel that is not black is the
+// plant's (a decal's image included).
+void write_mask_materials(Out out) {
+  fmt::format_to(out,
+                 "#ifdef (GB_Mask)\n"
+                 "  #declare GB_Glow = finish {{ emission 1 diffuse 0 ambient 0 specular 0 }}\n"
+                 "  #declare GB_Bark = texture {{ pigment {{ rgb 1 }} finish {{ GB_Glow }} }}\n"
+                 "  #declare GB_Leaf = GB_Bark #declare GB_YoungLeaf = GB_Bark\n"
+                 "  #declare GB_Flower = GB_Bark #declare GB_Bud = GB_Bark #declare GB_OrganFinish = GB_Glow\n"
+                 "  #declare GB_DecalFinish = GB_Glow\n"
+                 "  #declare GB_Surface = texture {{ pigment {{ rgb 0 }} finish {{ emission 0 diffuse 0 ambient 0 "
+                 "specular 0 }} }}\n"
+                 "  #declare GB_Ground = GB_Surface #declare GB_Studio = GB_Surface\n"
+                 "  background {{ rgb 0 }}\n"
+                 "#end\n");
+}
+
 // The file's first line, the global settings (radiosity in paper quality), the materials and the sky.
-void write_settings(Out out, const Scene& scene, const Plant& plant, const RenderOptions& o, float diag) {
+void write_settings(Out out, const Scene& scene, const Plant& plant, const RenderOptions& o, float diag,
+                    const glm::vec3& centre) {
   const bool paper = o.quality == RenderQuality::Paper;
   fmt::format_to(out,
                  "// growbench render: scene '{}', {} nodes, {} organs{}, quality {}\n"
@@ -195,10 +254,12 @@ void write_settings(Out out, const Scene& scene, const Plant& plant, const Rende
                  "global_settings {{\n  assumed_gamma 1.0\n  max_trace_level 8\n",
                  scene.name, plant.nodes.size(), plant.organs.size(),
                  plant.decals.empty() ? "" : fmt::format(", {} decals", plant.decals.size()), to_string(o.quality));
-  if (paper)
+  if (paper)  // not in the plant-pixel mask (GB_Mask), which needs no light
     fmt::format_to(out,
+                   "  #ifndef (GB_Mask)\n"
                    "  radiosity {{ pretrace_start 0.08 pretrace_end 0.01 count 60 nearest_count 5 error_bound 0.8\n"
-                   "              recursion_limit 1 low_error_factor 0.5 gray_threshold 0 brightness 1 }}\n");
+                   "              recursion_limit 1 low_error_factor 0.5 gray_threshold 0 brightness 1 }}\n"
+                   "  #end\n");
   fmt::format_to(out, "}}\n");
   const glm::vec3 bark = material_srgb("bark");
   // One material set for every algorithm. Colours are sRGB; with radiosity the sky lights the scene, so
@@ -215,20 +276,31 @@ void write_settings(Out out, const Scene& scene, const Plant& plant, const Rende
       "#declare GB_Flower = texture {{ pigment {{ srgb <0.95,0.80,0.88> }} finish {{ GB_OrganFinish }} }}\n"
       "#declare GB_Bud = texture {{ pigment {{ srgb <0.85,0.36,0.50> }} finish {{ GB_OrganFinish }} }}\n"
       "#declare GB_Surface = texture {{ pigment {{ srgb <0.80,0.78,0.74> }} }}\n"
-      "#declare GB_Ground = texture {{ pigment {{ checker srgb <0.56,0.55,0.52> srgb <0.62,0.61,0.58> scale {:.4g} }} "
-      "}}\n",
-      paper ? 0.0 : 0.12, bark.r, bark.g, bark.b, std::max(0.25f, 0.05f * diag));
+      "#declare GB_DecalFinish = finish {{ specular 0 }}\n",
+      paper ? 0.0 : 0.12, bark.r, bark.g, bark.b);
+  // The ground's checker fades into its mean colour away from the scene (a spherical pattern, 1 at the
+  // centre, 0 from `fade` out), so that its squares never shrink below a pixel toward the horizon, where
+  // they would alias into moire.
+  const float square = std::max(0.25f, 0.05f * diag), fade = 1.5f * diag;
+  fmt::format_to(out,
+                 "#declare GB_Ground = texture {{ pigment {{ spherical pigment_map {{ [0.0 srgb <0.59,0.58,0.55>]\n"
+                 "  [0.6 checker srgb <0.56,0.55,0.52> srgb <0.62,0.61,0.58> scale {:.4g}] }}\n"
+                 "  scale {:.4g} translate <{:.4g},{:.4g},{:.4g}> }} }}\n",
+                 square / fade, fade, centre.x, centre.y, -centre.z);
   if (o.backdrop == Backdrop::Studio) {
     // A neutral grey: the sweep, and the background behind it (which radiosity sees as the sky).
     fmt::format_to(out,
                    "#declare GB_Studio = texture {{ pigment {{ srgb <0.80,0.80,0.80> }} }}\n"
                    "background {{ srgb <0.80,0.80,0.80> }}\n");
-    return;
+  } else {
+    fmt::format_to(
+        out,
+        "#ifndef (GB_Mask)\n"
+        "sky_sphere {{ pigment {{ gradient y color_map {{ [0.0 srgb <0.93,0.94,0.95>] [0.5 srgb <0.93,0.94,0.95>]\n"
+        "  [1.0 srgb <0.50,0.66,0.86>] }} scale 2 translate -1 }} }}\n"
+        "#end\n");
   }
-  fmt::format_to(
-      out,
-      "sky_sphere {{ pigment {{ gradient y color_map {{ [0.0 srgb <0.93,0.94,0.95>] [0.5 srgb <0.93,0.94,0.95>]\n"
-      "  [1.0 srgb <0.50,0.66,0.86>] }} scale 2 translate -1 }} }}\n");
+  write_mask_materials(out);
 }
 
 // The render's camera, with its vertical field of view kept at the image's aspect; with depth of field,
@@ -251,22 +323,16 @@ void write_camera(Out out, const RenderView& view, float aspect, bool dof) {
   fmt::format_to(out, " }}\n");
 }
 
-// The light (the scene's, turned with a turntable's camera): the sun as a parallel light from far along
-// its direction, or the point light; in the preview also a dim shadowless light at the render's camera.
-void write_lights(Out out, const RenderView& view, const glm::vec3& centre, float diag, bool paper) {
-  const Light& light = view.light;
-  const bool sun = light.kind == Light::Kind::Sun;
-  const glm::vec3 towards = sun ? glm::normalize(light.direction) : glm::normalize(light.position - centre);
-  const glm::vec3 lpos = sun ? centre + towards * (20.0f * diag) : light.position;
+// A parallel light from far along `towards` (unit, from the scene to the light), aimed at `centre`; soft
+// (a square area light about 2 degrees across as seen from the scene) or shadowless when asked.
+void write_parallel_light(Out out, const glm::vec3& centre, const glm::vec3& towards, float diag, float srgb, bool soft,
+                          bool shadowless) {
+  const glm::vec3 lpos = centre + towards * (20.0f * diag);
   fmt::format_to(out, "light_source {{ ");
   vec(out, pov(lpos));
-  fmt::format_to(out, " color srgb <1.0,0.98,0.94>");
-  if (sun) {
-    fmt::format_to(out, " parallel point_at ");
-    vec(out, pov(centre));
-  }
-  if (paper) {
-    // Soft shadows: a square area light about 2 degrees across as seen from the scene.
+  fmt::format_to(out, " color srgb <{:.3g},{:.3g},{:.3g}> parallel point_at ", srgb, 0.98f * srgb, 0.94f * srgb);
+  vec(out, pov(centre));
+  if (soft) {
     const float side = 0.035f * glm::length(lpos - centre);
     const glm::vec3 u = any_perpendicular(towards) * side, v = glm::cross(towards, any_perpendicular(towards)) * side;
     fmt::format_to(out, " area_light ");
@@ -275,12 +341,37 @@ void write_lights(Out out, const RenderView& view, const glm::vec3& centre, floa
     vec(out, pov(v));
     fmt::format_to(out, ", 5, 5 adaptive 1 jitter");
   }
-  fmt::format_to(out, " }}\n");
-  if (!paper) {
-    fmt::format_to(out, "light_source {{ ");
-    vec(out, pov(view.camera.position));
-    fmt::format_to(out, " color srgb 0.35 shadowless }}\n");
+  fmt::format_to(out, "{} }}\n", shadowless ? " shadowless" : "");
+}
+
+// The lights. Paper quality: a studio's key and fill placed from the render's camera, so that a plant on
+// a wall facing the camera is lit across its surface and shows its relief: the key from the camera's right,
+// high and a little in front, with soft shadows; a weak shadowless fill from its left; radiosity adds the
+// sky. Preview: the scene's light (turned with a turntable's camera), the sun as a parallel light or the
+// point light, and a dim shadowless light at the camera. None in the plant-pixel mask.
+void write_lights(Out out, const RenderView& view, const glm::vec3& centre, float diag, bool paper) {
+  fmt::format_to(out, "#ifndef (GB_Mask)\n");
+  if (paper) {
+    const CameraFrame f = camera_frame(view.camera);
+    const glm::vec3 aim = view.subject.empty() ? centre : view.subject.center();
+    write_parallel_light(out, aim, glm::normalize(0.9f * f.right + 0.9f * f.up - 0.5f * f.forward), diag, 1.0f, true,
+                         false);
+    write_parallel_light(out, aim, glm::normalize(-0.8f * f.right + 0.3f * f.up - 0.6f * f.forward), diag, 0.3f, false,
+                         true);
+    fmt::format_to(out, "#end\n");
+    return;
   }
+  const Light& light = view.light;
+  if (light.kind == Light::Kind::Sun) {
+    write_parallel_light(out, centre, glm::normalize(light.direction), diag, 1.0f, false, false);
+  } else {
+    fmt::format_to(out, "light_source {{ ");
+    vec(out, pov(light.position));
+    fmt::format_to(out, " color srgb <1.0,0.98,0.94> }}\n");
+  }
+  fmt::format_to(out, "light_source {{ ");
+  vec(out, pov(view.camera.position));
+  fmt::format_to(out, " color srgb 0.35 shadowless }}\n#end\n");
 }
 
 // True when every triangle of `m` has texture coordinates that exist.
@@ -294,7 +385,7 @@ bool has_valid_uvs(const TriangleMesh& m) {
 
 // The decal layer's finish: the default's, with no highlight, which would shine through where the image
 // is transparent (a layer's highlight is not weighted by its transparency).
-constexpr const char* kDecalFinish = "finish { specular 0 }";
+constexpr const char* kDecalFinish = "finish { GB_DecalFinish }";
 
 // A decal laid over a scene mesh: the image through the mesh's texture coordinates, on top of the
 // textures before it; its transparent pixels show them (POV-Ray reads a PNG's alpha as transmit).
@@ -347,8 +438,9 @@ void write_scene_meshes(Out out, const Scene& scene, const std::vector<SurfaceDe
                      uv_decals.size() + planar.size() == 1 ? "" : "s");
     fmt::format_to(out, "\n");
     const MeshUvs uv{m.uvs, m.uv_triangles};
-    write_mesh2(out, m.vertices, smooth_normals(m), m.triangles, 0, static_cast<std::uint32_t>(m.triangles.size()),
-                uv_decals.empty() ? nullptr : &uv);
+    const ShadedMesh shaded = crease_shaded(m);
+    write_mesh2(out, shaded.vertices, shaded.normals, shaded.triangles, 0,
+                static_cast<std::uint32_t>(shaded.triangles.size()), uv_decals.empty() ? nullptr : &uv);
     // Layered textures: the first is the bottom layer, each later one lies on top of those before it.
     fmt::format_to(out, "  texture {{ {} }}\n", m.climbable ? "GB_Surface" : "GB_Ground");
     for (const SurfaceDecal* d : uv_decals) write_uv_decal_layer(out, *d);
@@ -618,7 +710,7 @@ std::uint64_t write_pov_view(const std::string& path, const Scene& scene, const 
   const float diag = std::max(glm::length(bounds.size()), 1.0f);
   const bool studio = o.backdrop == Backdrop::Studio;
 
-  write_settings(out, scene, plant, o, diag);
+  write_settings(out, scene, plant, o, diag, bounds.center());
   fmt::format_to(out, "// camera: {}\n", view.describe());
   write_camera(out, view, aspect_of(o), o.dof);
   write_lights(out, view, bounds.center(), diag, o.quality == RenderQuality::Paper);
@@ -648,9 +740,26 @@ std::uint64_t write_pov_view(const std::string& path, const Scene& scene, const 
 
 std::string RenderView::describe() const {
   if (subject.empty()) return "the scene's (the plant is empty)";
-  return fmt::format("{}: the plant's box spans {:.3f} of the frame with the scene camera, {:.3f} with this one",
-                     fitted ? "fitted to the plant" : "the scene's", scene_extent, extent);
+  const std::string how =
+      !fitted ? "the scene's"
+      : turn_deg == 0.0f && raise_deg == 0.0f
+          ? "fitted to the plant"
+          : fmt::format("fitted to the plant, turned {:g} deg about it and raised {:g} deg", turn_deg, raise_deg);
+  return fmt::format(
+      "{}: the plant's box spans {:.3f} of the frame with the scene camera, {:.3f} with this one; {:.3f} of its "
+      "points in frame, {:.3f} visible past the scene",
+      how, scene_extent, extent, seen.in_frame, seen.visible);
 }
+
+namespace {
+
+// The view's occlusion test: a ray from the eye to the point against the scene's meshes (Embree alone, no
+// distance field), stopped 1% short so that a point on a surface is not hidden by that surface.
+SightBlocked scene_sight(const std::shared_ptr<SceneQuery>& query) {
+  return [query](const glm::vec3& eye, const glm::vec3& p) { return query->occluded(eye, p - eye, 0.99f); };
+}
+
+}  // namespace
 
 RenderView render_view(const Scene& scene, const Plant& plant, const RenderOptions& o) {
   const float aspect = aspect_of(o);
@@ -666,9 +775,17 @@ RenderView render_view(const Scene& scene, const Plant& plant, const RenderOptio
     v.light.direction = turn_about_vertical(scene.light.direction, glm::vec3(0.0f), orbit.angle);
     v.light.position = turn_about_vertical(scene.light.position, orbit.axis_point, orbit.angle);
   } else {
-    const RenderCamera rc = choose_camera(scene.camera, aspect, v.subject, o.camera);
+    // The plant's own points, or the subject's corners when the caller fixed the subject (a growth frame).
+    const std::vector<glm::vec3> points = o.subject.empty() ? plant_points(scene, plant) : corners(v.subject);
+    SceneQueryOptions qo;
+    qo.build_sdf = false;
+    const auto query = std::make_shared<SceneQuery>(scene, qo);
+    const RenderCamera rc = choose_camera(scene.camera, aspect, points, scene.bounds(), o.camera, scene_sight(query));
     v.camera = rc.camera;
     v.fitted = rc.fitted;
+    v.seen = rc.seen;
+    v.turn_deg = rc.turn_deg;
+    v.raise_deg = rc.raise_deg;
   }
   v.scene_extent = projected_extent(scene.camera, aspect, v.subject);
   v.extent = projected_extent(v.camera, aspect, v.subject);
@@ -687,7 +804,10 @@ nlohmann::json RenderResult::to_json() const {
   if (!camera.empty()) {
     j["camera"] = camera;
     j["scene_extent"] = scene_extent;
+    j["in_frame_share"] = seen.in_frame;
+    j["visible_share"] = seen.visible;
   }
+  if (plant_pixel_share >= 0.0) j["plant_pixel_share"] = plant_pixel_share;
   return j;
 }
 
@@ -712,6 +832,52 @@ std::string povray_version() {
 
 namespace {
 
+// The share of the pixels POV-Ray has rendered, from the last "Rendered N of M pixels" of its log (+V);
+// negative before the first.
+double rendered_share(const std::string& log) {
+  std::ifstream in(log, std::ios::binary);
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  in.seekg(std::max<std::streamoff>(0, size - 4096));
+  const std::string tail((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t at = tail.rfind("Rendered ");
+  unsigned long long done = 0, total = 0;
+  if (at == std::string::npos || std::sscanf(tail.c_str() + at, "Rendered %llu of %llu", &done, &total) != 2 ||
+      total == 0)
+    return -1.0;
+  return static_cast<double>(done) / static_cast<double>(total);
+}
+
+// While it lives, reports POV-Ray's progress every few seconds from a thread of its own.
+class ProgressWatch {
+ public:
+  ProgressWatch(std::function<void(double, double)> report, std::string log, std::chrono::steady_clock::time_point t0) {
+    if (!report) return;
+    thread_ = std::thread([this, report = std::move(report), log = std::move(log), t0] {
+      std::unique_lock lock(mutex_);
+      while (!stop_.wait_for(lock, std::chrono::seconds(3), [this] { return done_; }))
+        report(rendered_share(log), std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    });
+  }
+  ~ProgressWatch() {
+    if (!thread_.joinable()) return;
+    {
+      std::lock_guard lock(mutex_);
+      done_ = true;
+    }
+    stop_.notify_all();
+    thread_.join();
+  }
+  ProgressWatch(const ProgressWatch&) = delete;
+  ProgressWatch& operator=(const ProgressWatch&) = delete;
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable stop_;
+  bool done_ = false;
+  std::thread thread_;
+};
+
 // POV-Ray's command line, the file names relative to the directory it runs in.
 std::vector<std::string> povray_args(const std::string& bin, const fs::path& pov_abs, const fs::path& png_abs,
                                      const fs::path& dir, const RenderResult& r, const RenderOptions& o) {
@@ -721,11 +887,12 @@ std::vector<std::string> povray_args(const std::string& bin, const fs::path& pov
                                    fmt::format("+W{}", r.width),
                                    fmt::format("+H{}", r.height),
                                    "+FN",
-                                   "-D",  // no display window (and no ASCII-art preview in the log)
-                                   "-V",
+                                   "-D",                      // no display window (and no ASCII-art preview in the log)
+                                   o.progress ? "+V" : "-V",  // +V: "Rendered N of M pixels" lines
                                    "-P",
                                    fmt::format("+WT{}", std::max(1, o.threads))};
-  if (o.quality == RenderQuality::Paper && !o.dof) {  // focal blur anti-aliases itself (write_camera)
+  if (o.mask) args.push_back("Declare=GB_Mask=1");
+  if (o.quality == RenderQuality::Paper && !o.dof && !o.mask) {  // focal blur anti-aliases itself (write_camera)
     args.insert(args.end(), {"+A0.1", "+AM2", "+R3"});
   } else {
     args.push_back("-A");
@@ -772,6 +939,7 @@ RenderResult run_povray(const std::string& pov_path, const std::string& png_path
   const std::vector<std::string> args = povray_args(bin, pov_abs, png_abs, dir, r, o);
   const auto t0 = std::chrono::steady_clock::now();
   ChildResult cr;
+  ProgressWatch watch(o.progress, fs::absolute(r.log).string(), t0);
   try {
     cr = run_program(args, dir.string(), {o.timeout_s, 0}, fs::absolute(r.log).string());
   } catch (const std::exception& e) {
@@ -799,6 +967,51 @@ RenderResult run_povray(const std::string& pov_path, const std::string& png_path
 }
 
 namespace {
+
+// The share of the pixels that are not black in a PNG (cairo reads it); negative when it cannot be read.
+double lit_share(const std::string& png) {
+  cairo_surface_t* img = cairo_image_surface_create_from_png(png.c_str());
+  double share = -1.0;
+  if (cairo_surface_status(img) == CAIRO_STATUS_SUCCESS) {
+    cairo_surface_flush(img);
+    const int w = cairo_image_surface_get_width(img), h = cairo_image_surface_get_height(img);
+    const int stride = cairo_image_surface_get_stride(img);
+    const unsigned char* data = cairo_image_surface_get_data(img);
+    std::size_t lit = 0;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        std::uint32_t px;
+        std::memcpy(&px, data + static_cast<std::size_t>(y) * stride + 4 * static_cast<std::size_t>(x), 4);
+        // Any channel above a few levels: the glow of the darkest bark, not a black pixel's rounding.
+        if (((px >> 16) & 0xFF) > 6 || ((px >> 8) & 0xFF) > 6 || (px & 0xFF) > 6) ++lit;
+      }
+    if (w > 0 && h > 0) share = static_cast<double>(lit) / (static_cast<double>(w) * h);
+  }
+  cairo_surface_destroy(img);
+  return share;
+}
+
+// plant_pixel_share: the .pov file rendered again as the mask (RenderOptions::mask) at a quarter of the
+// size, at least 80 pixels wide, without anti-aliasing; the mask image and its log are removed after.
+double plant_pixel_share(const std::string& pov_path, const std::string& png_path, const RenderOptions& o,
+                         const std::string& work_dir) {
+  RenderOptions mo = o;
+  mo.mask = true;
+  mo.progress = nullptr;
+  mo.quality = RenderQuality::Preview;
+  mo.dof = false;
+  mo.width = std::max(80, render_width(o) / 4);
+  mo.height = std::max(1, static_cast<int>(std::lround(mo.width * static_cast<double>(render_height(o)) /
+                                                       std::max(1, render_width(o)))));
+  const std::string mask =
+      (fs::path(png_path).parent_path() / (fs::path(png_path).stem().string() + ".mask.png")).string();
+  const RenderResult r = run_povray(pov_path, mask, mo, work_dir);
+  const double share = r.ok() ? lit_share(mask) : -1.0;
+  std::error_code ec;
+  fs::remove(mask, ec);
+  fs::remove(r.log, ec);
+  return share;
+}
 
 // Why the plant's decals cannot be rendered ("" when they can): a decal the scene cannot hold, or an
 // image missing from `dir`, where POV-Ray runs and reads them.
@@ -852,6 +1065,9 @@ RenderResult render_plant(const Scene& scene, const Plant& plant, const std::str
   r.write_s = write_s;
   r.camera = view.fitted ? "fitted" : "scene";
   r.scene_extent = view.scene_extent;
+  r.seen = view.seen;
+  if (r.ok() && o.draw_plant && o.turns == 0 && o.subject.empty())
+    r.plant_pixel_share = plant_pixel_share(pov_path, png_path, o, work_dir);
   return r;
 }
 
@@ -906,18 +1122,18 @@ bool draw_image(cairo_t* c, const std::string& file, double x0, double y0, int w
 }
 
 // A grey cell with `note` in it, where an image is missing.
-void draw_missing(cairo_t* c, const std::string& note, double x0, double y0, int w, int h) {
+void draw_missing(cairo_t* c, const std::string& note, double x0, double y0, int w, int h, double px) {
   cairo_set_source_rgb(c, 0.85, 0.85, 0.85);
   cairo_rectangle(c, x0, y0, w, h);
   cairo_fill(c);
   cairo_set_source_rgb(c, 0.35, 0.35, 0.35);
-  centred_text(c, note, x0 + w / 2.0, y0 + h / 2.0, 13, w - 12);
+  centred_text(c, note, x0 + w / 2.0, y0 + h / 2.0, px, w - 12);
 }
 
 // A band across the top of a cell's image with `text` in white: red for a degenerate plant, dark grey for
 // one otherwise left out (not applicable).
-void draw_badge(cairo_t* c, const std::string& text, double x0, double y0, int w) {
-  const double band = 22.0;
+void draw_badge(cairo_t* c, const std::string& text, double x0, double y0, int w, double px) {
+  const double band = 1.5 * px;
   if (text.rfind("degenerate", 0) == 0)
     cairo_set_source_rgba(c, 0.78, 0.1, 0.1, 0.9);
   else
@@ -925,7 +1141,7 @@ void draw_badge(cairo_t* c, const std::string& text, double x0, double y0, int w
   cairo_rectangle(c, x0, y0, w, band);
   cairo_fill(c);
   cairo_set_source_rgb(c, 1, 1, 1);
-  centred_text(c, text, x0 + w / 2.0, y0 + band / 2.0, 13, w - 8);
+  centred_text(c, text, x0 + w / 2.0, y0 + band / 2.0, px, w - 8);
 }
 
 void write_png(cairo_surface_t* surface, const std::string& png_path) {
@@ -948,42 +1164,122 @@ std::string at(const std::vector<std::vector<std::string>>& table, int i, int j)
 
 }  // namespace
 
-void write_grid(const std::string& png_path, const std::string& title, const std::vector<std::string>& row_labels,
-                const std::vector<std::string>& col_labels, const std::vector<std::vector<std::string>>& cells,
-                const std::vector<std::vector<std::string>>& notes, const std::vector<std::vector<std::string>>& badges,
-                int cell_width) {
+namespace {
+
+// The label size that reads kGridMinLabelPt when an image `width` pixels wide is printed kGridPrintWidthIn.
+double label_px_for(double width) {
+  return std::max(15.0, kGridMinLabelPt * width / (kGridPrintWidthIn * 72.0));
+}
+
+double text_width(cairo_t* c, const std::string& s, double size) {
+  cairo_set_font_size(c, size);
+  cairo_text_extents_t e;
+  cairo_text_extents(c, s.c_str(), &e);
+  return e.x_advance;
+}
+
+using Surface = std::unique_ptr<cairo_surface_t, void (*)(cairo_surface_t*)>;
+using Context = std::unique_ptr<cairo_t, void (*)(cairo_t*)>;
+
+// A cell: its image with its badge, or a grey box with the note.
+void draw_cell(cairo_t* c, const std::string& image, const std::string& note, const std::string& badge, double x0,
+               double y0, int w, int h, double px) {
+  if (draw_image(c, image, x0, y0, w, h)) {
+    if (!badge.empty()) draw_badge(c, badge, x0, y0, w, px);
+    return;
+  }
+  draw_missing(c, note.empty() ? "no render" : note, x0, y0, w, h, px);
+}
+
+}  // namespace
+
+GridLayout write_grid(const std::string& png_path, const std::string& title, const std::vector<std::string>& row_labels,
+                      const std::vector<std::string>& col_labels, const std::vector<std::vector<std::string>>& cells,
+                      const std::vector<std::vector<std::string>>& notes,
+                      const std::vector<std::vector<std::string>>& badges, int cell_width) {
   const int rows = static_cast<int>(row_labels.size()), cols = static_cast<int>(col_labels.size());
   const double aspect = image_aspect(cells);
-  const int cw = cell_width, ch = static_cast<int>(std::lround(cell_width * aspect));
-  const int pad = 6, label_w = 170, header_h = 30, title_h = title.empty() ? 0 : 40;
-  const int W = label_w + cols * (cw + pad) + pad, H = title_h + header_h + rows * (ch + pad) + pad;
-  std::unique_ptr<cairo_surface_t, void (*)(cairo_surface_t*)> surface(
-      cairo_image_surface_create(CAIRO_FORMAT_RGB24, W, H), &cairo_surface_destroy);
-  std::unique_ptr<cairo_t, void (*)(cairo_t*)> cr(cairo_create(surface.get()), &cairo_destroy);
+  const int cw = cell_width, ch = static_cast<int>(std::lround(cell_width * aspect)), pad = 6;
+  // The labels' size follows the image's width, which follows the row labels' width at that size: a few
+  // rounds settle both.
+  Surface probe(cairo_image_surface_create(CAIRO_FORMAT_RGB24, 1, 1), &cairo_surface_destroy);
+  Context pc(cairo_create(probe.get()), &cairo_destroy);
+  cairo_select_font_face(pc.get(), "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
+  GridLayout g;
+  int label_w = 0;
+  for (int round = 0; round < 4; ++round) {
+    g.width = label_w + cols * (cw + pad) + pad;
+    g.label_px = label_px_for(g.width);
+    double widest = 0.0;
+    for (const auto& l : row_labels) widest = std::max(widest, text_width(pc.get(), l, g.label_px));
+    label_w = static_cast<int>(std::ceil(widest + g.label_px));
+  }
+  g.width = label_w + cols * (cw + pad) + pad;
+  const double px = g.label_px;
+  const int header_h = static_cast<int>(std::ceil(2.0 * px)),
+            title_h = title.empty() ? 0 : static_cast<int>(std::ceil(2.4 * px));
+  g.height = title_h + header_h + rows * (ch + pad) + pad;
+  Surface surface(cairo_image_surface_create(CAIRO_FORMAT_RGB24, g.width, g.height), &cairo_surface_destroy);
+  Context cr(cairo_create(surface.get()), &cairo_destroy);
   cairo_t* c = cr.get();
   cairo_set_source_rgb(c, 1, 1, 1);
   cairo_paint(c);
   cairo_select_font_face(c, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
   cairo_set_source_rgb(c, 0.1, 0.1, 0.1);
-  if (!title.empty()) centred_text(c, title, W / 2.0, title_h / 2.0 + 4, 20, W - 20);
+  if (!title.empty()) centred_text(c, title, g.width / 2.0, title_h / 2.0, 1.2 * px, g.width - 20);
   for (int j = 0; j < cols; ++j)
     centred_text(c, col_labels[static_cast<std::size_t>(j)], label_w + pad + j * (cw + pad) + cw / 2.0,
-                 title_h + header_h / 2.0, 15, cw - 8);
+                 title_h + header_h / 2.0, px, cw - 8);
   for (int i = 0; i < rows; ++i) {
     const double y0 = title_h + header_h + i * (ch + pad);
     cairo_set_source_rgb(c, 0.1, 0.1, 0.1);
-    centred_text(c, row_labels[static_cast<std::size_t>(i)], label_w / 2.0, y0 + ch / 2.0, 15, label_w - 12);
+    centred_text(c, row_labels[static_cast<std::size_t>(i)], label_w / 2.0, y0 + ch / 2.0, px, label_w);
     for (int j = 0; j < cols; ++j) {
       const double x0 = label_w + pad + j * (cw + pad);
-      if (draw_image(c, at(cells, i, j), x0, y0, cw, ch)) {
-        if (const std::string badge = at(badges, i, j); !badge.empty()) draw_badge(c, badge, x0, y0, cw);
-        continue;
-      }
-      const std::string note = at(notes, i, j);
-      draw_missing(c, note.empty() ? "no render" : note, x0, y0, cw, ch);
+      draw_cell(c, at(cells, i, j), at(notes, i, j), at(badges, i, j), x0, y0, cw, ch, px);
+      g.cells.push_back({i, j, static_cast<int>(x0), static_cast<int>(y0), cw, ch});
     }
   }
   write_png(surface.get(), png_path);
+  return g;
+}
+
+GridLayout write_captioned_grid(const std::string& png_path, const std::string& title,
+                                const std::vector<std::string>& captions, const std::vector<std::string>& images,
+                                const std::vector<std::string>& notes, const std::vector<std::string>& badges,
+                                int per_row, int cell_width) {
+  const int n = static_cast<int>(images.size()), cols = std::max(1, std::min(per_row, n));
+  const int rows = (n + cols - 1) / cols;
+  const double aspect = image_aspect({images});
+  const int cw = cell_width, ch = static_cast<int>(std::lround(cell_width * aspect)), pad = 6;
+  GridLayout g;
+  g.width = cols * (cw + pad) + pad;
+  g.label_px = label_px_for(g.width);
+  const double px = g.label_px;
+  const int caption_h = static_cast<int>(std::ceil(1.8 * px)),
+            title_h = title.empty() ? 0 : static_cast<int>(std::ceil(2.4 * px));
+  g.height = title_h + rows * (caption_h + ch + pad) + pad;
+  Surface surface(cairo_image_surface_create(CAIRO_FORMAT_RGB24, g.width, g.height), &cairo_surface_destroy);
+  Context cr(cairo_create(surface.get()), &cairo_destroy);
+  cairo_t* c = cr.get();
+  cairo_set_source_rgb(c, 1, 1, 1);
+  cairo_paint(c);
+  cairo_select_font_face(c, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
+  cairo_set_source_rgb(c, 0.1, 0.1, 0.1);
+  if (!title.empty()) centred_text(c, title, g.width / 2.0, title_h / 2.0, 1.2 * px, g.width - 20);
+  auto item = [](const std::vector<std::string>& v, int k) {
+    return static_cast<std::size_t>(k) < v.size() ? v[static_cast<std::size_t>(k)] : std::string();
+  };
+  for (int k = 0; k < n; ++k) {
+    const int i = k / cols, j = k % cols;
+    const double x0 = pad + j * (cw + pad), y0 = title_h + i * (caption_h + ch + pad);
+    cairo_set_source_rgb(c, 0.1, 0.1, 0.1);
+    centred_text(c, item(captions, k), x0 + cw / 2.0, y0 + caption_h / 2.0, px, cw - 4);
+    draw_cell(c, item(images, k), item(notes, k), item(badges, k), x0, y0 + caption_h, cw, ch, px);
+    g.cells.push_back({i, j, static_cast<int>(x0), static_cast<int>(y0 + caption_h), cw, ch});
+  }
+  write_png(surface.get(), png_path);
+  return g;
 }
 
 }  // namespace growbench

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -58,6 +59,12 @@ struct RenderOptions {
   // The box the camera frames and focuses on, when not empty; else the plant's own (plant_bounds). A
   // growth frame takes the grown plant's, so the animation's camera stands still.
   Aabb subject;
+  // The plant-pixel mask pass (render_plant's, for plant_pixel_share): POV-Ray reads the file with GB_Mask
+  // declared, which draws the plant glowing and the rest black, without lights.
+  bool mask = false;
+  // Called every few seconds while POV-Ray renders, with the share of the image's pixels done (negative
+  // while it parses or traces radiosity's pretrace) and the seconds since it started; empty: no progress.
+  std::function<void(double done, double elapsed_s)> progress;
 };
 
 // InputError naming the option for options that cannot render: depth of field in preview quality (a
@@ -76,6 +83,8 @@ struct RenderView {
   bool fitted = false;     // the camera was moved to frame the subject
   float scene_extent = 0;  // the subject's projected extent with the scene camera (camera.hpp)
   float extent = 0;        // ... and with this camera
+  Sight seen;              // the share of the plant's points in this camera's frame, and visible past the scene
+  float turn_deg = 0, raise_deg = 0;           // a fitted camera's turn about the plant and rise above the scene's view
   [[nodiscard]] std::string describe() const;  // a line for the .pov file's header
 };
 RenderView render_view(const Scene& scene, const Plant& plant, const RenderOptions& options);
@@ -100,6 +109,10 @@ struct RenderResult {
   int width = 0, height = 0;
   std::string camera;      // "scene" or "fitted" (RenderView::fitted); "" when nothing was written
   float scene_extent = 0;  // RenderView's
+  Sight seen;              // RenderView's
+  // The share of the image's pixels that show the plant (a render of the same file as a mask, at a quarter
+  // of the size); negative when not measured (a growth or turntable frame, no plant drawn, a failed render).
+  double plant_pixel_share = -1.0;
   std::uint64_t pov_bytes = 0;
   double write_s = 0.0;              // writing the .pov file
   double wall_s = 0.0, cpu_s = 0.0;  // the POV-Ray process (parse + render), apart from the trial's time
@@ -125,13 +138,36 @@ RenderResult run_povray(const std::string& pov_path, const std::string& png_path
 RenderResult render_plant(const Scene& scene, const Plant& plant, const std::string& pov_path,
                           const std::string& png_path, const RenderOptions& options, const std::string& work_dir = "");
 
+// A grid is drawn to be read when printed kGridPrintWidthIn wide: its labels are then at least
+// kGridMinLabelPt high (their pixel size grows with the image's width).
+constexpr double kGridPrintWidthIn = 7.0, kGridMinLabelPt = 8.0;
+// growbench render splits a suite's grid into pages of at most this many scenes (columns).
+constexpr std::size_t kGridPageScenes = 4;
+
+// Where each cell's image lies in a grid image, in pixels (for an image map linking cells to trials).
+struct GridCell {
+  int row = 0, col = 0, x = 0, y = 0, w = 0, h = 0;
+};
+struct GridLayout {
+  int width = 0, height = 0;
+  double label_px = 0.0;  // the labels' font size
+  std::vector<GridCell> cells;
+};
+
 // One labelled image: `cells` is rows x cols PNG paths (an empty path or a missing file draws a grey
 // box with `notes[r][c]`, if given). A non-empty `badges[r][c]` is written in a band across the top of that
 // cell's image (a plant left out of comparisons: "degenerate" in red, anything else in grey). Throws
 // std::runtime_error naming the file it cannot write.
-void write_grid(const std::string& png_path, const std::string& title, const std::vector<std::string>& row_labels,
-                const std::vector<std::string>& col_labels, const std::vector<std::vector<std::string>>& cells,
-                const std::vector<std::vector<std::string>>& notes = {},
-                const std::vector<std::vector<std::string>>& badges = {}, int cell_width = 320);
+GridLayout write_grid(const std::string& png_path, const std::string& title, const std::vector<std::string>& row_labels,
+                      const std::vector<std::string>& col_labels, const std::vector<std::vector<std::string>>& cells,
+                      const std::vector<std::vector<std::string>>& notes = {},
+                      const std::vector<std::vector<std::string>>& badges = {}, int cell_width = 320);
+
+// The same for a list of images each with its own caption above it, `per_row` to a row (a scene's
+// entries): no row labels to repeat the title. notes[k] and badges[k] as in write_grid.
+GridLayout write_captioned_grid(const std::string& png_path, const std::string& title,
+                                const std::vector<std::string>& captions, const std::vector<std::string>& images,
+                                const std::vector<std::string>& notes, const std::vector<std::string>& badges,
+                                int per_row = 4, int cell_width = 320);
 
 }  // namespace growbench

@@ -167,6 +167,23 @@ bool add_trial(std::vector<Job>& jobs, const std::string& key, const fs::path& t
   return true;
 }
 
+// A render's progress line: "render NAME: 45% after 30 s, ETA 37 s", redrawn in place on a terminal, and
+// every half minute into a log.
+std::function<void(double, double)> progress_printer(std::string name, bool tty, std::mutex& print_mutex) {
+  return [name = std::move(name), tty, &print_mutex, last = -1e9](double done, double el) mutable {
+    if (!tty && el - last < 30.0) return;
+    last = el;
+    std::lock_guard lock(print_mutex);
+    const std::string line = done < 0.0 ? fmt::format("render {}: preparing ({:.0f} s)", name, el)
+                                        : fmt::format("render {}: {:.0f}% after {:.0f} s, ETA {:.0f} s", name,
+                                                      100.0 * done, el, done > 0.0 ? el * (1.0 - done) / done : 0.0);
+    if (tty)
+      fmt::print(stderr, "\r{:<110}", line.substr(0, 110));
+    else
+      fmt::print(stderr, "{}\n", line);
+  };
+}
+
 // Renders every job with `workers` POV-Ray processes at once, each scene loaded and each leaf read once.
 void render_jobs(std::vector<Job>& jobs, int workers, const RenderOptions& ro, const RenderDirOptions& o) {
   std::mutex scene_mutex, print_mutex;
@@ -220,8 +237,12 @@ void render_jobs(std::vector<Job>& jobs, int workers, const RenderOptions& ro, c
       try {
         const auto scene = scene_for(j);
         const Plant plant = read_plant_snapshot(j.snapshot.string());
+        RenderOptions jo = job_options(j, *scene);
+        // A paper render can take minutes: it says how far it is, with an estimate of the time left.
+        if (!o.quiet && o.render.quality == RenderQuality::Paper)
+          jo.progress = progress_printer(j.key.empty() ? j.png.filename().string() : j.key, tty, print_mutex);
         // A turntable frame runs POV-Ray in the trial's directory, where the decal images are.
-        j.result = render_plant(*scene, plant, j.pov.string(), j.png.string(), job_options(j, *scene),
+        j.result = render_plant(*scene, plant, j.pov.string(), j.png.string(), jo,
                                 j.turn >= 0 ? j.trial_dir.string() : std::string());
       } catch (const std::exception& e) {
         j.result.status = "failed";
@@ -278,7 +299,10 @@ RenderRecord render_record(const Job& j, const RenderOptions& ro, const fs::path
   if (!r.camera.empty()) {
     rr.camera = r.camera;
     rr.scene_extent = r.scene_extent;
+    rr.in_frame_share = r.seen.in_frame;
+    rr.visible_share = r.seen.visible;
   }
+  if (r.plant_pixel_share >= 0.0) rr.plant_pixel_share = r.plant_pixel_share;
   rr.backdrop = to_string(ro.backdrop);
   rr.dof = ro.dof;
   return rr;
@@ -349,10 +373,15 @@ void record_renders(const std::vector<Job>& jobs, const RenderOptions& ro, const
               [&](const std::string& key, AnimationRecord a) { targets.set_turntable(key, std::move(a)); });
 }
 
-// grid.png: one row per algorithm entry (and sweep value), one column per scene, the lowest seed's plant;
-// and grid-SCENE.png per scene. Failures to write them are recorded in `summary`, never fatal.
-void write_grids(const ResultsFile& doc, const fs::path& dir, const RenderOptions& ro, RenderSummary& summary) {
+// What a suite's grids show: one row per algorithm entry (and sweep value), one column per scene, the
+// lowest seed's plant; per cell its image (or a note why there is none), its badge and its trial.
+struct GridTable {
   std::vector<std::string> rows, cols;
+  std::vector<std::vector<std::string>> cells, notes, badges, trials;
+};
+
+GridTable grid_table(const ResultsFile& doc, const fs::path& dir) {
+  GridTable g;
   std::map<std::pair<std::string, std::string>, const SuiteCell*> pick;
   for (const auto& t : doc.trials) {
     std::string row = t.label.empty() ? t.algorithm : t.label;
@@ -362,62 +391,122 @@ void write_grids(const ResultsFile& doc, const fs::path& dir, const RenderOption
         kv.push_back(fmt::format("{}={}", k, v.is_string() ? v.get<std::string>() : v.dump()));
       row += fmt::format(" {}", fmt::join(kv, " "));
     }
-    const std::string& col = t.scene;
-    if (std::find(rows.begin(), rows.end(), row) == rows.end()) rows.push_back(row);
-    if (std::find(cols.begin(), cols.end(), col) == cols.end()) cols.push_back(col);
-    const SuiteCell*& p = pick[{row, col}];
+    if (std::find(g.rows.begin(), g.rows.end(), row) == g.rows.end()) g.rows.push_back(row);
+    if (std::find(g.cols.begin(), g.cols.end(), t.scene) == g.cols.end()) g.cols.push_back(t.scene);
+    const SuiteCell*& p = pick[{row, t.scene}];
     if (!p || t.seed < p->seed) p = &t;
   }
-  auto cell = [&](const std::string& r, const std::string& c, std::string& note) {
-    const auto it = pick.find({r, c});
-    if (it == pick.end()) {
-      note = "not in suite";
-      return std::string();
+  g.cells.assign(g.rows.size(), std::vector<std::string>(g.cols.size()));
+  g.notes = g.badges = g.trials = g.cells;
+  for (std::size_t i = 0; i < g.rows.size(); ++i)
+    for (std::size_t k = 0; k < g.cols.size(); ++k) {
+      const auto it = pick.find({g.rows[i], g.cols[k]});
+      if (it == pick.end()) {
+        g.notes[i][k] = "not in suite";
+        continue;
+      }
+      const SuiteCell& t = *it->second;
+      g.trials[i][k] = t.id;
+      if (t.status != "ok")
+        g.notes[i][k] = t.status;
+      else if (!t.media.render)
+        g.notes[i][k] = "no snapshot";
+      else if (t.media.render->status != "ok")
+        g.notes[i][k] = "render " + t.media.render->status;
+      else
+        g.cells[i][k] = (dir / t.media.render->png).string();
+      // A plant left out of comparisons says so on its image (docs/metrics.md, "Validity").
+      if (t.results.plant && t.results.plant->verdict && t.results.plant->verdict->status != "valid")
+        g.badges[i][k] =
+            t.results.plant->verdict->status == "not_applicable" ? "not applicable" : t.results.plant->verdict->status;
     }
-    const SuiteCell& t = *it->second;
-    if (t.status != "ok")
-      note = t.status;
-    else if (!t.media.render)
-      note = "no snapshot";
-    else if (t.media.render->status != "ok")
-      note = "render " + t.media.render->status;
-    else
-      return (dir / t.media.render->png).string();
-    return std::string();
-  };
-  // A plant left out of comparisons says so on its image (docs/metrics.md, "Validity").
-  auto badge = [&](const std::string& r, const std::string& c) {
-    const auto it = pick.find({r, c});
-    if (it == pick.end() || !it->second->results.plant || !it->second->results.plant->verdict) return std::string();
-    const std::string& v = it->second->results.plant->verdict->status;
-    return v == "valid" ? std::string() : v == "not_applicable" ? std::string("not applicable") : v;
-  };
-  std::vector<std::vector<std::string>> cells(rows.size(), std::vector<std::string>(cols.size()));
-  std::vector<std::vector<std::string>> notes = cells, badges = cells;
-  for (std::size_t i = 0; i < rows.size(); ++i)
-    for (std::size_t k = 0; k < cols.size(); ++k) {
-      cells[i][k] = cell(rows[i], cols[k], notes[i][k]);
-      badges[i][k] = badge(rows[i], cols[k]);
+  return g;
+}
+
+// The columns [first, last) of a table.
+GridTable grid_columns(const GridTable& g, std::size_t first, std::size_t last) {
+  GridTable out;
+  out.rows = g.rows;
+  out.cols.assign(g.cols.begin() + static_cast<std::ptrdiff_t>(first),
+                  g.cols.begin() + static_cast<std::ptrdiff_t>(last));
+  for (auto* t : {&out.cells, &out.notes, &out.badges, &out.trials}) t->resize(g.rows.size());
+  for (std::size_t i = 0; i < g.rows.size(); ++i)
+    for (std::size_t k = first; k < last; ++k) {
+      out.cells[i].push_back(g.cells[i][k]);
+      out.notes[i].push_back(g.notes[i][k]);
+      out.badges[i].push_back(g.badges[i][k]);
+      out.trials[i].push_back(g.trials[i][k]);
     }
+  return out;
+}
+
+// IMAGE.map.json beside a grid image: which trial each cell shows and where (the report links them).
+void write_grid_map(const fs::path& dir, const std::string& image, const GridLayout& layout,
+                    const std::vector<std::string>& trial_of_cell) {
+  json cells = json::array();
+  for (std::size_t n = 0; n < layout.cells.size() && n < trial_of_cell.size(); ++n)
+    if (const GridCell& c = layout.cells[n]; !trial_of_cell[n].empty())
+      cells.push_back({{"trial", trial_of_cell[n]}, {"x", c.x}, {"y", c.y}, {"w", c.w}, {"h", c.h}});
+  write_file_atomic(
+      (dir / (image + ".map.json")).string(),
+      json_text({{"image", image}, {"width", layout.width}, {"height", layout.height}, {"cells", cells}}, 1));
+}
+
+// A table drawn as one grid image, with its map.
+void draw_grid_table(const fs::path& dir, const std::string& image, const std::string& title, const GridTable& g) {
+  const GridLayout layout = write_grid((dir / image).string(), title, g.rows, g.cols, g.cells, g.notes, g.badges);
+  std::vector<std::string> ids;
+  for (const GridCell& c : layout.cells)
+    ids.push_back(g.trials[static_cast<std::size_t>(c.row)][static_cast<std::size_t>(c.col)]);
+  write_grid_map(dir, image, layout, ids);
+}
+
+// The grid in pages of at most kGridPageScenes scenes, each legible at a page's width; none when one page
+// holds it all.
+std::vector<std::string> write_grid_pages(const fs::path& dir, const std::string& title, const GridTable& g) {
+  std::vector<std::string> pages;
+  const std::size_t n = (g.cols.size() + kGridPageScenes - 1) / kGridPageScenes;
+  for (std::size_t page = 0; n > 1 && page < n; ++page) {
+    const std::string name = fmt::format("grid-page-{}.png", page + 1);
+    draw_grid_table(dir, name, fmt::format("{} ({} of {})", title, page + 1, n),
+                    grid_columns(g, page * g.cols.size() / n, (page + 1) * g.cols.size() / n));
+    pages.push_back(name);
+  }
+  return pages;
+}
+
+// Per scene, grid-SCENE.png: its entries side by side, each under its own caption.
+std::map<std::string, std::string> write_scene_grids(const fs::path& dir, const GridTable& g) {
+  std::map<std::string, std::string> out;
+  for (std::size_t k = 0; k < g.cols.size(); ++k) {
+    const GridTable col = grid_columns(g, k, k + 1);
+    std::vector<std::string> images, notes, badges, ids;
+    for (std::size_t i = 0; i < g.rows.size(); ++i) {
+      images.push_back(col.cells[i][0]);
+      notes.push_back(col.notes[i][0]);
+      badges.push_back(col.badges[i][0]);
+      ids.push_back(col.trials[i][0]);
+    }
+    const std::string name = "grid-" + safe_name(g.cols[k]) + ".png";
+    const GridLayout layout = write_captioned_grid((dir / name).string(), fmt::format("{} (lowest seed)", g.cols[k]),
+                                                   g.rows, images, notes, badges);
+    write_grid_map(dir, name, layout, ids);
+    out[g.cols[k]] = name;
+  }
+  return out;
+}
+
+// grid.png (the whole suite), its pages and the per-scene grids, each with its map. Failures to write them
+// are recorded in `summary`, never fatal.
+void write_grids(const ResultsFile& doc, const fs::path& dir, const RenderOptions& ro, RenderSummary& summary) {
+  const GridTable g = grid_table(doc, dir);
   const std::string title = fmt::format("growbench suite '{}': algorithm x scene (lowest seed), POV-Ray {}",
                                         doc.suite.name, to_string(ro.quality));
   try {
-    write_grid((dir / "grid.png").string(), title, rows, cols, cells, notes, badges);
+    draw_grid_table(dir, "grid.png", title, g);
     summary.grid = "grid.png";
-    std::map<std::string, std::string> per_scene;
-    for (std::size_t k = 0; k < cols.size(); ++k) {
-      std::vector<std::vector<std::string>> col_cells(1), col_notes(1), col_badges(1);
-      for (std::size_t i = 0; i < rows.size(); ++i) {
-        col_cells[0].push_back(cells[i][k]);
-        col_notes[0].push_back(notes[i][k]);
-        col_badges[0].push_back(badges[i][k]);
-      }
-      const std::string name = "grid-" + safe_name(cols[k]) + ".png";
-      write_grid((dir / name).string(), fmt::format("{} (lowest seed)", cols[k]), {cols[k]}, rows, col_cells, col_notes,
-                 col_badges);
-      per_scene[cols[k]] = name;
-    }
-    summary.grid_per_scene = per_scene;
+    if (std::vector<std::string> pages = write_grid_pages(dir, title, g); !pages.empty()) summary.grid_pages = pages;
+    summary.grid_per_scene = write_scene_grids(dir, g);
   } catch (const std::exception& e) {
     summary.grid_error = e.what();
     fmt::print(stderr, "growbench: {}\n", e.what());

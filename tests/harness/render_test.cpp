@@ -258,7 +258,8 @@ TEST(RenderCamera, AutoFramesASmallPlantWithTheMarginKeepingTheViewDirection) {
   EXPECT_NEAR(box.min.x, -0.6f - 0.01f, 1e-5f);  // a side branch tip, without organs
   const float before = projected_extent(scene.camera, aspect, box);
   EXPECT_LT(before, kSmallPlantExtent);
-  const RenderCamera rc = choose_camera(scene.camera, aspect, box, CameraMode::Auto);
+  // No scene bounds: no context around the plant, which then fills the frame to the margin.
+  const RenderCamera rc = choose_camera(scene.camera, aspect, corners(box), Aabb{}, CameraMode::Auto);
   ASSERT_TRUE(rc.fitted);
   EXPECT_FLOAT_EQ(rc.scene_extent, before);
   EXPECT_FLOAT_EQ(rc.camera.fov_deg, scene.camera.fov_deg);
@@ -269,13 +270,13 @@ TEST(RenderCamera, AutoFramesASmallPlantWithTheMarginKeepingTheViewDirection) {
   Aabb side = box;
   side.min += glm::vec3(3.0f, 0.0f, -2.0f);
   side.max += glm::vec3(3.0f, 0.0f, -2.0f);
-  const Camera wide = choose_camera(scene.camera, 2.0f, side, CameraMode::Auto).camera;
+  const Camera wide = choose_camera(scene.camera, 2.0f, corners(side), Aabb{}, CameraMode::Auto).camera;
   expect_framed(wide, 2.0f, corners(side));
   const auto [lo, hi] = projected_box(wide, 2.0f, corners(side));
   EXPECT_NEAR(lo.x + hi.x, 0.0f, 1e-3f);
   EXPECT_NEAR(lo.y + hi.y, 0.0f, 1e-3f);
   // camera=scene keeps the scene's camera however small the plant.
-  const RenderCamera kept = choose_camera(scene.camera, aspect, box, CameraMode::Scene);
+  const RenderCamera kept = choose_camera(scene.camera, aspect, corners(box), scene.bounds(), CameraMode::Scene);
   EXPECT_FALSE(kept.fitted);
   EXPECT_EQ(kept.camera.position, scene.camera.position);
 }
@@ -285,8 +286,9 @@ TEST(RenderCamera, SceneCameraIsKeptWhenThePlantFillsItsFrameOrIsEmpty) {
   scene.camera.position = {0.0f, 1.0f, 2.5f};
   const Aabb box = plant_bounds(scene, tiny_plant());
   EXPECT_GT(projected_extent(scene.camera, 4.0f / 3.0f, box), kSmallPlantExtent);
-  const RenderCamera rc = choose_camera(scene.camera, 4.0f / 3.0f, box, CameraMode::Auto);
-  EXPECT_FALSE(rc.fitted);
+  const RenderCamera rc =
+      choose_camera(scene.camera, 4.0f / 3.0f, plant_points(scene, tiny_plant()), scene.bounds(), CameraMode::Auto);
+  EXPECT_FALSE(rc.fitted) << rc.scene_extent << " " << rc.seen.in_frame << " " << rc.seen.visible;
   EXPECT_EQ(rc.camera.position, scene.camera.position);
   EXPECT_EQ(rc.camera.look_at, scene.camera.look_at);
   const auto dir = test::temp_dir("camera_kept");
@@ -295,11 +297,77 @@ TEST(RenderCamera, SceneCameraIsKeptWhenThePlantFillsItsFrameOrIsEmpty) {
   // An empty plant has nothing to frame.
   const Scene far = far_scene();
   EXPECT_TRUE(plant_bounds(far, Plant{}).empty());
-  const RenderCamera empty = choose_camera(far.camera, 4.0f / 3.0f, plant_bounds(far, Plant{}), CameraMode::Auto);
+  const RenderCamera empty =
+      choose_camera(far.camera, 4.0f / 3.0f, plant_points(far, Plant{}), far.bounds(), CameraMode::Auto);
   EXPECT_FALSE(empty.fitted);
   EXPECT_EQ(empty.camera.position, far.camera.position);
   write_pov((dir / "e.pov").string(), far, Plant{}, RenderOptions{});
   EXPECT_NE(read_file(dir / "e.pov").find("location <0,4,-12>"), std::string::npos);
+}
+
+TEST(RenderCamera, AHiddenPlantIsSeenFromAroundWhatHidesIt) {
+  // The plant behind the wall of tiny_scene (z < -0.1), the camera in front: every sight line from the
+  // front crosses the wall's plane within it, and none from behind does.
+  const Scene scene = tiny_scene();
+  Plant plant = tiny_plant();
+  for (PlantNode& n : plant.nodes) n.position.z -= 1.0f;
+  for (Organ& o : plant.organs) o.position.z -= 1.0f;
+  for (PlantPolygon& poly : plant.polygons)
+    for (glm::vec3& v : poly.vertices) v.z -= 1.0f;
+  const std::vector<glm::vec3> points = plant_points(scene, plant);
+  const SightBlocked wall = [](const glm::vec3& eye, const glm::vec3& p) {
+    if ((eye.z > 0.0f) == (p.z > 0.0f) || eye.z == p.z) return false;
+    const float t = eye.z / (eye.z - p.z);
+    const glm::vec3 q = eye + t * (p - eye);
+    return std::abs(q.x) <= 1.0f && q.y >= 0.0f && q.y <= 2.0f;
+  };
+  const float aspect = 4.0f / 3.0f;
+  EXPECT_FLOAT_EQ(sight(scene.camera, aspect, points, wall).visible, 0.0f);
+  EXPECT_FLOAT_EQ(sight(scene.camera, aspect, points, {}).visible, 1.0f);  // nothing blocks
+  const RenderCamera rc = choose_camera(scene.camera, aspect, points, scene.bounds(), CameraMode::Auto, wall);
+  ASSERT_TRUE(rc.fitted);
+  EXPECT_GE(rc.seen.visible, kVisibleEnough);
+  EXPECT_FLOAT_EQ(rc.seen.in_frame, 1.0f);  // never cropped
+  EXPECT_TRUE(rc.turn_deg != 0.0f || rc.raise_deg != 0.0f) << "the camera went round or over the wall";
+  // camera=scene keeps the scene's view and says how little it sees.
+  const RenderCamera kept = choose_camera(scene.camera, aspect, points, scene.bounds(), CameraMode::Scene, wall);
+  EXPECT_FALSE(kept.fitted);
+  EXPECT_FLOAT_EQ(kept.seen.visible, 0.0f);
+}
+
+TEST(RenderCamera, APlantLargerThanTheSceneFrameIsFittedNotCropped) {
+  Scene scene = tiny_scene();
+  Plant plant = tiny_plant();
+  plant.nodes[1].position.y = 9.0f;  // far above the frame's top edge
+  const std::vector<glm::vec3> points = plant_points(scene, plant);
+  const RenderCamera rc = choose_camera(scene.camera, 4.0f / 3.0f, points, scene.bounds(), CameraMode::Auto);
+  EXPECT_LT(sight(scene.camera, 4.0f / 3.0f, points, {}).in_frame, 1.0f);
+  ASSERT_TRUE(rc.fitted);
+  EXPECT_FLOAT_EQ(rc.seen.in_frame, 1.0f);
+  for (const glm::vec3& p : points) {
+    const glm::vec3 q = project(rc.camera, 4.0f / 3.0f, p);
+    EXPECT_LE(std::max(std::abs(q.x), std::abs(q.y)), 1.0f - 2.0f * kFrameMargin + 2e-3f);
+  }
+}
+
+TEST(RenderCamera, PlantPointsSampleNodesEvenlyAndKeepOrgans) {
+  const Scene scene = tiny_scene();
+  Plant plant;
+  for (int i = 0; i < 1000; ++i) {
+    PlantNode n;
+    n.position = {0.0f, 0.001f * static_cast<float>(i), 0.0f};
+    plant.nodes.push_back(n);
+  }
+  Organ leaf;
+  leaf.position = {5.0f, 0.0f, 0.0f};
+  plant.organs.push_back(leaf);
+  const std::vector<glm::vec3> pts = plant_points(scene, plant, 100);
+  // Every tenth node, the last tip, and the organ.
+  ASSERT_EQ(pts.size(), 102u);
+  EXPECT_FLOAT_EQ(pts[1].y, 0.001f * 10.0f);
+  EXPECT_FLOAT_EQ(pts[100].y, 0.001f * 999.0f);
+  EXPECT_EQ(pts[101], leaf.position);
+  EXPECT_TRUE(plant_points(scene, Plant{}).empty());
 }
 
 TEST(RenderCamera, APlantWithDecalsIsFramedByThem) {
@@ -506,10 +574,70 @@ TEST(PlantSnapshot, BadFilesAreClearErrors) {
             std::string::npos);
 }
 
+TEST(PovWriter, SceneMeshesAreSmoothExceptAcrossCreases) {
+  const auto dir = test::temp_dir("pov_creases");
+  // A box: each corner's three faces meet at 90 degrees, so each corner is split three ways, one normal
+  // per face.
+  write_pov((dir / "box.pov").string(), tiny_scene(), Plant{}, RenderOptions{});
+  const std::string box = read_file(dir / "box.pov");
+  EXPECT_NE(box.find("vertex_vectors { 24"), std::string::npos);
+  EXPECT_NE(box.find("normal_vectors { 24"), std::string::npos);
+  // A 32-sided column: its sides turn by 11.25 degrees, so a side vertex keeps one normal, and only the
+  // caps' rims are split from the sides.
+  const TriangleMesh col = geom::make_cylinder("column", {0, 0, 0}, {0, 2, 0}, 0.3f, 0.3f, 32);
+  write_pov((dir / "col.pov").string(), test::scene_with(col), Plant{}, RenderOptions{});
+  const std::string pov = read_file(dir / "col.pov");
+  const std::smatch m = [&] {
+    std::smatch r;
+    std::regex_search(pov, r, std::regex(R"(normal_vectors \{ (\d+),)"));
+    return r;
+  }();
+  ASSERT_FALSE(m.empty());
+  // Each rim vertex once for the side and once for its cap (and a cap's centre, if it has one).
+  EXPECT_LE(std::stoul(m[1]), 2 * col.vertices.size());
+  EXPECT_GE(std::stoul(m[1]), col.vertices.size() + 2 * 32 - 2);
+  // Neighbouring side normals differ by the turn, not by the face: the first 4 normals are unit and
+  // horizontal or vertical.
+  EXPECT_EQ(pov.find("normal_vectors { 0"), std::string::npos);
+}
+
+TEST(PovRender, ThePlantsPixelShareIsMeasuredByAMask) {
+  ASSERT_FALSE(find_povray().empty()) << "povray is not installed (scripts/install-deps installs it)";
+  const auto dir = test::temp_dir("render_mask");
+  Scene scene = tiny_scene();
+  RenderOptions o;
+  o.width = 160;
+  o.height = 120;
+  o.camera = CameraMode::Scene;
+  const RenderResult r = render_plant(scene, tiny_plant(), (dir / "a.pov").string(), (dir / "a.png").string(), o);
+  ASSERT_TRUE(r.ok()) << r.message;
+  // The plant's pixels, counted as PovRender.AutoCameraFillsTheFrameWithASmallPlant does: where the render
+  // differs from the scene alone (its shadow counts there, so that count is the larger).
+  o.draw_plant = false;
+  const RenderResult bare = render_plant(scene, tiny_plant(), (dir / "b.pov").string(), (dir / "b.png").string(), o);
+  ASSERT_TRUE(bare.ok()) << bare.message;
+  EXPECT_LT(bare.plant_pixel_share, 0.0) << "no plant drawn: not measured";
+  const Image a = load_png(r.png), b = load_png(bare.png);
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i + 2 < a.rgb.size(); i += 3)
+    if (std::abs(a.rgb[i] - b.rgb[i]) + std::abs(a.rgb[i + 1] - b.rgb[i + 1]) + std::abs(a.rgb[i + 2] - b.rgb[i + 2]) >
+        30)
+      ++differ;
+  const double by_difference = static_cast<double>(differ) / (a.w * a.h);
+  EXPECT_GT(r.plant_pixel_share, 0.2 * by_difference);
+  EXPECT_LT(r.plant_pixel_share, 1.5 * by_difference);
+  EXPECT_GT(r.plant_pixel_share, 0.0);
+  // The mask's image and log are not left beside the render.
+  EXPECT_FALSE(std::filesystem::exists(dir / "a.mask.png"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "a.mask.png.log"));
+  EXPECT_NEAR(r.to_json().at("plant_pixel_share").get<double>(), r.plant_pixel_share, 1e-12);
+}
+
 TEST(PovWriter, WritesEveryPartInPovRayHandedness) {
   const auto dir = test::temp_dir("pov");
   const Plant p = tiny_plant();
   RenderOptions o;
+  o.camera = CameraMode::Scene;  // the scene camera, whose place in the file is known
   const auto bytes = write_pov((dir / "s.pov").string(), tiny_scene(), p, o);
   const std::string pov = read_file(dir / "s.pov");
   EXPECT_EQ(bytes, pov.size());
@@ -745,20 +873,40 @@ TEST(RenderGrid, LabelsCellsAndMarksMissingOnes) {
   const RenderResult r =
       render_plant(tiny_scene(), tiny_plant(), (dir / "a.pov").string(), (dir / "a.png").string(), o);
   ASSERT_TRUE(r.ok()) << r.message;
-  write_grid((dir / "grid.png").string(), "title", {"alpha", "beta"}, {"s1", "s2", "s3"},
-             {{r.png, r.png, ""}, {r.png, "", (dir / "missing.png").string()}}, {{"", "", "timeout"}},
-             {{"", "degenerate"}}, 100);
+  const GridLayout lay = write_grid((dir / "grid.png").string(), "title", {"alpha", "beta"}, {"s1", "s2", "s3"},
+                                    {{r.png, r.png, ""}, {r.png, "", (dir / "missing.png").string()}},
+                                    {{"", "", "timeout"}}, {{"", "degenerate"}}, 100);
   const Image g = load_png((dir / "grid.png").string());
-  EXPECT_EQ(g.w, 170 + 3 * 106 + 6);           // row labels, three cells with padding
-  EXPECT_EQ(g.h, 40 + 30 + 2 * (75 + 6) + 6);  // title, column labels, two rows of 4:3 cells
+  EXPECT_EQ(g.w, lay.width);
+  EXPECT_EQ(g.h, lay.height);
+  // Printed 7 in wide, the labels are 8 pt or more.
+  EXPECT_GE(lay.label_px * kGridPrintWidthIn * 72.0 / lay.width, kGridMinLabelPt - 1e-9);
+  ASSERT_EQ(lay.cells.size(), 6u);  // row-major, with where each image is
+  EXPECT_EQ(lay.cells[1].row, 0);
+  EXPECT_EQ(lay.cells[1].col, 1);
+  EXPECT_EQ(lay.cells[1].x - lay.cells[0].x, 100 + 6);  // cells of 100 px with 6 px between
+  EXPECT_EQ(lay.cells[3].y - lay.cells[0].y, 75 + 6);   // two rows of 4:3 cells
+  EXPECT_EQ(lay.height, lay.cells[3].y + 75 + 6 + 6);   // a pad below each row, and the margin
   EXPECT_GT(luminance_variance(g), 100.0);
   // The degenerate plant's cell (row 0, column 1) carries a red band at its top; its neighbour does not.
   auto pixel = [&](int x, int y) { return g.rgb[static_cast<std::size_t>(3 * (y * g.w + x))]; };
   auto greenish = [&](int x, int y) { return g.rgb[static_cast<std::size_t>(3 * (y * g.w + x) + 1)]; };
-  const int y = 40 + 30 + 3, x_badged = 170 + 6 + 106 + 3, x_plain = 170 + 6 + 3;
+  const int y = lay.cells[1].y + 2, x_badged = lay.cells[1].x + 2, x_plain = lay.cells[0].x + 2;
   EXPECT_GT(pixel(x_badged, y), 150);
   EXPECT_LT(greenish(x_badged, y), 80);
   EXPECT_FALSE(pixel(x_plain, y) > 150 && greenish(x_plain, y) < 80);
+  // A wider grid has larger labels, still 8 pt at 7 in.
+  const GridLayout wide = write_grid((dir / "wide.png").string(), "t", {"a"}, std::vector<std::string>(12, "s"),
+                                     {std::vector<std::string>(12, r.png)});
+  EXPECT_GT(wide.label_px, lay.label_px);
+  EXPECT_GE(wide.label_px * kGridPrintWidthIn * 72.0 / wide.width, kGridMinLabelPt - 1e-9);
+  // The captioned form: each image under its own caption, four to a row.
+  const GridLayout cap = write_captioned_grid((dir / "cap.png").string(), "scene", {"a", "b", "c", "d", "e"},
+                                              std::vector<std::string>(5, r.png), {}, {}, 4, 100);
+  ASSERT_EQ(cap.cells.size(), 5u);
+  EXPECT_EQ(cap.cells[4].row, 1);
+  EXPECT_EQ(cap.cells[4].col, 0);
+  EXPECT_EQ(load_png((dir / "cap.png").string()).w, cap.width);
 }
 
 TEST(RenderCli, RunRendersThePlantAndItsGrowthFrames) {
