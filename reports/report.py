@@ -657,7 +657,7 @@ def figure_memory(F):
         if pts:
             axes[1].plot([c.nodes for c in pts], [max(c.alloc_bytes, 1) / 2 ** 20 for c in pts], F.marker[label],
                          color=F.colours[label], label=label)
-    for a, t in zip(axes, ["growth peak RSS (MiB), median over repetitions", "bytes allocated during growth (MiB)"]):
+    for a, t in zip(axes, ["growth peak RSS (MiB)\nmedian over repetitions", "bytes allocated during growth (MiB)"]):
         a.set_xscale("log")
         a.set_yscale("log")
         a.set_xlabel("plant nodes")
@@ -967,6 +967,105 @@ def pareto_figures(F):
 
 # ---------------------------------------------------------------- HTML
 
+def slug(text):
+    """A file name for a trial id: 'ivy-luft/wall/s1' -> 'ivy-luft_wall_s1'."""
+    return re.sub(r"[^A-Za-z0-9._-]+", "_", text).strip("_") or "trial"
+
+
+def copy_grids(doc, base, out, pages):
+    """The grids the results file names, copied beside the page, with their cells' links to trial pages (from
+    IMAGE.map.json beside each image, as percentages of the image so that they scale with it)."""
+    renders = doc.get("renders", {})
+    what = "rendered the same way (POV-Ray, shared materials; the camera frames each plant where the scene's does not)"
+    names = [(p, f"Every algorithm entry (rows) on the scenes of this page (columns), the lowest seed, {what}.", False)
+             for p in renders.get("grid_pages") or []]
+    if not names and renders.get("grid"):
+        names = [(renders["grid"], f"Every algorithm entry (rows) on every scene (columns), the lowest seed, {what}.",
+                  False)]
+    names += [(f, f"{scene}: every algorithm entry", True) for scene, f in renders.get("grid_per_scene", {}).items()]
+    grids = []
+    for name, title, per_scene in names:
+        src = os.path.join(base, name)
+        if not os.path.exists(src):
+            print(f"report: warning: render grid {src} is missing", file=sys.stderr)
+            continue
+        os.makedirs(os.path.join(out, "renders"), exist_ok=True)
+        shutil.copyfile(src, os.path.join(out, "renders", os.path.basename(name)))
+        links = []
+        try:
+            with open(src + ".map.json") as f:
+                m = json.load(f)
+            for c in m.get("cells", []):
+                if c.get("trial") in pages:
+                    links.append((100.0 * c["x"] / m["width"], 100.0 * c["y"] / m["height"], 100.0 * c["w"] / m["width"],
+                                  100.0 * c["h"] / m["height"], pages[c["trial"]], c["trial"]))
+        except (OSError, ValueError, KeyError, TypeError, ZeroDivisionError):
+            pass  # a grid without its map (rendered before maps were written) simply has no links
+        grids.append({"src": "renders/" + os.path.basename(name), "title": title, "links": links,
+                      "per_scene": per_scene})
+    return grids
+
+
+def grid_html(g):
+    e = html.escape
+    cells = "".join(f"<a class='cell' href='{e(href)}' title='{e(tid)}' style='left:{x:.3f}%;top:{y:.3f}%;"
+                    f"width:{w:.3f}%;height:{h:.3f}%'></a>" for x, y, w, h, href, tid in g["links"])
+    return (f"<figure><div class='grid-image'><img src='{e(g['src'])}' alt='{e(g['title'])}'>{cells}</div>"
+            f"<figcaption>{e(g['title'])}</figcaption></figure>")
+
+
+def trial_dir_of(c, base):
+    """The trial's directory in the results directory: where its render (or record) is."""
+    render = c.t.get("render") or {}
+    if render.get("png"):
+        return os.path.dirname(os.path.join(base, render["png"]))
+    d = os.path.join(base, "trials", *c.id().split("/"))
+    return d if os.path.isdir(d) else None
+
+
+def write_trial_pages(cells, base, out):
+    """One page per trial under OUT/trials/: its render, verdict, numbers and files (links into the results
+    directory). Returns {trial id: the page's path relative to OUT}."""
+    e = html.escape
+    pages = {}
+    os.makedirs(os.path.join(out, "trials"), exist_ok=True)
+    for c in cells:
+        name = f"trials/{slug(c.id())}.html"
+        here = os.path.join(out, "trials")
+        rel = lambda p: os.path.relpath(p, here)
+        d = trial_dir_of(c, base)
+        render = c.t.get("render") or {}
+        parts = ["<!DOCTYPE html>", "<html lang='en'><head><meta charset='utf-8'>",
+                 f"<title>growbench trial {e(c.id())}</title><style>{CSS}</style></head><body>",
+                 "<p><a href='../index.html'>Back to the report</a></p>", f"<h1>{e(c.id())}</h1>"]
+        verdict = VERDICT_WORDS.get(c.verdict, c.verdict) if c.verdict else "not judged"
+        parts.append(f"<p>Status: {e(c.status)}. Verdict: {e(verdict)}" +
+                     (f" ({e('; '.join(c.reasons))})" if c.reasons else "") + ".</p>")
+        if render.get("png") and render.get("status") == "ok":
+            png = os.path.join(base, render["png"])
+            shares = ", ".join(f"{label} {render[k]:.3f}" for k, label in
+                               (("visible_share", "plant points visible"), ("plant_pixel_share", "plant pixels"))
+                               if isinstance(render.get(k), (int, float)))
+            parts.append(f"<figure><img src='{e(rel(png))}' alt='render of {e(c.id())}'><figcaption>POV-Ray "
+                         f"{e(str(render.get('quality', '')))}, camera {e(str(render.get('camera', '?')))}"
+                         f"{'; ' + e(shares) if shares else ''}.</figcaption></figure>")
+        rows = [("growth time", growth_time_text(c.growth_summary, c.growth)), ("nodes", f"{c.nodes}")]
+        rows += [(k, "n/a" if v is None else f"{v:.4g}" if isinstance(v, float) else str(v))
+                 for k, v in sorted(c.metrics.items()) if not isinstance(v, (list, dict))]
+        parts.append("<table class='context'>" + "".join(f"<tr><th>{e(k)}</th><td>{e(v)}</td></tr>" for k, v in rows) +
+                     "</table>")
+        if d and os.path.isdir(d):
+            files = sorted(f for f in os.listdir(d) if os.path.isfile(os.path.join(d, f)))
+            parts.append("<h2>Files</h2><ul>" + "".join(
+                f"<li><a href='{e(rel(os.path.join(d, f)))}'>{e(f)}</a> ({fmt_bytes(os.path.getsize(os.path.join(d, f)))})"
+                "</li>" for f in files) + "</ul>")
+        parts.append("</body></html>")
+        with open(os.path.join(out, name), "w") as f:
+            f.write("\n".join(parts) + "\n")
+        pages[c.id()] = name
+    return pages
+
+
 CSS = """
 body { font-family: DejaVu Sans, sans-serif; margin: 2em auto; padding: 0 2em; max-width: 1400px; color: #222; }
 h1 { font-size: 1.5em; } h2 { font-size: 1.2em; border-bottom: 1px solid #ccc; margin-top: 2em; }
@@ -985,6 +1084,8 @@ img { max-width: 100%; border: 1px solid #ddd; }
 .banner p { margin: 0.3em 0; }
 .left-out li { font-size: 0.9em; }
 .wide { overflow-x: auto; } table.results { font-size: 0.8em; } table.results td { white-space: nowrap; }
+.grid-image { position: relative; display: inline-block; max-width: 100%; } .grid-image img { display: block; }
+.grid-image a.cell { position: absolute; } .grid-image a.cell:hover { outline: 3px solid #2a6fdb; }
 """
 
 # Marks any image that did not load, and records the count on <body> (a headless browser test reads it).
@@ -1073,14 +1174,16 @@ def write_html(path, doc, results_path, rows, figs, grids, failed, caption, metr
 
     parts.append("<h2>Renders</h2>")
     if grids:
-        # The full grid, then one row per scene (larger cells side by side), folded away.
-        src, title = grids[0]
-        parts.append(f"<figure><img src='{e(src)}' alt='{e(title)}'><figcaption>{e(title)}</figcaption></figure>")
-        if len(grids) > 1:
+        # The grid's pages, then each scene's entries side by side, folded away; every cell links to its trial.
+        main = [g for g in grids if not g["per_scene"]]
+        per_scene = [g for g in grids if g["per_scene"]]
+        parts += [grid_html(g) for g in main]
+        if per_scene:
             parts.append("<details><summary>Per scene</summary>")
-            for src, title in grids[1:]:
-                parts.append(f"<figure><img src='{e(src)}' alt='{e(title)}'><figcaption>{e(title)}</figcaption></figure>")
+            parts += [grid_html(g) for g in per_scene]
             parts.append("</details>")
+        parts.append("<p class='note'>Click a cell for its trial's page: the render, its numbers, its record and "
+                     "files.</p>")
     else:
         parts.append("<p class='note'>No renders in this results file: run <code>growbench render DIR</code> on the "
                      "results directory, then the report again.</p>")
@@ -1266,22 +1369,9 @@ def write_report(doc, results_path, out, formats, peers_path=None, pareto_metric
                            ordered(c.row for c in cells), ordered(c.scene for c in cells), QUALITY, notes)
     write_markdown(os.path.join(out, "table.md"), rows, CAPTION, notes)
 
-    # Renders: the grids named in the results file, copied beside the page so it stands alone.
-    grids = []
-    renders = doc.get("renders", {})
     base = os.path.dirname(os.path.abspath(results_path))
-    names = ([(renders["grid"], "Every algorithm entry (rows) on every scene (columns), the lowest seed, rendered "
-                                "the same way (POV-Ray, shared materials, the scene's camera and light).")]
-             if renders.get("grid") else []) + \
-            [(f, f"{scene}: every algorithm entry") for scene, f in renders.get("grid_per_scene", {}).items()]
-    for name, title in names:
-        src = os.path.join(base, name)
-        if os.path.exists(src):
-            os.makedirs(os.path.join(out, "renders"), exist_ok=True)
-            shutil.copyfile(src, os.path.join(out, "renders", os.path.basename(name)))
-            grids.append(("renders/" + os.path.basename(name), title))
-        else:
-            print(f"report: warning: render grid {src} is missing", file=sys.stderr)
+    pages = write_trial_pages(cells, base, out)
+    grids = copy_grids(doc, base, out, pages)
     failed = [c for c in cells if not c.ok]
     peers_path = peers_path or os.path.join(base, "peers.json")
     peers = peers_html(load_peers(peers_path), peers_path, out, formats) if os.path.exists(peers_path) else []

@@ -2,6 +2,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -14,7 +15,7 @@ namespace growbench::cli {
 namespace {
 
 struct ReportArgs {
-  std::string results, out;
+  std::string results, out, pareto_metric;
 };
 
 Outcome report(ReportArgs& a) {
@@ -22,7 +23,9 @@ Outcome report(ReportArgs& a) {
   // Read first as the typed record: a file that does not fit is refused here with its JSON path, before
   // Python starts.
   (void)read_results(a.results);
-  return script_status(run_report(a.results, a.out, {}), "reports/report.py");
+  std::vector<std::string> extra;
+  if (!a.pareto_metric.empty()) extra = {"--pareto-metric", a.pareto_metric};
+  return script_status(run_report(a.results, a.out, extra), "reports/report.py");
 }
 
 }  // namespace
@@ -33,6 +36,9 @@ Command add_report(CLI::App& app) {
   auto a = std::make_shared<ReportArgs>();
   cmd->add_option("results", a->results, "results.json written by `growbench suite`")->required();
   cmd->add_option("-o,--out", a->out, "report directory (default: report/ beside the results file)");
+  cmd->add_option("--pareto-metric", a->pareto_metric,
+                  "the quality metric of the quality-against-cost figures (one per scene of a suite with sweeps; "
+                  "default coverage): any metric of the results file, e.g. attached_fraction, leaf_light_exposure");
   return {cmd, [a] { return report(*a); }};
 }
 

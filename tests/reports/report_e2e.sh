@@ -37,6 +37,14 @@ grep -q '\\toprule' "$work/report/table.tex" || fail "table.tex is not booktabs"
 grep -q "href='metrics.html'" "$work/report/index.html" || fail "index.html does not link metrics.html"
 grep -q '<h2>penetration_nodes, penetration_samples</h2>' "$work/report/metrics.html" || fail "metrics.html is not docs/metrics.md"
 grep -q 'http' "$work/report/index.html" && fail "index.html refers to the network"
+# Each grid cell links to its trial's page, whose render resolves from where the page is.
+links=$(grep -o "class='cell' href='trials/[^']*'" "$work/report/index.html" | wc -l)
+(( links >= 8 )) || fail "only $links grid cells link to trial pages"
+page=$(grep -o "class='cell' href='trials/[^']*'" "$work/report/index.html" | head -1 | sed "s/.*href='//; s/'$//")
+[[ -f "$work/report/$page" ]] || fail "the grid links $page, which is not there"
+img=$(grep -o "<img src='[^']*'" "$work/report/$page" | head -1 | sed "s/<img src='//; s/'$//")
+[[ -n "$img" && -f "$(dirname "$work/report/$page")/$img" ]] || fail "the trial page's render '$img' does not resolve"
+grep -q "record.json" "$work/report/$page" || fail "the trial page does not link its record"
 
 browser=$(command -v chromium || command -v chromium-browser || true)
 [[ -n "$browser" ]] || fail "chromium is not installed (scripts/install-deps installs it)"

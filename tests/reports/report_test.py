@@ -381,7 +381,7 @@ class Memory(unittest.TestCase):
         with tempfile.TemporaryDirectory() as d, Drawn() as drawn:
             report.figures(cells, d, ["png"])
         mem = [(a, ax) for n, ax, a, _ in drawn.calls
-               if n == "plot" and ax.get_ylabel() == "growth peak RSS (MiB), median over repetitions"]
+               if n == "plot" and ax.get_ylabel() == "growth peak RSS (MiB)\nmedian over repetitions"]
         self.assertEqual(len(mem), 1)
         self.assertEqual(list(mem[0][0][1]), [21.0])
 
