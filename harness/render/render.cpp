@@ -233,11 +233,11 @@ void write_mask_materials(Out out) {
   fmt::format_to(out,
                  "#ifdef (GB_Mask)\n"
                  "  #declare GB_Glow = finish {{ emission 1 diffuse 0 ambient 0 specular 0 }}\n"
-                 "  #declare GB_Bark = texture {{ pigment {{ rgb 1 }} finish {{ GB_Glow }} }}\n"
+                 "  #declare GB_Bark = texture {{ pigment {{ srgb 1 }} finish {{ GB_Glow }} }}\n"
                  "  #declare GB_Leaf = GB_Bark #declare GB_YoungLeaf = GB_Bark\n"
                  "  #declare GB_Flower = GB_Bark #declare GB_Bud = GB_Bark #declare GB_OrganFinish = GB_Glow\n"
                  "  #declare GB_DecalFinish = GB_Glow\n"
-                 "  #declare GB_Surface = texture {{ pigment {{ rgb 0 }} finish {{ emission 0 diffuse 0 ambient 0 "
+                 "  #declare GB_Surface = texture {{ pigment {{ srgb 0 }} finish {{ emission 0 diffuse 0 ambient 0 "
                  "specular 0 }} }}\n"
                  "  #declare GB_Ground = GB_Surface #declare GB_Studio = GB_Surface\n"
                  "  background {{ rgb 0 }}\n"
