@@ -14,7 +14,7 @@ install(TARGETS growbench RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT 
 # docs/metrics.md relative to itself, and the binary (core/data_path.hpp) reads from here once the
 # checkout it was built from is gone.
 set(GROWBENCH_INSTALL_DATADIR ${CMAKE_INSTALL_DATADIR}/growbench)
-install(FILES reports/report.py reports/history.py DESTINATION ${GROWBENCH_INSTALL_DATADIR}/reports COMPONENT runtime)
+install(FILES reports/report.py reports/paper_tables.py reports/history.py DESTINATION ${GROWBENCH_INSTALL_DATADIR}/reports COMPONENT runtime)
 install(FILES harness/record/results.schema.json DESTINATION ${GROWBENCH_INSTALL_DATADIR}/harness/record
         COMPONENT runtime)
 install(FILES docs/metrics.md DESTINATION ${GROWBENCH_INSTALL_DATADIR}/docs COMPONENT runtime)
