@@ -1191,6 +1191,15 @@ void draw_cell(cairo_t* c, const std::string& image, const std::string& note, co
   draw_missing(c, note.empty() ? "no render" : note, x0, y0, w, h, px);
 }
 
+// A grid's blank page: white, the labels' font and colour, and the title centred in its band.
+void start_grid(cairo_t* c, const GridLayout& g, const std::string& title, int title_h) {
+  cairo_set_source_rgb(c, 1, 1, 1);
+  cairo_paint(c);
+  cairo_select_font_face(c, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
+  cairo_set_source_rgb(c, 0.1, 0.1, 0.1);
+  if (!title.empty()) centred_text(c, title, g.width / 2.0, title_h / 2.0, 1.2 * g.label_px, g.width - 20);
+}
+
 }  // namespace
 
 GridLayout write_grid(const std::string& png_path, const std::string& title, const std::vector<std::string>& row_labels,
@@ -1222,11 +1231,7 @@ GridLayout write_grid(const std::string& png_path, const std::string& title, con
   Surface surface(cairo_image_surface_create(CAIRO_FORMAT_RGB24, g.width, g.height), &cairo_surface_destroy);
   Context cr(cairo_create(surface.get()), &cairo_destroy);
   cairo_t* c = cr.get();
-  cairo_set_source_rgb(c, 1, 1, 1);
-  cairo_paint(c);
-  cairo_select_font_face(c, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
-  cairo_set_source_rgb(c, 0.1, 0.1, 0.1);
-  if (!title.empty()) centred_text(c, title, g.width / 2.0, title_h / 2.0, 1.2 * px, g.width - 20);
+  start_grid(c, g, title, title_h);
   for (int j = 0; j < cols; ++j)
     centred_text(c, col_labels[static_cast<std::size_t>(j)], label_w + pad + j * (cw + pad) + cw / 2.0,
                  title_h + header_h / 2.0, px, cw - 8);
@@ -1262,11 +1267,7 @@ GridLayout write_captioned_grid(const std::string& png_path, const std::string& 
   Surface surface(cairo_image_surface_create(CAIRO_FORMAT_RGB24, g.width, g.height), &cairo_surface_destroy);
   Context cr(cairo_create(surface.get()), &cairo_destroy);
   cairo_t* c = cr.get();
-  cairo_set_source_rgb(c, 1, 1, 1);
-  cairo_paint(c);
-  cairo_select_font_face(c, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
-  cairo_set_source_rgb(c, 0.1, 0.1, 0.1);
-  if (!title.empty()) centred_text(c, title, g.width / 2.0, title_h / 2.0, 1.2 * px, g.width - 20);
+  start_grid(c, g, title, title_h);
   auto item = [](const std::vector<std::string>& v, int k) {
     return static_cast<std::size_t>(k) < v.size() ? v[static_cast<std::size_t>(k)] : std::string();
   };
