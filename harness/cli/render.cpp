@@ -55,6 +55,11 @@ Command add_render(CLI::App& app) {
                   "(the mesher's tubes as mesh2)")
       ->default_val("cones")
       ->check(CLI::IsMember({"cones", "mesh"}));
+  cmd->add_option("--min-branch-px", ro.min_branch_px,
+                  "draw cone branches at least this many pixels wide on screen, so that thin stems stay visible "
+                  "(0: true widths)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0f, 64.0f));
   add_render_flags(cmd, a->flags);
   cmd->add_flag("-q,--quiet", a->options.quiet, "no progress lines");
   return {cmd, [a] { return render_dir(*a); }};

@@ -264,6 +264,8 @@ struct RenderRecord {
   // (ray casts against the scene meshes); the share of the image's pixels that show the plant.
   std::optional<double> in_frame_share, visible_share, plant_pixel_share;
   std::optional<bool> dof;
+  // The least width on screen, in pixels, branches were drawn with (RenderOptions::min_branch_px).
+  std::optional<double> min_branch_px;
 
   static constexpr std::string_view kSchemaName = "render";
   static constexpr auto fields() {
@@ -289,7 +291,8 @@ struct RenderRecord {
                       field("visible_share", &R::visible_share).in(0, 1),
                       field("plant_pixel_share", &R::plant_pixel_share).in(0, 1),
                       field("backdrop", &R::backdrop).one_of(kBackdrops),
-                      field("dof", &R::dof)};
+                      field("dof", &R::dof),
+                      field("min_branch_px", &R::min_branch_px).in(0, kNoBound)};
   }
 };
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -170,6 +171,39 @@ Camera turned_fit(const Camera& scene_camera, float aspect, const std::vector<gl
 
 }  // namespace
 
+namespace {
+
+// The ring: the scene camera's side first, then turns either way, then the same from higher up.
+constexpr float kTurns[] = {0, 30, -30, 60, -60, 90, -90, 135, -135, 180};
+constexpr float kRaises[] = {0, 25, 50};
+
+// Ring candidate `k` (raise-major), or nothing when it stands under the ground.
+std::optional<RenderCamera> ring_camera(const Camera& scene_camera, float aspect, const std::vector<glm::vec3>& plant,
+                                        const Aabb& scene_bounds, const SightBlocked& blocked, std::size_t k) {
+  Aabb box;
+  for (const glm::vec3& p : plant) box.extend(p);
+  const float context = 0.5f * kContextShare * (scene_bounds.empty() ? 0.0f : glm::length(scene_bounds.size()));
+  const float turn = kTurns[k % std::size(kTurns)], raise = kRaises[k / std::size(kTurns)];
+  const Camera c =
+      turned_fit(scene_camera, aspect, plant, box.center(), context, glm::radians(turn), glm::radians(raise));
+  if (!scene_bounds.empty() && c.position.y < scene_bounds.min.y) return std::nullopt;
+  return RenderCamera{c,    true, projected_extent(scene_camera, aspect, box), sight(c, aspect, plant, blocked),
+                      turn, raise};
+}
+
+constexpr std::size_t kRingSize = std::size(kTurns) * std::size(kRaises);
+
+}  // namespace
+
+std::vector<RenderCamera> camera_ring(const Camera& scene_camera, float aspect, const std::vector<glm::vec3>& plant,
+                                      const Aabb& scene_bounds, const SightBlocked& blocked) {
+  std::vector<RenderCamera> out;
+  if (plant.empty()) return out;
+  for (std::size_t k = 0; k < kRingSize; ++k)
+    if (auto c = ring_camera(scene_camera, aspect, plant, scene_bounds, blocked, k)) out.push_back(*c);
+  return out;
+}
+
 RenderCamera choose_camera(const Camera& scene_camera, float aspect, const std::vector<glm::vec3>& plant,
                            const Aabb& scene_bounds, CameraMode mode, const SightBlocked& blocked) {
   Aabb box;
@@ -178,22 +212,15 @@ RenderCamera choose_camera(const Camera& scene_camera, float aspect, const std::
                   sight(scene_camera, aspect, plant, blocked)};
   if (mode == CameraMode::Scene || plant.empty()) return rc;
   if (rc.seen.in_frame >= 1.0f && rc.seen.visible >= kVisibleEnough && rc.scene_extent >= kSmallPlantExtent) return rc;
-  const float context = 0.5f * kContextShare * (scene_bounds.empty() ? 0.0f : glm::length(scene_bounds.size()));
-  const float floor_y = scene_bounds.empty() ? -INFINITY : scene_bounds.min.y;
-  // The ring: the scene camera's side first, then turns either way, then the same from higher up.
-  constexpr float kTurns[] = {0, 30, -30, 60, -60, 90, -90, 135, -135, 180};
-  constexpr float kRaises[] = {0, 25, 50};
   RenderCamera best = rc;
   best.seen.visible = -1.0f;
-  for (const float raise : kRaises)
-    for (const float turn : kTurns) {
-      const Camera c =
-          turned_fit(scene_camera, aspect, plant, box.center(), context, glm::radians(turn), glm::radians(raise));
-      if (c.position.y < floor_y) continue;  // under the ground
-      const Sight s = sight(c, aspect, plant, blocked);
-      if (s.visible > best.seen.visible) best = {c, true, rc.scene_extent, s, turn, raise};
-      if (s.visible >= kVisibleEnough) return best;
-    }
+  // Candidates one at a time: the first that sees enough ends the search.
+  for (std::size_t k = 0; k < kRingSize; ++k) {
+    const auto c = ring_camera(scene_camera, aspect, plant, scene_bounds, blocked, k);
+    if (!c) continue;
+    if (c->seen.visible > best.seen.visible) best = *c;
+    if (c->seen.visible >= kVisibleEnough) return best;
+  }
   return best.seen.visible < 0.0f ? rc : best;  // every candidate under the ground: the scene's
 }
 

@@ -90,6 +90,10 @@ struct RenderCamera {
 // the plant and rises above it that sees kVisibleEnough, else the one that sees most. `scene` always keeps
 // the scene camera; no points keep it too.
 constexpr float kSmallPlantExtent = 0.65f, kVisibleEnough = 0.9f, kContextShare = 0.05f;
+// The ring choose_camera searches, in its order, each fitted as it fits them and with what it sees of the
+// plant; candidates under the scene's ground are left out. Empty for no points.
+std::vector<RenderCamera> camera_ring(const Camera& scene_camera, float aspect, const std::vector<glm::vec3>& plant,
+                                      const Aabb& scene_bounds, const SightBlocked& blocked = {});
 RenderCamera choose_camera(const Camera& scene_camera, float aspect, const std::vector<glm::vec3>& plant,
                            const Aabb& scene_bounds, CameraMode mode, const SightBlocked& blocked = {});
 

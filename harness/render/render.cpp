@@ -14,7 +14,10 @@
 #include <fstream>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <sstream>
+#include <tuple>
+#include <utility>
 
 #include <cairo.h>
 #include <fmt/format.h>
@@ -512,10 +515,22 @@ void write_studio(Out out, const Camera& camera, float aspect, const Aabb& conte
   fmt::format_to(out, "  texture {{ GB_Studio }}\n}}\n");
 }
 
-// Branches as cones between each node and its parent, with a sphere at each joint and tip. A plant with
-// the attribute Cd (the L-system's a("Cd", r, g, b), linear RGB) colours each cone and sphere by its node
-// (a segment by its child, as its tube is): the bark texture with that pigment.
-void write_cones(Out out, const Plant& plant) {
+// The least radius a branch at `p` is drawn with: `px` pixels across at its depth before `camera`.
+using RadiusFloor = std::function<float(const glm::vec3& p)>;
+RadiusFloor pixel_radius_floor(const Camera& camera, int height_px, float px) {
+  const CameraFrame f = camera_frame(camera);
+  // A pixel at depth z is 2 z tan(fov / 2) / height high.
+  const float per_depth = px * std::tan(0.5f * glm::radians(camera.fov_deg)) / static_cast<float>(height_px);
+  return [f, eye = camera.position, per_depth](const glm::vec3& p) {
+    return std::max(glm::dot(p - eye, f.forward), 0.0f) * per_depth;
+  };
+}
+
+// Branches as cones between each node and its parent, with a sphere at each joint and tip, none narrower
+// than `floor` gives. A plant with the attribute Cd (the L-system's a("Cd", r, g, b), linear RGB) colours
+// each cone and sphere by its node (a segment by its child, as its tube is): the bark texture with that
+// pigment.
+void write_cones(Out out, const Plant& plant, const RadiusFloor& floor) {
   std::vector<std::uint8_t> has_child(plant.nodes.size(), 0);
   for (const auto& n : plant.nodes)
     if (n.parent != kNoParent) has_child[static_cast<std::size_t>(n.parent)] = 1;
@@ -536,7 +551,7 @@ void write_cones(Out out, const Plant& plant) {
           std::size_t count = 0;
           for (std::size_t i = 0; i < plant.nodes.size(); ++i) {
             const PlantNode& n = plant.nodes[i];
-            const float r = std::max(n.radius, kMinRadius);
+            const float r = std::max({n.radius, kMinRadius, floor(n.position)});
             if (n.parent != kNoParent) {
               const PlantNode& p = plant.nodes[static_cast<std::size_t>(n.parent)];
               if (glm::length(n.position - p.position) > 1e-5f) {
@@ -544,7 +559,7 @@ void write_cones(Out out, const Plant& plant) {
                 vec(o2, pov(p.position));
                 // A lateral branch starts with its own radius, as the mesher's tubes do, not its parent's.
                 const float base = n.shoot != p.shoot ? std::min(p.radius, n.radius) : p.radius;
-                fmt::format_to(o2, ",{:.5g},", std::max(base, kMinRadius));
+                fmt::format_to(o2, ",{:.5g},", std::max({base, kMinRadius, floor(p.position)}));
                 vec(o2, pov(n.position));
                 fmt::format_to(o2, ",{:.5g}", r);
                 texture(o2, i);
@@ -567,7 +582,7 @@ void write_cones(Out out, const Plant& plant) {
 }
 
 // Branches as RenderOptions::branches asks: cone chains, or the mesher's tubes as one mesh2.
-void write_branches(Out out, const Plant& plant, const RenderOptions& o) {
+void write_branches(Out out, const Plant& plant, const RenderOptions& o, const Camera& camera) {
   if (o.branches == "mesh") {
     Plant branches;  // the tubes alone, with the cross sections and divisions F(l,w,s,d) gave them
     branches.nodes = plant.nodes;
@@ -580,7 +595,7 @@ void write_branches(Out out, const Plant& plant, const RenderOptions& o) {
       fmt::format_to(out, "  texture {{ GB_Bark }}\n}}\n");
     }
   } else if (o.branches == "cones") {
-    write_cones(out, plant);
+    write_cones(out, plant, pixel_radius_floor(camera, render_height(o), o.min_branch_px));
   } else {
     throw InputError(fmt::format("render branches '{}': expected cones or mesh", o.branches));
   }
@@ -728,7 +743,7 @@ std::uint64_t write_pov_view(const std::string& path, const Scene& scene, const 
   // A plant with decals is drawn by them (CONTRIBUTING.md, Rendering): its branches, organs and polygons
   // are not drawn again on top.
   if (o.draw_plant && !decals) {
-    write_branches(out, plant, o);
+    write_branches(out, plant, o, view.camera);
     write_organs(out, plant, o.mesher);
     write_polygons(out, plant);
   }
@@ -755,8 +770,19 @@ namespace {
 
 // The view's occlusion test: a ray from the eye to the point against the scene's meshes (Embree alone, no
 // distance field), stopped 1% short so that a point on a surface is not hidden by that surface.
-SightBlocked scene_sight(const std::shared_ptr<SceneQuery>& query) {
+SightBlocked scene_sight(const Scene& scene) {
+  SceneQueryOptions qo;
+  qo.build_sdf = false;
+  auto query = std::make_shared<SceneQuery>(scene, qo);
   return [query](const glm::vec3& eye, const glm::vec3& p) { return query->occluded(eye, p - eye, 0.99f); };
+}
+
+void take_camera(RenderView& v, const RenderCamera& rc) {
+  v.camera = rc.camera;
+  v.fitted = rc.fitted;
+  v.seen = rc.seen;
+  v.turn_deg = rc.turn_deg;
+  v.raise_deg = rc.raise_deg;
 }
 
 }  // namespace
@@ -777,19 +803,25 @@ RenderView render_view(const Scene& scene, const Plant& plant, const RenderOptio
   } else {
     // The plant's own points, or the subject's corners when the caller fixed the subject (a growth frame).
     const std::vector<glm::vec3> points = o.subject.empty() ? plant_points(scene, plant) : corners(v.subject);
-    SceneQueryOptions qo;
-    qo.build_sdf = false;
-    const auto query = std::make_shared<SceneQuery>(scene, qo);
-    const RenderCamera rc = choose_camera(scene.camera, aspect, points, scene.bounds(), o.camera, scene_sight(query));
-    v.camera = rc.camera;
-    v.fitted = rc.fitted;
-    v.seen = rc.seen;
-    v.turn_deg = rc.turn_deg;
-    v.raise_deg = rc.raise_deg;
+    take_camera(v, choose_camera(scene.camera, aspect, points, scene.bounds(), o.camera, scene_sight(scene)));
   }
   v.scene_extent = projected_extent(scene.camera, aspect, v.subject);
   v.extent = projected_extent(v.camera, aspect, v.subject);
   return v;
+}
+
+std::vector<RenderView> ring_views(const Scene& scene, const Plant& plant, const RenderOptions& o) {
+  const float aspect = aspect_of(o);
+  const RenderView base = render_view(scene, plant, o);
+  std::vector<RenderView> out;
+  for (const RenderCamera& rc :
+       camera_ring(scene.camera, aspect, plant_points(scene, plant), scene.bounds(), scene_sight(scene))) {
+    RenderView v = base;
+    take_camera(v, rc);
+    v.extent = projected_extent(v.camera, aspect, v.subject);
+    out.push_back(v);
+  }
+  return out;
 }
 
 std::uint64_t write_pov(const std::string& path, const Scene& scene, const Plant& plant, const RenderOptions& o) {
@@ -1025,6 +1057,41 @@ std::string decal_render_problem(const Scene& scene, const Plant& plant, const f
   return "";
 }
 
+// The ring view (ring_views) whose small mask render shows the plant on the most pixels, with that share,
+// when it is clearly more than `share`; each probe's .pov, mask and log are removed after.
+std::optional<std::pair<RenderView, double>> view_showing_most(const Scene& scene, const Plant& plant,
+                                                               const std::string& pov_path, const std::string& png_path,
+                                                               const RenderOptions& o, const std::string& work_dir,
+                                                               double share) {
+  const fs::path probe_pov = fs::path(pov_path).replace_extension(".probe.pov");
+  const std::string probe_png = fs::path(png_path).replace_extension(".probe.png").string();
+  std::optional<std::pair<RenderView, double>> best;
+  double most = share * 1.25;  // a probe within noise of the first camera does not replace it
+  for (const RenderView& v : ring_views(scene, plant, o)) {
+    write_pov_view(probe_pov.string(), scene, plant, o, v);
+    const double s = plant_pixel_share(probe_pov.string(), probe_png, o, work_dir);
+    if (s > most) {
+      most = s;
+      best = {v, s};
+    }
+  }
+  std::error_code ec;
+  fs::remove(probe_pov, ec);
+  return best;
+}
+
+RenderResult failed_render(const std::string& pov_path, const std::string& png_path, const RenderOptions& o,
+                           std::string message) {
+  RenderResult r;
+  r.status = "failed";
+  r.message = std::move(message);
+  r.pov = pov_path;
+  r.png = png_path;
+  r.width = render_width(o);
+  r.height = render_height(o);
+  return r;
+}
+
 }  // namespace
 
 RenderResult render_plant(const Scene& scene, const Plant& plant, const std::string& pov_path,
@@ -1035,39 +1102,38 @@ RenderResult render_plant(const Scene& scene, const Plant& plant, const std::str
   if (const std::string bad = decal_render_problem(scene, plant, dir, o); !bad.empty()) {
     std::error_code ec;
     fs::remove(png_path, ec);  // an earlier render's image would pass for this one's
-    RenderResult r;
-    r.status = "failed";
-    r.message = fmt::format("cannot render {}: {}", png_path, bad);
-    r.pov = pov_path;
-    r.png = png_path;
-    r.width = render_width(o);
-    r.height = render_height(o);
-    return r;
+    return failed_render(pov_path, png_path, o, fmt::format("cannot render {}: {}", png_path, bad));
   }
   const auto t0 = std::chrono::steady_clock::now();
   std::uint64_t bytes = 0;
-  const RenderView view = render_view(scene, plant, o);
+  double write_s = 0.0;  // the first view's file; probing other views is the mask's cost, not the writer's
+  RenderView view = render_view(scene, plant, o);
+  // The mask goes first: a plant on too few pixels is looked at from the ring's cameras before the
+  // (possibly long) render of the image.
+  double share = -1.0;
   try {
     bytes = write_pov_view(pov_path, scene, plant, o, view);
+    write_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (o.draw_plant && o.turns == 0 && o.subject.empty()) {
+      share = plant_pixel_share(pov_path, png_path, o, work_dir);
+      if (share >= 0.0 && share < kFewPlantPixels && o.camera == CameraMode::Auto)
+        if (auto better = view_showing_most(scene, plant, pov_path, png_path, o, work_dir, share)) {
+          std::tie(view, share) = *better;
+          bytes = write_pov_view(pov_path, scene, plant, o, view);
+        }
+    }
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {
-    RenderResult r;
-    r.status = "failed";
-    r.message = fmt::format("cannot write {}: {}", pov_path, e.what());
-    r.pov = pov_path;
-    r.png = png_path;
-    return r;
+    return failed_render(pov_path, png_path, o, fmt::format("cannot write {}: {}", pov_path, e.what()));
   }
-  const double write_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   RenderResult r = run_povray(pov_path, png_path, o, work_dir);
   r.pov_bytes = bytes;
   r.write_s = write_s;
   r.camera = view.fitted ? "fitted" : "scene";
   r.scene_extent = view.scene_extent;
   r.seen = view.seen;
-  if (r.ok() && o.draw_plant && o.turns == 0 && o.subject.empty())
-    r.plant_pixel_share = plant_pixel_share(pov_path, png_path, o, work_dir);
+  if (r.ok()) r.plant_pixel_share = share;
   return r;
 }
 

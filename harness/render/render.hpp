@@ -45,6 +45,10 @@ struct RenderOptions {
   // "mesh": the shared mesher's tubes as one mesh2. Cones are the default: see CONTRIBUTING.md for the
   // measured render times.
   std::string branches = "cones";
+  // Branches narrower on screen than this many pixels are drawn this wide (branches=cones), so that a thin
+  // stem far from the camera stays in the picture rather than falling between pixels, as production
+  // renderers' minimum pixel width for curves does; 0 draws true widths.
+  float min_branch_px = 1.0f;
   bool draw_plant = true;  // false: the scene alone (the tests compare renders with and without the plant)
   double timeout_s = 900.0;
   MesherOptions mesher;                  // tube sides (branches=mesh) and the leaf shape
@@ -88,6 +92,11 @@ struct RenderView {
   [[nodiscard]] std::string describe() const;  // a line for the .pov file's header
 };
 RenderView render_view(const Scene& scene, const Plant& plant, const RenderOptions& options);
+// render_view with each of camera.hpp's camera_ring cameras in turn (auto mode's candidates).
+std::vector<RenderView> ring_views(const Scene& scene, const Plant& plant, const RenderOptions& options);
+// An auto-camera render whose plant shows on fewer of its pixels than this tries every ring camera as a
+// small mask render and keeps the one that shows the plant on the most pixels (render_plant).
+constexpr double kFewPlantPixels = 0.01;
 
 // Writes a POV-Ray 3.7 scene file (`#version 3.7`, `assumed_gamma 1.0`): the scene's meshes as mesh2,
 // the plant's branches, its leaves and flowers instanced from one declared mesh each, render_view's

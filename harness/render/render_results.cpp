@@ -295,6 +295,7 @@ RenderRecord render_record(const Job& j, const RenderOptions& ro, const fs::path
   rr.cpu_s = r.cpu_s;
   rr.quality = to_string(ro.quality);
   rr.branches = ro.branches;
+  if (ro.branches == "cones") rr.min_branch_px = ro.min_branch_px;
   rr.threads = ro.threads;
   if (!r.camera.empty()) {
     rr.camera = r.camera;

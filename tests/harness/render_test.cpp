@@ -633,6 +633,80 @@ TEST(PovRender, ThePlantsPixelShareIsMeasuredByAMask) {
   EXPECT_NEAR(r.to_json().at("plant_pixel_share").get<double>(), r.plant_pixel_share, 1e-12);
 }
 
+// A thin plant lying flat on the ground, seen edge-on from the scene camera's height: a zig-zag of
+// segments a few millimetres thick across the floor in front of the wall.
+Plant flat_plant() {
+  Plant p;
+  int prev = kNoParent;
+  for (int i = 0; i <= 12; ++i) {
+    PlantNode n;
+    n.position = {i % 2 == 0 ? -0.8f : 0.8f, 0.005f, 0.2f + 0.1f * static_cast<float>(i)};
+    n.radius = 0.004f;
+    n.parent = prev;
+    p.nodes.push_back(n);
+    prev = static_cast<int>(p.nodes.size()) - 1;
+  }
+  return p;
+}
+
+TEST(PovRender, APlantOnFewPixelsIsLookedAtFromTheRingCameraShowingMostOfIt) {
+  ASSERT_FALSE(find_povray().empty()) << "povray is not installed (scripts/install-deps installs it)";
+  const auto dir = test::temp_dir("render_few_pixels");
+  Scene scene = tiny_scene();
+  scene.camera = {{0.0f, 0.005f, 4.0f}, {0.0f, 0.005f, 0.0f}, 45.0f};  // level with the plant: edge-on
+  RenderOptions o;
+  o.width = 160;
+  o.height = 120;
+  o.min_branch_px = 0.0f;
+  const Plant plant = flat_plant();
+  // The rule's first choice: the first ring camera, level with the plant, which sees all its points but
+  // next to none of its pixels.
+  const std::vector<RenderView> ring = ring_views(scene, plant, o);
+  ASSERT_FALSE(ring.empty());
+  EXPECT_EQ(ring.front().raise_deg, 0.0f);
+  EXPECT_EQ(render_view(scene, plant, o).raise_deg, 0.0f);
+  const RenderResult r = render_plant(scene, plant, (dir / "a.pov").string(), (dir / "a.png").string(), o);
+  ASSERT_TRUE(r.ok()) << r.message;
+  EXPECT_GE(r.plant_pixel_share, kFewPlantPixels);
+  const std::string pov = read_file(dir / "a.pov");
+  EXPECT_NE(pov.find("raised 50 deg"), std::string::npos) << "the view from highest above shows the flat plant best";
+  // The probes leave nothing behind.
+  for (const char* f : {"a.probe.pov", "a.probe.mask.png", "a.probe.mask.png.log", "a.mask.png"})
+    EXPECT_FALSE(std::filesystem::exists(dir / f)) << f;
+  // The scene camera is never second-guessed.
+  o.camera = CameraMode::Scene;
+  const RenderResult kept = render_plant(scene, plant, (dir / "b.pov").string(), (dir / "b.png").string(), o);
+  ASSERT_TRUE(kept.ok()) << kept.message;
+  EXPECT_LT(kept.plant_pixel_share, kFewPlantPixels);
+  EXPECT_EQ(kept.camera, "scene");
+}
+
+TEST(PovWriter, ThinBranchesAreDrawnAtLeastTheLeastPixelWidth) {
+  const auto dir = test::temp_dir("pov_min_px");
+  Plant p;
+  for (int i = 0; i < 2; ++i) {
+    PlantNode n;
+    n.position = {0.0f, 1.0f + 0.5f * static_cast<float>(i), 0.2f};  // 3.8 m in front of the camera
+    n.radius = 1e-4f;
+    n.parent = i == 0 ? kNoParent : 0;
+    p.nodes.push_back(n);
+  }
+  RenderOptions o;
+  o.camera = CameraMode::Scene;
+  o.width = 480;
+  o.height = 360;
+  o.min_branch_px = 2.0f;
+  write_pov((dir / "a.pov").string(), tiny_scene(), p, o);
+  // Two pixels across at depth 3.8 under a 45 degree vertical field over 360 rows: a radius of
+  // 3.8 tan(22.5 deg) / 180 = 0.0087445.
+  const std::string wide = read_file(dir / "a.pov");
+  EXPECT_NE(wide.find(",0.0087445,<0,1.5,-0.2>,0.0087445"), std::string::npos) << wide.substr(wide.find("cone {"), 80);
+  o.min_branch_px = 0.0f;
+  write_pov((dir / "b.pov").string(), tiny_scene(), p, o);
+  const std::string thin = read_file(dir / "b.pov");
+  EXPECT_NE(thin.find(",0.0001,<0,1.5,-0.2>,0.0001"), std::string::npos) << thin.substr(thin.find("cone {"), 80);
+}
+
 TEST(PovWriter, WritesEveryPartInPovRayHandedness) {
   const auto dir = test::temp_dir("pov");
   const Plant p = tiny_plant();
