@@ -810,9 +810,9 @@ RenderView render_view(const Scene& scene, const Plant& plant, const RenderOptio
   return v;
 }
 
-std::vector<RenderView> ring_views(const Scene& scene, const Plant& plant, const RenderOptions& o) {
+std::vector<RenderView> ring_views(const Scene& scene, const Plant& plant, const RenderOptions& o,
+                                   const RenderView& base) {
   const float aspect = aspect_of(o);
-  const RenderView base = render_view(scene, plant, o);
   std::vector<RenderView> out;
   for (const RenderCamera& rc :
        camera_ring(scene.camera, aspect, plant_points(scene, plant), scene.bounds(), scene_sight(scene))) {
@@ -1058,16 +1058,16 @@ std::string decal_render_problem(const Scene& scene, const Plant& plant, const f
 }
 
 // The ring view (ring_views) whose small mask render shows the plant on the most pixels, with that share,
-// when it is clearly more than `share`; each probe's .pov, mask and log are removed after.
+// when it is clearly more than `share` (`first`'s); each probe's .pov, mask and log are removed after.
 std::optional<std::pair<RenderView, double>> view_showing_most(const Scene& scene, const Plant& plant,
                                                                const std::string& pov_path, const std::string& png_path,
                                                                const RenderOptions& o, const std::string& work_dir,
-                                                               double share) {
+                                                               const RenderView& first, double share) {
   const fs::path probe_pov = fs::path(pov_path).replace_extension(".probe.pov");
   const std::string probe_png = fs::path(png_path).replace_extension(".probe.png").string();
   std::optional<std::pair<RenderView, double>> best;
   double most = share * 1.25;  // a probe within noise of the first camera does not replace it
-  for (const RenderView& v : ring_views(scene, plant, o)) {
+  for (const RenderView& v : ring_views(scene, plant, o, first)) {
     write_pov_view(probe_pov.string(), scene, plant, o, v);
     const double s = plant_pixel_share(probe_pov.string(), probe_png, o, work_dir);
     if (s > most) {
@@ -1117,7 +1117,7 @@ RenderResult render_plant(const Scene& scene, const Plant& plant, const std::str
     if (o.draw_plant && o.turns == 0 && o.subject.empty()) {
       share = plant_pixel_share(pov_path, png_path, o, work_dir);
       if (share >= 0.0 && share < kFewPlantPixels && o.camera == CameraMode::Auto)
-        if (auto better = view_showing_most(scene, plant, pov_path, png_path, o, work_dir, share)) {
+        if (auto better = view_showing_most(scene, plant, pov_path, png_path, o, work_dir, view, share)) {
           std::tie(view, share) = *better;
           bytes = write_pov_view(pov_path, scene, plant, o, view);
         }

@@ -92,8 +92,9 @@ struct RenderView {
   [[nodiscard]] std::string describe() const;  // a line for the .pov file's header
 };
 RenderView render_view(const Scene& scene, const Plant& plant, const RenderOptions& options);
-// render_view with each of camera.hpp's camera_ring cameras in turn (auto mode's candidates).
-std::vector<RenderView> ring_views(const Scene& scene, const Plant& plant, const RenderOptions& options);
+// `base` (render_view's) with each of camera.hpp's camera_ring cameras in turn (auto mode's candidates).
+std::vector<RenderView> ring_views(const Scene& scene, const Plant& plant, const RenderOptions& options,
+                                   const RenderView& base);
 // An auto-camera render whose plant shows on fewer of its pixels than this tries every ring camera as a
 // small mask render and keeps the one that shows the plant on the most pixels (render_plant).
 constexpr double kFewPlantPixels = 0.01;

@@ -661,7 +661,7 @@ TEST(PovRender, APlantOnFewPixelsIsLookedAtFromTheRingCameraShowingMostOfIt) {
   const Plant plant = flat_plant();
   // The rule's first choice: the first ring camera, level with the plant, which sees all its points but
   // next to none of its pixels.
-  const std::vector<RenderView> ring = ring_views(scene, plant, o);
+  const std::vector<RenderView> ring = ring_views(scene, plant, o, render_view(scene, plant, o));
   ASSERT_FALSE(ring.empty());
   EXPECT_EQ(ring.front().raise_deg, 0.0f);
   EXPECT_EQ(render_view(scene, plant, o).raise_deg, 0.0f);
