@@ -37,6 +37,18 @@ std::string read_text_file(const std::string& path) {
   return text;
 }
 
+std::string file_problem(const std::string& path, bool allow_stream) {
+  namespace fs = std::filesystem;
+  if (path.empty()) return "no file named (an empty path)";
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (st.type() == fs::file_type::not_found) return "no such file";
+  if (ec) return ec.message();
+  if (fs::is_directory(st)) return "is a directory, not a file";
+  if (!allow_stream && !fs::is_regular_file(st)) return "not a regular file";
+  return "";
+}
+
 std::pair<std::size_t, std::size_t> line_column(const std::string& text, std::size_t byte) {
   std::size_t line = 1, col = 1;
   for (std::size_t i = 0; i + 1 < byte && i < text.size(); ++i) {

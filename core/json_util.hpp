@@ -12,6 +12,11 @@ namespace growbench {
 // The whole file as text; InputError "PATH: cannot open" when it cannot be read (or is a directory).
 std::string read_text_file(const std::string& path);
 
+// Why `path` cannot be read as a regular file ("no such file", "is a directory", "File name too long"),
+// or "" when it can be; `allow_stream` also accepts a pipe or device (/dev/stdin). Never throws: a user's
+// path may be anything (a name longer than the system allows), and checking it must not crash.
+std::string file_problem(const std::string& path, bool allow_stream = false);
+
 // 1-based line and column of a byte offset (as nlohmann's parse_error::byte reports it).
 std::pair<std::size_t, std::size_t> line_column(const std::string& text, std::size_t byte);
 

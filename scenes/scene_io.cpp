@@ -35,7 +35,7 @@ std::vector<std::string> bundled_meshes() {
 std::string mesh_path(const std::string& ref) {
   if (!is_mesh_name(ref)) return ref;
   const fs::path p = fs::path(data_path("scenes/meshes")) / (ref + ".obj");
-  if (fs::exists(p)) return p.string();
+  if (file_problem(p.string()).empty()) return p.string();
   const std::vector<std::string> names = bundled_meshes();
   std::string near = closest_match(ref, names);
   for (const auto& n : names)  // "bunny" means the Stanford bunny
@@ -47,7 +47,8 @@ std::string mesh_path(const std::string& ref) {
 }
 
 TriangleMesh load_obj(const std::string& path) {
-  if (!fs::exists(path)) throw InputError(fmt::format("{}: no such file", path));
+  if (const std::string why = file_problem(path, true); !why.empty())
+    throw InputError(fmt::format("{}: {} (expected an OBJ file)", path, why));
   check_obj_text(path, read_text_file(path));
   tinyobj::ObjReaderConfig cfg;
   cfg.triangulate = true;

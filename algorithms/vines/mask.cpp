@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <stb_image.h>
 
+#include "core/json_util.hpp"
 #include "core/errors.hpp"
 
 namespace growbench::vines {
@@ -45,10 +46,8 @@ bool header_size(const std::string& bytes, std::uint32_t& w, std::uint32_t& h) {
 }  // namespace
 
 Mask Mask::read(const std::string& path, const std::string& key) {
-  if (!std::filesystem::exists(path))
-    throw InputError(fmt::format("{}={}: no such file (expected a PNG inclusion/exclusion map)", key, path));
-  if (!std::filesystem::is_regular_file(path))
-    throw InputError(fmt::format("{}={}: not a file (expected a PNG inclusion/exclusion map)", key, path));
+  if (const std::string why = file_problem(path); !why.empty())
+    throw InputError(fmt::format("{}={}: {} (expected a PNG inclusion/exclusion map)", key, path, why));
   std::string head(24, '\0');
   {
     std::ifstream in(path, std::ios::binary);

@@ -37,6 +37,7 @@
 #include "algorithms/vines/grid.hpp"
 #include "algorithms/vines/mask.hpp"
 #include "algorithms/vines/surface.hpp"
+#include "core/json_util.hpp"
 #include "core/random.hpp"
 
 namespace growbench {
@@ -303,10 +304,8 @@ class Vines final : public GrowthAlgorithm {
 
   static void check_png(const std::string& path, const char* key) {
     int w = 0, h = 0, n = 0;
-    if (!std::filesystem::exists(path))
-      throw InputError(fmt::format("{}={}: no such file (expected a PNG)", key, path));
-    if (!std::filesystem::is_regular_file(path))
-      throw InputError(fmt::format("{}={}: not a file (expected a PNG)", key, path));
+    if (const std::string why = file_problem(path); !why.empty())
+      throw InputError(fmt::format("{}={}: {} (expected a PNG)", key, path, why));
     if (stbi_info(path.c_str(), &w, &h, &n) == 0 || w <= 0 || h <= 0)
       throw InputError(
           fmt::format("{}={}: not a readable image ({}); expected a PNG", key, path, stbi_failure_reason()));

@@ -532,7 +532,8 @@ TEST(Vines, BadInputIsAClearError) {
   EXPECT_NE(error(wall(), wall_query(), {"kill=5"}).find("kill (5) must be smaller than influence (4)"),
             std::string::npos);
   EXPECT_NE(error(wall(), wall_query(), {"leaf_scale_min=2"}).find("leaf_scale_min (2) exceeds"), std::string::npos);
-  EXPECT_NE(error(wall(), wall_query(), {"mask=/tmp"}).find("mask=/tmp: not a file"), std::string::npos);
+  EXPECT_NE(error(wall(), wall_query(), {"mask=/tmp"}).find("mask=/tmp: is a directory, not a file (expected a PNG"),
+            std::string::npos);
   // An inclusion map with no red: nowhere for an attractor.
   const fs::path d = test::temp_dir("vines_bad_mask");
   const std::string white = write_mask(d / "white.png", 8, 8, [](int, int) { return kWhite; });

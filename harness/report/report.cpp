@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "core/json_util.hpp"
 #include "core/data_path.hpp"
 #include "core/errors.hpp"
 #include "harness/run/process.hpp"
@@ -46,7 +47,8 @@ int run_report(const std::string& results, const std::string& out_dir, const std
   if (!fs::exists(script))
     throw InputError(
         fmt::format("report script {} not found (set GROWBENCH_REPORT_SCRIPT to reports/report.py)", script));
-  if (!fs::exists(results)) throw InputError(fmt::format("{}: no such results file", results));
+  if (const std::string why = file_problem(results); !why.empty())
+    throw InputError(fmt::format("{}: {} (expected a results file)", results, why));
   std::vector<std::string> args = {results, "--out", out_dir};
   args.insert(args.end(), extra.begin(), extra.end());
   return run_python(script, args);

@@ -518,7 +518,8 @@ std::string results_text(ResultsFile& results) {
 }  // namespace
 
 Suite load_suite(const std::string& path) {
-  if (!fs::exists(path)) throw InputError(fmt::format("{}: no such suite file", path));
+  if (const std::string why = file_problem(path, true); !why.empty())
+    throw InputError(fmt::format("{}: {} (expected a suite file)", path, why));
   return SuiteReader(path).read();
 }
 

@@ -47,6 +47,19 @@ TEST(JsonFile, ADirectoryIsNotReadAsAFile) {
   EXPECT_EQ(error_of([&] { (void)read_text_file(dir.string()); }), dir.string() + ": is a directory, not a file");
 }
 
+TEST(JsonFile, AFileProblemIsSaidNotThrown) {
+  const auto dir = test::temp_dir("file_problem");
+  const std::string file = test::write_text(dir / "f.txt", "x");
+  EXPECT_EQ(file_problem(file), "");
+  EXPECT_EQ(file_problem((dir / "none").string()), "no such file");
+  EXPECT_EQ(file_problem(dir.string()), "is a directory, not a file");
+  EXPECT_EQ(file_problem("/dev/null"), "not a regular file");
+  EXPECT_EQ(file_problem("/dev/null", true), "");
+  EXPECT_EQ(file_problem(""), "no file named (an empty path)");
+  // A name longer than NAME_MAX: std::filesystem::exists without an error code throws on it.
+  EXPECT_EQ(file_problem((dir / std::string(300, 'a') / "x.obj").string()), "File name too long");
+}
+
 TEST(JsonFile, ExcerptsAreShortAndWhole) {
   const nlohmann::json long_text = std::string(200, 'x');
   const std::string e = json_excerpt(long_text);

@@ -109,6 +109,9 @@ TEST(MeshScene, BadFilesGiveClearErrors) {
   const auto dir = test::temp_dir("meshio");
   std::string e = error_of([&] { load_scene("mesh:" + (dir / "missing.obj").string()); });
   EXPECT_NE(e.find("missing.obj: no such file"), std::string::npos) << e;
+  const std::string too_long = (dir / std::string(300, 'a') / "x.obj").string();  // a fuzzing finding
+  e = error_of([&] { load_scene("mesh:" + too_long); });
+  EXPECT_NE(e.find(too_long + ": File name too long (expected an OBJ file)"), std::string::npos) << e;
   const std::string empty = test::write_text(dir / "empty.obj", "# nothing\nv 0 0 0\n");
   e = error_of([&] { load_scene("mesh:" + empty); });
   EXPECT_NE(e.find("no faces"), std::string::npos) << e;
