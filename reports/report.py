@@ -535,18 +535,22 @@ def tick_text(v, _pos=None):
 
 def plain_log_ticks(ax):
     """Plain tick labels on the log axes of `ax`; where the axis spans under two decades the minor ticks at 2 and 5
-    times a power of ten are labelled too, so that it has more than one label."""
+    times a power of ten are labelled too, and under one decade those at 2 to 8, so that it has several labels."""
     from matplotlib.ticker import FuncFormatter, NullFormatter
 
-    def minor(v, pos=None):
-        mantissa = v / 10 ** math.floor(math.log10(v) + 1e-9) if v > 0 else 0
-        return tick_text(v) if any(math.isclose(mantissa, m, rel_tol=1e-6) for m in (2, 5)) else ""
+    def minor(labelled):
+        def text(v, pos=None):
+            mantissa = v / 10 ** math.floor(math.log10(v) + 1e-9) if v > 0 else 0
+            return tick_text(v) if any(math.isclose(mantissa, m, rel_tol=1e-6) for m in labelled) else ""
+        return FuncFormatter(text)
     for axis, (lo, hi) in ((ax.xaxis, ax.get_xlim()), (ax.yaxis, ax.get_ylim())):
         if axis.get_scale() != "log":
             continue
         axis.set_major_formatter(FuncFormatter(tick_text))
         lo, hi = min(lo, hi), max(lo, hi)
-        axis.set_minor_formatter(FuncFormatter(minor) if lo > 0 and hi / lo < 100 else NullFormatter())
+        span = hi / lo if lo > 0 else math.inf
+        axis.set_minor_formatter(minor((2, 3, 4, 6, 8, 5)) if span < 10 else minor((2, 5)) if span < 100
+                                 else NullFormatter())
 
 
 class Canvas:
@@ -593,7 +597,26 @@ class Canvas:
                         handles.append(h)
                         labels.append(l)
         if handles:
-            ax.legend(handles, labels, loc="upper left", borderaxespad=0, **kw)
+            # A long legend packs its rows closer and then takes two columns, rather than run off the figure.
+            packed = {"labelspacing": 0.25, "handlelength": 1.5} if len(handles) > 6 else {}
+            packed |= {"ncols": 2, "columnspacing": 0.8} if len(handles) > 12 else {}
+            legend = ax.legend(handles, labels, loc="upper left", borderaxespad=0, **(packed | kw))
+            # Taller than its panel: the figure grows (its width stays the page's) until the legend fits.
+            fig = ax.figure
+            for _ in range(4):
+                fig.canvas.draw()
+                need, have = legend.get_window_extent().height, ax.get_window_extent().height
+                if need <= have:
+                    break
+                width, height = fig.get_size_inches()
+                fig.set_size_inches(width, height * (need / have + 0.05))
+
+    def scene_styles(self):
+        """({scene: colour}, {scene: marker}): ten colours and ten markers, each of up to ten scenes its own
+        colour, and past ten the marker shifts, so that no two of up to a hundred scenes share both."""
+        colour = {s: self.plt.cm.tab10(i % 10) for i, s in enumerate(self.scenes)}
+        marker = {s: self.markers[(i + i // 10) % len(self.markers)] for i, s in enumerate(self.scenes)}
+        return colour, marker
 
     def entry_handles(self, labels=None, markers=True):
         from matplotlib.lines import Line2D
@@ -657,7 +680,9 @@ def figure_memory(F):
         if pts:
             axes[1].plot([c.nodes for c in pts], [max(c.alloc_bytes, 1) / 2 ** 20 for c in pts], F.marker[label],
                          color=F.colours[label], label=label)
-    for a, t in zip(axes, ["growth peak RSS (MiB)\nmedian over repetitions", "bytes allocated during growth (MiB)"]):
+    one = all(len(c.growth_rss) <= 1 for c in F.good)
+    rss = "growth peak RSS (MiB)\n" + ("one trial per point" if one else "median over repetitions")
+    for a, t in zip(axes, [rss, "bytes allocated during growth (MiB)"]):
         a.set_xscale("log")
         a.set_yscale("log")
         a.set_xlabel("plant nodes")
@@ -755,8 +780,7 @@ def figure_quality(F):
         return
     ncol = 4
     fig, axes = F.panels(len(keys), ncol, 0.5 + 0.16 * len(labels), extra=1 + (-(len(keys) + 1)) % ncol)
-    scene_colour = {s: F.plt.cm.Dark2(i % 8) for i, s in enumerate(F.scenes)}
-    scene_marker = {s: "os^Dv<>ph*"[i % 10] for i, s in enumerate(F.scenes)}
+    scene_colour, scene_marker = F.scene_styles()
     step = 0.7 / max(1, len(F.scenes))
     for idx, (key, title) in enumerate(keys):
         a = axes[idx]
@@ -777,11 +801,11 @@ def figure_quality(F):
     handles = [Line2D([], [], color=scene_colour[s], marker=scene_marker[s], ls="-", label=s) for s in F.scenes]
     for a in axes[len(keys):]:
         a.axis("off")
-    F.legend_panel(axes[-1], handles, list(F.scenes), title="scene\n(line: range over seeds)")
+    F.legend_panel(axes[-1], handles, list(F.scenes), title="scene")
     F.save(fig, "fig-quality", "Quality metrics computed identically for every algorithm (harness/output/metrics.hpp): "
            "coverage of the climbable surface, fraction of nodes attached, penetration into solids, self-intersection, "
            "leaf overlap and leaf light exposure with and without the plant's own shade. Per algorithm entry (rows) "
-           "and scene (marker): the median over the valid seeds, and a line over their range where there are two or "
+           "and scene (colour and marker): the median over the valid seeds, and a line over their range where there are two or "
            "more. A metric that does not apply (no climbable surface, no leaves, no segments) draws nothing: it is "
            "not 0." + LEFT_OUT)
 
@@ -804,13 +828,15 @@ def figure_growth_curves(F):
     fig, axes = F.panels(len(F.scenes), ncol, 1.55, extra=1)
     for idx, scene in enumerate(F.scenes):
         a = axes[idx]
+        top = 1.0
         for label in labels:
             pts = sorted((c for c in F.good if c.scene == scene and c.label == label), key=lambda c: c.seed)
             xy = curve_fractions(pts[0]) if pts else None
             if xy:
                 a.plot(*xy, color=F.colours[label], label=label)
+                top = max(top, max(xy[1]))
         a.set_xlim(0, 1)
-        a.set_ylim(0, 1.02)
+        a.set_ylim(0, 1.02 * top)  # a plant that shrank before it ended rises above 1: drawn, not cut off
         a.set_title(scene)
         if idx % ncol == 0:
             a.set_ylabel("share of final nodes")
@@ -821,7 +847,8 @@ def figure_growth_curves(F):
     F.save(fig, "fig-growth-curves", "Growth curves on common axes: the plant's nodes as a share of its final count "
            "against the elapsed share of its growth phase's wall time (lowest valid seed of each cell). An algorithm "
            "that builds its plant in one pass at the end (an L-system's interpretation) rises at the right; one that "
-           "grows a little every step rises steadily." + LEFT_OUT)
+           "grows a little every step rises steadily; a curve that falls, or rises above 1, is a plant that had more "
+           "nodes earlier than at its end (a rule or step that removes some)." + LEFT_OUT)
 
 
 def figures(cells, out, formats, pareto_metric=PARETO_METRIC):

@@ -115,5 +115,72 @@ class Pareto(unittest.TestCase):
                 report.write_report(suite(), os.path.join(d, "r.json"), d, ["png"], pareto_metric="coverge")
 
 
+class Readable(unittest.TestCase):
+    """What a reader of the figures must be able to tell apart or see whole."""
+
+    def drawn(self, doc):
+        """{figure name: the figure}, drawn (so that text has its extent) just before the report saves it."""
+        figs, save = {}, report.Canvas.save
+
+        def keep(canvas, fig, name, caption):
+            fig.canvas.draw()
+            figs[name] = (fig, [(a.get_title(), a.get_ylim(), a.get_legend()) for a in fig.axes],
+                          fig.bbox.extents)
+            save(canvas, fig, name, caption)
+        report.Canvas.save = keep
+        try:
+            with tempfile.TemporaryDirectory() as d:
+                report.write_report(doc, os.path.join(d, "results.json"), d, ["png"])
+        finally:
+            report.Canvas.save = save
+        return figs
+
+    def test_no_two_scenes_share_both_colour_and_marker(self):
+        with tempfile.TemporaryDirectory() as d:
+            canvas = report.Canvas([], d, [])
+            for n in (8, 10, 11, 25, 100):
+                canvas.scenes = [f"scene{i}" for i in range(n)]
+                colour, marker = canvas.scene_styles()
+                pairs = {(tuple(colour[s]), marker[s]) for s in canvas.scenes}
+                self.assertEqual(len(pairs), n, f"{n} scenes")
+                if n <= 10:
+                    self.assertEqual(len({tuple(c) for c in colour.values()}), n, "up to ten: a colour each")
+
+    def test_ten_scenes_legend_stays_inside_the_quality_figure(self):
+        scenes = ["wall", "facade", "column", "corner", "pergola", "boulder", "trunk", "envelope",
+                  "mesh:stanford-bunny", "mesh:spot"]
+        doc = document([trial(label, scene, 1, [0.1], 1000) for label in ("a", "b") for scene in scenes])
+        _, axes, (x0, y0, x1, y1) = self.drawn(doc)["fig-quality"]
+        legends = [legend for _, _, legend in axes if legend is not None]
+        self.assertEqual(len(legends), 1)
+        box = legends[0].get_window_extent()
+        self.assertTrue(box.x0 >= x0 - 1 and box.y0 >= y0 - 1 and box.x1 <= x1 + 1 and box.y1 <= y1 + 1,
+                        f"legend {box.extents} outside the figure {(x0, y0, x1, y1)}")
+
+    def test_a_growth_curve_that_rises_above_its_end_is_drawn_whole(self):
+        t = trial("lsystem", "wall", 1, [0.1], 100)
+        t["curve"] = {"step": [0, 1, 2, 3], "nodes": [1, 80, 250, 100], "wall_s": [0, 0.1, 0.2, 0.3]}
+        _, axes, _ = self.drawn(document([t]))["fig-growth-curves"]
+        top = [ylim[1] for title, ylim, _ in axes if title == "wall"]
+        self.assertEqual(len(top), 1)
+        self.assertGreaterEqual(top[0], 2.5, "the curve peaks at 2.5 times its final count")
+
+    def test_a_log_axis_under_a_decade_has_several_labels(self):
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        for lo, hi in ((35, 95), (0.12, 0.9), (3, 70)):
+            fig, ax = plt.subplots()
+            ax.set_yscale("log")
+            ax.plot([1, 2], [lo, hi])
+            ax.set_ylim(lo, hi)
+            report.plain_log_ticks(ax)
+            fig.canvas.draw()
+            shown = [t.get_text() for t in ax.yaxis.get_ticklabels() + ax.yaxis.get_ticklabels(minor=True)
+                     if t.get_text() and lo <= t.get_position()[1] <= hi]
+            plt.close(fig)
+            self.assertGreaterEqual(len(shown), 3, f"{lo}..{hi}: {shown}")
+
+
 if __name__ == "__main__":
     unittest.main()
