@@ -40,15 +40,17 @@ inline std::size_t utf8_char_length(std::string_view s, std::size_t i) {
 }
 
 // `text` with every byte that is not part of a well-formed character, and every control character but
-// newline and tab, written as \xNN: valid UTF-8 that prints as one line per line of the input.
-inline std::string escape_utf8(std::string_view text) {
+// newline and tab, written as \xNN: valid UTF-8 that prints as one line per line of the input. With
+// `one_line`, newline and tab too: text that cannot end the line (or the comment) it is written into.
+inline std::string escape_utf8(std::string_view text, bool one_line = false) {
   static constexpr char kHex[] = "0123456789abcdef";
   std::string out;
   out.reserve(text.size());
   for (std::size_t i = 0; i < text.size();) {
     const std::size_t n = utf8_char_length(text, i);
     const auto c = static_cast<unsigned char>(text[i]);
-    if (n == 0 || (n == 1 && ((c < 0x20 && c != '\n' && c != '\t') || c == 0x7f))) {
+    const bool kept_space = !one_line && (c == '\n' || c == '\t');
+    if (n == 0 || (n == 1 && ((c < 0x20 && !kept_space) || c == 0x7f))) {
       out += "\\x";
       out += kHex[c >> 4];
       out += kHex[c & 15];

@@ -24,6 +24,7 @@
 
 #include "core/errors.hpp"
 #include "core/json_util.hpp"
+#include "core/utf8.hpp"
 #include "harness/output/exporters.hpp"
 #include "harness/record/files.hpp"
 #include "harness/run/process.hpp"
@@ -209,6 +210,12 @@ void write_mesh2(Out out, const std::vector<glm::vec3>& vertices, const std::vec
   if (uv) write_uv_indices(out, *uv, first, count);
 }
 
+// A name from input in a `//` comment: one line, so that a newline in a shared scene file's names cannot
+// end the comment and have the lines after it read as POV-Ray directives.
+std::string pov_comment(std::string_view text) {
+  return escape_utf8(text, true);
+}
+
 // A group of objects with one texture: a union when there are two or more (POV-Ray warns about a union
 // of one), the object itself when there is one, nothing when there are none. The members are written
 // into a buffer first, so the group's form is known before it starts.
@@ -255,7 +262,7 @@ void write_settings(Out out, const Scene& scene, const Plant& plant, const Rende
                  "// growbench render: scene '{}', {} nodes, {} organs{}, quality {}\n"
                  "#version 3.7;\n"
                  "global_settings {{\n  assumed_gamma 1.0\n  max_trace_level 8\n",
-                 scene.name, plant.nodes.size(), plant.organs.size(),
+                 pov_comment(scene.name), plant.nodes.size(), plant.organs.size(),
                  plant.decals.empty() ? "" : fmt::format(", {} decals", plant.decals.size()), to_string(o.quality));
   if (paper)  // not in the plant-pixel mask (GB_Mask), which needs no light
     fmt::format_to(out,
@@ -435,7 +442,7 @@ void write_scene_meshes(Out out, const Scene& scene, const std::vector<SurfaceDe
       if (d.mesh == kPlanarDecal && m.climbable) planar.push_back(&d);
       if (d.mesh >= 0 && static_cast<std::size_t>(d.mesh) == i) uv_decals.push_back(&d);
     }
-    fmt::format_to(out, "// scene mesh '{}': {} triangles", m.name, m.triangles.size());
+    fmt::format_to(out, "// scene mesh '{}': {} triangles", pov_comment(m.name), m.triangles.size());
     if (!uv_decals.empty() || !planar.empty())
       fmt::format_to(out, ", {} decal{} on top", uv_decals.size() + planar.size(),
                      uv_decals.size() + planar.size() == 1 ? "" : "s");
@@ -463,7 +470,7 @@ void write_free_decals(Out out, const Scene& scene, const std::vector<SurfaceDec
     const std::vector<glm::uvec3> triangles = {{0, 1, 2}, {0, 2, 3}};
     const std::vector<glm::vec2> uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
     const MeshUvs uv{uvs, triangles};
-    fmt::format_to(out, "// decal '{}' standing free: the scene has nothing to climb\n", d.image);
+    fmt::format_to(out, "// decal '{}' standing free: the scene has nothing to climb\n", pov_comment(d.image));
     write_mesh2(out, corners, {}, triangles, 0, 2, &uv);
     write_uv_decal_layer(out, d);
     fmt::format_to(out, "}}\n");
@@ -613,7 +620,7 @@ void write_organs(Out out, const Plant& plant, const MesherOptions& mesher) {
   for (std::size_t k = 0; k < used.size(); ++k) {
     if (!used[k]) continue;
     const TriangleMesh& m = shapes.at(k).mesh;
-    fmt::format_to(out, "#declare GB_Organ{} =  // {}\n", k, shapes.at(k).name);
+    fmt::format_to(out, "#declare GB_Organ{} =  // {}\n", k, pov_comment(shapes.at(k).name));
     write_mesh2(out, m.vertices, shapes.at(k).normals, m.triangles, 0, static_cast<std::uint32_t>(m.triangles.size()));
     fmt::format_to(out, "}}\n");
   }
@@ -910,6 +917,29 @@ class ProgressWatch {
   std::thread thread_;
 };
 
+// A private folder for one POV-Ray run, removed with this object: the only folder POV-Ray may write
+// (run_program's Landlock confinement), its image moved out after. POV-Ray's own I/O restriction
+// (povray.conf) does not stop a scene file's #fopen from writing anywhere in Debian's 3.7, so a directive
+// that escaped into a scene file is stopped by the kernel instead.
+class PovSandbox {
+ public:
+  explicit PovSandbox(const fs::path& image_dir) {
+    std::string pattern = (image_dir / ".povray-XXXXXX").string();
+    if (mkdtemp(pattern.data()) == nullptr)
+      throw std::runtime_error(
+          fmt::format("cannot make POV-Ray's private folder in {}: {}", image_dir.string(), std::strerror(errno)));
+    dir = pattern;
+  }
+  ~PovSandbox() {
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+  }
+  PovSandbox(const PovSandbox&) = delete;
+  PovSandbox& operator=(const PovSandbox&) = delete;
+
+  fs::path dir;
+};
+
 // POV-Ray's command line, the file names relative to the directory it runs in.
 std::vector<std::string> povray_args(const std::string& bin, const fs::path& pov_abs, const fs::path& png_abs,
                                      const fs::path& dir, const RenderResult& r, const RenderOptions& o) {
@@ -961,24 +991,34 @@ RenderResult run_povray(const std::string& pov_path, const std::string& png_path
     r.message = "povray is not installed (scripts/install-deps installs Debian's povray package)";
     return r;
   }
-  // POV-Ray runs in the output directory with relative file names: Debian's povray.conf restricts
-  // reading and writing to the working directory and below.
+  // POV-Ray runs in the output directory with relative file names, and writes its image into a private
+  // folder (PovSandbox) the image is moved out of.
   const fs::path png_abs = fs::absolute(png_path), pov_abs = fs::absolute(pov_path);
   const fs::path dir = work_dir.empty() ? png_abs.parent_path() : fs::absolute(work_dir);
   std::error_code ec;
   fs::remove(png_abs, ec);
   fs::remove(r.log, ec);
-  const std::vector<std::string> args = povray_args(bin, pov_abs, png_abs, dir, r, o);
-  const auto t0 = std::chrono::steady_clock::now();
-  ChildResult cr;
-  ProgressWatch watch(o.progress, fs::absolute(r.log).string(), t0);
+  std::optional<PovSandbox> box;
   try {
-    cr = run_program(args, dir.string(), {o.timeout_s, 0}, fs::absolute(r.log).string());
+    box.emplace(png_abs.parent_path());
   } catch (const std::exception& e) {
     r.status = "failed";
     r.message = e.what();
     return r;
   }
+  const fs::path drawn = box->dir / png_abs.filename();
+  const std::vector<std::string> args = povray_args(bin, pov_abs, drawn, dir, r, o);
+  const auto t0 = std::chrono::steady_clock::now();
+  ChildResult cr;
+  ProgressWatch watch(o.progress, fs::absolute(r.log).string(), t0);
+  try {
+    cr = run_program(args, dir.string(), {o.timeout_s, 0}, fs::absolute(r.log).string(), box->dir.string());
+  } catch (const std::exception& e) {
+    r.status = "failed";
+    r.message = e.what();
+    return r;
+  }
+  if (fs::is_regular_file(drawn)) fs::rename(drawn, png_abs, ec);
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.cpu_s = cr.user_s + cr.system_s;
   const std::vector<std::string> errors =
@@ -1050,10 +1090,24 @@ double plant_pixel_share(const std::string& pov_path, const std::string& png_pat
 std::string decal_render_problem(const Scene& scene, const Plant& plant, const fs::path& dir, const RenderOptions& o) {
   if (!o.draw_plant || plant.decals.empty()) return "";
   if (std::string bad = decal_problem(scene, plant); !bad.empty()) return bad;
-  for (std::size_t i = 0; i < plant.decals.size(); ++i)
+  for (std::size_t i = 0; i < plant.decals.size(); ++i) {
+    // Written into a POV-Ray string and read under the render's I/O restriction: a plain relative name.
+    const std::string& image = plant.decals[i].image;
+    const fs::path rel(image);
+    const bool plain = !image.empty() && rel.is_relative() &&
+                       std::none_of(rel.begin(), rel.end(), [](const fs::path& p) { return p == ".."; }) &&
+                       std::none_of(image.begin(), image.end(), [](char c) {
+                         return c == '"' || c == '\\' || static_cast<unsigned char>(c) < 0x20 || c == 0x7f;
+                       });
+    if (!plain)
+      return fmt::format(
+          "decal {}: its image '{}' is not a plain file name inside the render's directory (expected a "
+          "relative path with no '..', quote, backslash or control character)",
+          i, pov_comment(image));
     if (!fs::is_regular_file(dir / plant.decals[i].image))
       return fmt::format("decal {}: its image {} is missing (a render reads decal images from its own directory)", i,
                          (dir / plant.decals[i].image).string());
+  }
   return "";
 }
 

@@ -1,6 +1,10 @@
 #include "harness/run/process.hpp"
 
 #include <fcntl.h>
+#include <linux/landlock.h>
+#ifndef LANDLOCK_ACCESS_FS_TRUNCATE  // Landlock ABI 3, newer than Debian 12's kernel headers
+#define LANDLOCK_ACCESS_FS_TRUNCATE (1ULL << 14)
+#endif
 #include <poll.h>
 #include <signal.h>
 #include <limits.h>
@@ -512,15 +516,59 @@ std::string find_program(const std::string& name) {
   return "";
 }
 
+namespace {
+
+// Landlock's write rights for files and directories that this kernel knows (its ABI version `abi`):
+// creating, changing, removing, renaming and linking anything.
+std::uint64_t landlock_write_rights(long abi) {
+  std::uint64_t rights = LANDLOCK_ACCESS_FS_WRITE_FILE | LANDLOCK_ACCESS_FS_REMOVE_DIR |
+                         LANDLOCK_ACCESS_FS_REMOVE_FILE | LANDLOCK_ACCESS_FS_MAKE_CHAR | LANDLOCK_ACCESS_FS_MAKE_DIR |
+                         LANDLOCK_ACCESS_FS_MAKE_REG | LANDLOCK_ACCESS_FS_MAKE_SOCK | LANDLOCK_ACCESS_FS_MAKE_FIFO |
+                         LANDLOCK_ACCESS_FS_MAKE_BLOCK | LANDLOCK_ACCESS_FS_MAKE_SYM;
+  if (abi >= 2) rights |= LANDLOCK_ACCESS_FS_REFER;
+  if (abi >= 3) rights |= LANDLOCK_ACCESS_FS_TRUNCATE;
+  return rights;
+}
+
+// In the child, before exec (raw system calls only): lets it and what it runs write nowhere but under
+// `dir`. Returns false when the kernel cannot (no Landlock) or `dir` cannot be opened.
+bool confine_writes(const char* dir, long abi) {
+  landlock_ruleset_attr attr{};
+  attr.handled_access_fs = landlock_write_rights(abi);
+  const int ruleset = static_cast<int>(syscall(SYS_landlock_create_ruleset, &attr, sizeof attr, 0));
+  if (ruleset < 0) return false;
+  landlock_path_beneath_attr beneath{};
+  beneath.allowed_access = attr.handled_access_fs;
+  beneath.parent_fd = open(dir, O_PATH | O_CLOEXEC | O_DIRECTORY);
+  const bool ok = beneath.parent_fd >= 0 &&
+                  syscall(SYS_landlock_add_rule, ruleset, LANDLOCK_RULE_PATH_BENEATH, &beneath, 0) == 0 &&
+                  prctl(PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0) == 0 && syscall(SYS_landlock_restrict_self, ruleset, 0) == 0;
+  if (beneath.parent_fd >= 0) close(beneath.parent_fd);
+  close(ruleset);
+  return ok;
+}
+
+}  // namespace
+
+long landlock_abi() {
+  static const long abi = [] {
+    const long v = syscall(SYS_landlock_create_ruleset, nullptr, 0, LANDLOCK_CREATE_RULESET_VERSION);
+    return v < 0 ? 0L : v;
+  }();
+  return abi;
+}
+
 ChildResult run_program(const std::vector<std::string>& args, const std::string& cwd, const ChildLimits& limits,
-                        const std::string& log_path) {
+                        const std::string& log_path, const std::string& write_only_under) {
   std::vector<std::string> copy = args;  // argv is built before the fork: no allocation in the child
   std::vector<char*> argv;
   for (auto& a : copy) argv.push_back(a.data());
   argv.push_back(nullptr);
+  const long abi = write_only_under.empty() ? 0 : landlock_abi();
   return run_forked(
       [&]() -> int {
         if (!cwd.empty() && chdir(cwd.c_str()) != 0) return 126;
+        if (abi > 0 && !confine_writes(write_only_under.c_str(), abi)) return 126;
         execv(argv[0], argv.data());
         return 127;
       },

@@ -94,9 +94,15 @@ std::string signal_name(int sig);
 std::string find_program(const std::string& name);
 
 // Runs the program args[0] (a path) with `args`, in directory `cwd` ("" : this one), its output appended
-// to `log_path` (exit status 127: it could not be started). Only async-signal-safe calls run between
-// fork and exec, so this is safe from a process with threads, and from several threads at once.
+// to `log_path` (exit status 127: it could not be started). With `write_only_under`, the program can
+// create, change or remove files only under that folder (Landlock; where the kernel has none, it runs
+// unconfined: landlock_abi() says which; exit status 126: the confinement failed). Only
+// async-signal-safe calls run between fork and exec, so this is safe from a process with threads, and
+// from several threads at once.
 ChildResult run_program(const std::vector<std::string>& args, const std::string& cwd, const ChildLimits& limits,
-                        const std::string& log_path);
+                        const std::string& log_path, const std::string& write_only_under = "");
+
+// The kernel's Landlock ABI version, 0 when it has none (then run_program cannot confine writes).
+long landlock_abi();
 
 }  // namespace growbench

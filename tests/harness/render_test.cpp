@@ -17,6 +17,7 @@
 #include "harness/output/exporters.hpp"
 #include "harness/render/render.hpp"
 #include "harness/render/render_results.hpp"
+#include "harness/run/process.hpp"
 #include "scenes/geometry.hpp"
 #include "test_util.hpp"
 
@@ -937,6 +938,77 @@ TEST(PovRender, FailuresAreRecordedWithPovRaysMessage) {
   setenv("PATH", path.c_str(), 1);
   EXPECT_EQ(missing.status, "no_povray");
   EXPECT_NE(missing.message.find("install-deps"), std::string::npos);
+}
+
+// A hostile scene file: names with line breaks, written into `//` comments of the .pov file, would end
+// the comment and run what follows as POV-Ray directives.
+TEST(PovWriter, NamesWithLineBreaksStayInsideTheirComments) {
+  const auto dir = test::temp_dir("pov_inject");
+  const std::string attack = "x'\n#fopen F \"" + (dir / "pwned.txt").string() + "\" write\n#fclose F\n// ";
+  Scene scene = tiny_scene();
+  scene.name = attack;
+  scene.meshes[0].name = attack;
+  write_pov((dir / "a.pov").string(), scene, tiny_plant(), RenderOptions{});
+  const std::string text = read_file(dir / "a.pov");
+  EXPECT_EQ(text.find("\n#fopen"), std::string::npos);
+  EXPECT_EQ(text.find("\n#fclose"), std::string::npos);
+  EXPECT_NE(text.find("// growbench render: scene 'x'\\x0a#fopen F"), std::string::npos) << text.substr(0, 300);
+  EXPECT_NE(text.find("// scene mesh 'x'\\x0a#fopen F"), std::string::npos);
+  if (!find_povray().empty()) {
+    RenderOptions o;
+    o.width = 32;
+    o.height = 24;
+    const RenderResult r = run_povray((dir / "a.pov").string(), (dir / "a.png").string(), o);
+    EXPECT_TRUE(r.ok()) << r.message;
+    EXPECT_FALSE(std::filesystem::exists(dir / "pwned.txt"));
+  }
+}
+
+// Were a directive to escape anyway, POV-Ray runs confined to writing its image: a scene file that opens
+// a file for writing fails to render and writes nothing, in the render's folder or anywhere else.
+TEST(PovRender, PovRayWritesNothingButItsImage) {
+  ASSERT_FALSE(find_povray().empty()) << "povray is not installed (scripts/install-deps installs it)";
+  if (landlock_abi() == 0) GTEST_SKIP() << "this kernel has no Landlock: POV-Ray runs unconfined";
+  const auto dir = test::temp_dir("pov_confined");
+  const auto outside = test::temp_dir("pov_confined_outside");
+  RenderOptions o;
+  o.width = 32;
+  o.height = 24;
+  for (const std::filesystem::path& target : {dir / "here.txt", outside / "tmp.txt"}) {
+    test::write_text(dir / "w.pov", "#version 3.7;\n#fopen F \"" + target.string() +
+                                        "\" write\n#write (F, \"x\")\n#fclose F\n"
+                                        "camera { location <0,0,-3> look_at 0 }\nsphere { 0, 1 pigment { rgb 1 } }\n");
+    const RenderResult r = run_povray((dir / "w.pov").string(), (dir / "w.png").string(), o);
+    EXPECT_FALSE(std::filesystem::exists(target)) << target;
+    EXPECT_EQ(r.status, "failed") << target;
+    EXPECT_FALSE(std::filesystem::exists(dir / "w.png"));
+  }
+  // The same scene without the write renders, and POV-Ray's private folder is gone after.
+  test::write_text(dir / "ok.pov",
+                   "#version 3.7;\ncamera { location <0,0,-3> look_at 0 }\n"
+                   "light_source { <0,5,-5> rgb 1 }\nsphere { 0, 1 pigment { rgb 1 } }\n");
+  const RenderResult ok = run_povray((dir / "ok.pov").string(), (dir / "ok.png").string(), o);
+  EXPECT_TRUE(ok.ok()) << ok.message;
+  EXPECT_TRUE(std::filesystem::is_regular_file(dir / "ok.png"));
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    EXPECT_NE(e.path().filename().string().rfind(".povray-", 0), 0u) << e.path();
+}
+
+TEST(PovRender, ADecalImageNameMustStayInTheRendersFolder) {
+  const auto dir = test::temp_dir("decal_name");
+  RenderOptions o;
+  o.width = 32;
+  o.height = 24;
+  for (const std::string name : {"../vine.png", "/tmp/vine.png", "a\"b.png", "a\nb.png", "a\\b.png", ""}) {
+    Plant p = tiny_plant();
+    p.decals = {uv_decal(name, 0)};
+    const RenderResult r = render_plant(uv_quad_scene(), p, (dir / "a.pov").string(), (dir / "a.png").string(), o);
+    EXPECT_EQ(r.status, "failed") << name;
+    const bool said = r.message.find("decal 0: its image") != std::string::npos &&
+                      (r.message.find("is not a plain file name inside the render's directory") != std::string::npos ||
+                       r.message.find("has a control character") != std::string::npos);
+    EXPECT_TRUE(said) << r.message;
+  }
 }
 
 TEST(RenderGrid, LabelsCellsAndMarksMissingOnes) {
