@@ -49,6 +49,7 @@ peers: cli
 	/usr/bin/python3 reports/report.py --peers out/peers/peers.json --out out/peers/report
 
 # The deterministic regression gate (CI runs it after the tests): the quick suite once, single-threaded,
+# one trial per core at a time (instruction counts do not depend on what runs beside them),
 # under callgrind, its files checked against the generated schema, compared with the committed baseline.
 # Instruction counts depend on the compiler flags: the baseline is made with the CI preset (make baseline PRESET=ci).
 GATE := $(BUILD)/gate

@@ -1,9 +1,11 @@
 // growbench suite: run a suite file's trials, each in its own process, and summarise the results.
+#include <algorithm>
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -25,7 +27,7 @@ namespace {
 struct SuiteArgs {
   std::string file, out, shard;
   bool resume = false, quiet = false;
-  int repetitions = 0;
+  int repetitions = 0, jobs = 0;
   bool instructions = false, plan = false;
   std::string render, history;
   RenderFlags render_flags;
@@ -70,10 +72,17 @@ Outcome run_suite_file(const SuiteArgs& a) {
   o.resume = a.resume;
   o.quiet = a.quiet;
   o.instructions = a.instructions;
+  if (a.jobs > 0 && !a.instructions)
+    throw InputError(
+        "--jobs runs callgrind trials side by side and needs --instructions: timed trials run one at "
+        "a time, so that none disturbs another's timing");
+  o.jobs = a.jobs > 0 ? a.jobs : static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
   if (!a.shard.empty()) parse_shard(a.shard, o);
   if (o.instructions)
-    fmt::print("suite {}: {} cells, each once, single-threaded, under callgrind (instruction counts per phase)\n",
-               suite.name, suite.configs.size());
+    fmt::print(
+        "suite {}: {} cells, each once, single-threaded, under callgrind (instruction counts per phase), {} at a "
+        "time\n",
+        suite.name, suite.configs.size(), o.jobs);
   else
     fmt::print("suite {}: {} cells x {} repetitions (+{} warm-up)\n", suite.name, suite.configs.size(),
                suite.repetitions, suite.warmup);
@@ -112,6 +121,11 @@ Command add_suite(CLI::App& app) {
   cmd->add_flag("--instructions", a->instructions,
                 "run each trial once, single-threaded, under valgrind's callgrind, and record instructions per "
                 "phase (the deterministic regression gate: see `growbench compare`)");
+  cmd->add_option(
+         "-j,--jobs", a->jobs,
+         "with --instructions: how many callgrind trials run at once (default: the number of cores; the counts "
+         "do not depend on it)")
+      ->check(CLI::Range(1, 256));
   CLI::Option* render = cmd->add_option(
       "--render", a->render, "render every trial with POV-Ray afterwards (preview or paper) and compose grid.png");
   add_render_flags(cmd, a->render_flags, render);

@@ -13,6 +13,7 @@
 #include <map>
 #include <memory>
 #include <new>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -30,6 +31,7 @@
 #include "harness/organs/options.hpp"
 #include "harness/output/exporters.hpp"
 #include "harness/record/record.hpp"
+#include "harness/run/ordered_pool.hpp"
 #include "harness/run/process.hpp"
 #include "harness/stats/stats.hpp"
 #include "scenes/scene_library.hpp"
@@ -773,9 +775,15 @@ class SuiteRun {
     const std::vector<Job> jobs = plan_jobs();
     const bool tty = isatty(STDERR_FILENO) != 0 && !o_.quiet;
     const auto t_start = std::chrono::steady_clock::now();
+    // Callgrind trials side by side (each cell once, so each in its own folder): their counts do not
+    // depend on what else runs. Timed trials run one at a time, so that none disturbs another's timing.
+    std::optional<OrderedPool<TrialProcess>> pool;
+    const auto width = static_cast<std::size_t>(std::max(1, o_.instructions ? o_.jobs : 1));
+    if (width > 1 && jobs.size() > 1)
+      pool.emplace(jobs.size(), std::min(width, jobs.size()), [&](std::size_t i) { return start_job(jobs[i]); });
     for (std::size_t jn = 0; jn < jobs.size(); ++jn) {
       if (!o_.quiet) print_progress(jobs, jn, t_start, tty);
-      if (!run_job(jobs[jn])) continue;  // a warm-up
+      if (!finish_job(jobs[jn], pool ? pool->take(jn) : start_job(jobs[jn]))) continue;  // a warm-up
       // Readable snapshots of the whole run every few seconds (always written atomically).
       if (std::chrono::steady_clock::now() - last_snapshot > std::chrono::seconds(10)) {
         write_snapshot();
@@ -1045,14 +1053,19 @@ class SuiteRun {
     sample.harness_overhead_s = launch + bookkeeping + parent;
   }
 
-  // Runs one job; false for a warm-up, which is run but not kept.
-  bool run_job(const Job& job) {
-    const SuiteConfig& c = *job.cell;
-    const fs::path dir = out_ / "trials" / c.id;
+  // Runs one job's trial in a clean folder.
+  TrialProcess start_job(const Job& job) {
+    const fs::path dir = out_ / "trials" / job.cell->id;
     make_directories(dir.string());
     fs::remove(dir / "record.json");
     fs::remove(dir / "error.txt");
-    const TrialProcess p = run_process(c, dir);
+    return run_process(*job.cell, dir);
+  }
+
+  // Keeps what a job's trial left; false for a warm-up, which is run but not kept.
+  bool finish_job(const Job& job, const TrialProcess& p) {
+    const SuiteConfig& c = *job.cell;
+    const fs::path dir = out_ / "trials" / c.id;
     SuiteSample sample;
     sample.repetition = job.repetition;
     sample.child_wall_s = p.cr.wall_s;

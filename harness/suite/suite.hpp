@@ -62,6 +62,8 @@ struct SuiteRunOptions {
   // Run each trial once, single-threaded, under valgrind's callgrind, recording instructions per phase
   // ("instructions" in each cell): the deterministic measure the regression gate compares.
   bool instructions = false;
+  // With `instructions`: how many callgrind trials run at once (their counts do not depend on it).
+  int jobs = 1;
   // Forks the trials (timing mode). Null: run_suite starts one. `growbench suite` starts it first thing,
   // before the suite file is read, so trials inherit as little of this process as possible.
   Launcher* launcher = nullptr;

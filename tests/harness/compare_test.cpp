@@ -1,7 +1,11 @@
 // The deterministic regression gate: what `growbench compare` flags, and what it lets pass.
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -208,6 +212,49 @@ TEST(RegressionGate, CatchesAPlantedFivePercentSlowdownAndNotAnUnchangedRerun) {
   EXPECT_GT(ratio, 1.03);
   EXPECT_LT(ratio, 1.08);
   EXPECT_EQ(slowed["geometry_hash"], cell["geometry_hash"]);  // the plant is the same: only the cost changed
+}
+
+// Callgrind trials run side by side (--jobs) count what they count one at a time, and are kept in the same
+// order: the results and the journal do not say how many ran at once.
+TEST(RegressionGate, TrialsSideBySideCountTheSameAsOneAtATime) {
+  if (kAddressSanitizer) GTEST_SKIP() << "callgrind cannot run an AddressSanitizer build";
+  const auto dir = test::temp_dir("gate_jobs");
+  const nlohmann::json s = {{"schema_version", 1},
+                            {"name", "jobs"},
+                            {"seeds", {1, 2}},
+                            {"scenes", {"wall", "envelope"}},
+                            {"algorithms", {{{"name", "spacecol"}, {"params", {{"point_count", 200}}}}}}};
+  const std::string file = test::write_text(dir / "jobs.json", s.dump());
+  auto run = [&](const std::string& out, int jobs) {
+    const auto r = test::run_growbench(
+        fmt::format("suite -q --instructions --jobs {} {} --out {}", jobs, file, (dir / out).string()));
+    EXPECT_EQ(r.status, 0) << r.out;
+    EXPECT_NE(r.out.find(fmt::format("{} at a time", jobs)), std::string::npos) << r.out;
+    std::ifstream in(dir / out / "results.json");
+    const auto results = nlohmann::json::parse(in);
+    std::vector<std::string> journal;  // cell ids, in the order they were appended
+    std::ifstream jin(dir / out / "journal.jsonl");
+    for (std::string line; std::getline(jin, line);) journal.push_back(nlohmann::json::parse(line)["id"]);
+    return std::pair{results, journal};
+  };
+  // Equal-length output names: paths enter the export phase's counts.
+  const auto [one, one_journal] = run("w1", 1);
+  const auto [three, three_journal] = run("w3", 3);
+  ASSERT_EQ(one["trials"].size(), 4u);
+  EXPECT_EQ(one_journal, three_journal);
+  for (std::size_t i = 0; i < 4; ++i) {
+    const auto& a = one["trials"][i];
+    const auto& b = three["trials"][i];
+    EXPECT_EQ(a["id"], b["id"]);
+    ASSERT_EQ(a["status"], "ok") << a["id"];
+    EXPECT_EQ(a["instructions"], b["instructions"]) << a["id"];
+    EXPECT_EQ(a["geometry_hash"], b["geometry_hash"]) << a["id"];
+  }
+  // Timed trials are not run side by side.
+  const auto timed = test::run_growbench(fmt::format("suite -q --jobs 2 {} --out {}", file, (dir / "t").string()));
+  EXPECT_EQ(timed.status, 2) << timed.out;
+  EXPECT_NE(timed.out.find("--jobs runs callgrind trials side by side and needs --instructions"), std::string::npos)
+      << timed.out;
 }
 
 }  // namespace
