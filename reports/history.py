@@ -18,6 +18,7 @@ import html
 import json
 import math
 import os
+import re
 import statistics
 import sys
 
@@ -75,6 +76,14 @@ def change_points(values, min_step=0.01):
 
     split(0, n)
     return sorted(found)
+
+
+def safe_name(s):
+    """A folder name for a machine or suite name a history file gives, as growbench's safe_name makes
+    them: characters outside [A-Za-z0-9-_.=,] become '_', and a name of dots only ('..') becomes
+    underscores, so a hostile file cannot send a figure outside --out."""
+    s = re.sub(r"[^A-Za-z0-9._=,-]", "_", str(s))
+    return "_" * len(s) if s and s.strip(".") == "" else s
 
 
 def fail(message):
@@ -143,6 +152,7 @@ def main():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import matplotlib.ticker
+    plt.rcParams["text.parse_math"] = False  # names and commits are data, never TeX
 
     groups = load(a.dir)
     if not groups:
@@ -151,10 +161,10 @@ def main():
     report = {"min_step": a.min_step, "groups": []}
     body = []
     for (machine, suite), docs in sorted(groups.items()):
-        commits = [d["commit"] for d in docs]
+        commits = [str(d.get("commit", "")) for d in docs]
         group = {"machine": machine, "suite": suite, "commits": commits, "change_points": [],
                  "behaviour_changes": [{"cell": c, "commit": commits[i]} for c, i in behaviour_changes(docs)]}
-        sub = os.path.join(machine, suite)
+        sub = os.path.join(safe_name(machine), safe_name(suite))
         os.makedirs(os.path.join(a.out, sub), exist_ok=True)
         data = series(docs)
         metrics = sorted({m for _, m in data})
@@ -195,14 +205,14 @@ def main():
             figures.append((m, os.path.join(sub, f"{name}.png")))
         report["groups"].append(group)
         rows = "".join(
-            f"<tr><td>{html.escape(c['cell'])}</td><td>{html.escape(c['metric'])}</td><td>{c['before']}</td>"
-            f"<td>{c['after']}</td><td>{c['ratio']:.3f}</td></tr>" for c in group["change_points"])
+            f"<tr><td>{html.escape(c['cell'])}</td><td>{html.escape(c['metric'])}</td><td>{html.escape(c['before'])}</td>"
+            f"<td>{html.escape(c['after'])}</td><td>{c['ratio']:.3f}</td></tr>" for c in group["change_points"])
         body.append(f"<h2>{html.escape(machine)} / {html.escape(suite)}: {len(commits)} commits</h2>")
         body.append("<table><tr><th>cell</th><th>metric</th><th>before</th><th>after</th><th>after/before</th></tr>"
                     f"{rows or '<tr><td colspan=5>no change points</td></tr>'}</table>")
         if group["behaviour_changes"]:
             body.append("<p>Behaviour changed (geometry hash): " + ", ".join(
-                f"{html.escape(b['cell'])} at {b['commit']}" for b in group["behaviour_changes"]) + "</p>")
+                f"{html.escape(b['cell'])} at {html.escape(b['commit'])}" for b in group["behaviour_changes"]) + "</p>")
         for m, png in figures:
             body.append(f"<figure><img src='{html.escape(png)}' alt='{html.escape(m)}'><figcaption>{html.escape(m)}</figcaption></figure>")
     with open(os.path.join(a.out, "change_points.json"), "w") as f:

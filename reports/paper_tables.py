@@ -19,13 +19,16 @@ TABCOLSEP_PT = 4.0
 MAX_ROWS = 40  # \\footnotesize rows under a caption in a float of a 9 in text height, with room to spare
 
 LATEX_SPECIAL = {"\\": "\\textbackslash{}", "&": "\\&", "%": "\\%", "_": "\\_", "#": "\\#", "~": "$\\sim$",
-                 "[": "{[}", "]": "{]}", "$": "\\$", "{": "\\{", "}": "\\}", "^": "\\^{}"}
+                 "[": "{[}", "]": "{]}", "$": "\\$", "{": "\\{", "}": "\\}", "^": "\\^{}",
+                 "<": "\\textless{}", ">": "\\textgreater{}", "|": "\\textbar{}"}
 
 
 def escape(s):
-    """Text for LaTeX: each special character replaced once (labels and reasons are free text)."""
+    """Text for LaTeX: each special character replaced once (labels and reasons are free text), on one line
+    (a line break or control character inside a cell would end it or the paragraph)."""
     import re
-    return re.sub(r"[\\&%_#~\[\]$\{\}^]", lambda m: LATEX_SPECIAL[m.group(0)], s)
+    s = " ".join("".join(c if c.isprintable() else " " for c in str(s)).split())
+    return re.sub(r"[\\&%_#~\[\]$\{\}^<>|]", lambda m: LATEX_SPECIAL[m.group(0)], s)
 
 
 def sig(x):

@@ -453,14 +453,20 @@ def table_notes(cells):
     return ["Left out of comparisons (verdict not valid):"] + [excluded_note(c) for c in ex]
 
 
+def md_text(s):
+    """Free text (labels, scenes, reasons) for Markdown: shown as written, never as markup or HTML, on one line."""
+    s = html.escape(" ".join(str(s).split()), quote=False)
+    return re.sub(r"([\\`*\[\]|])", r"\\\1", s)  # '_' within a word is not emphasis: left readable
+
+
 def write_markdown(path, rows, caption, notes=()):
     lines = ["| " + " | ".join(TABLE_HEAD) + " |",
              "|" + "|".join(["---"] * TABLE_LEFT + ["---:"] * (len(TABLE_HEAD) - TABLE_LEFT)) + "|"]
     for r in rows:
-        lines.append("| " + " | ".join(x.replace("|", "\\|") for x in r) + " |")
+        lines.append("| " + " | ".join(md_text(x) for x in r) + " |")
     lines += ["", caption, ""]
     if notes:
-        lines += [notes[0], ""] + [f"- {n}" for n in notes[1:]] + [""]
+        lines += [notes[0], ""] + [f"- {md_text(n)}" for n in notes[1:]] + [""]
     with open(path, "w") as f:
         f.write("\n".join(lines))
 
@@ -519,7 +525,9 @@ COLUMN_IN, PAGE_IN, MIN_FONT_PT = 3.5, 7.0, 7
 STYLE = {"font.size": 8, "axes.titlesize": 8, "axes.labelsize": 8, "xtick.labelsize": 7, "ytick.labelsize": 7,
          "legend.fontsize": 7, "figure.titlesize": 8, "axes.grid": True, "grid.alpha": 0.3, "grid.linewidth": 0.5,
          "lines.markersize": 3.5, "lines.linewidth": 1.0, "axes.linewidth": 0.6, "pdf.fonttype": 42,
-         "savefig.dpi": 200, "legend.frameon": False}
+         "savefig.dpi": 200, "legend.frameon": False,
+         # Labels, scenes and commits are data, never TeX: a label "$\frac{$" is drawn as written.
+         "text.parse_math": False}
 LEFT_OUT = " Plants judged degenerate or not applicable are left out (listed under the table)."
 
 
@@ -999,6 +1007,16 @@ def slug(text):
     return re.sub(r"[^A-Za-z0-9._-]+", "_", text).strip("_") or "trial"
 
 
+def own_path(base, name):
+    """BASE/NAME if NAME is a relative path that stays inside BASE once symlinks are resolved, else None:
+    a results file names its own renders, and the report copies or links nothing else."""
+    if not isinstance(name, str) or not name or os.path.isabs(name) or "\0" in name:
+        return None
+    root = os.path.realpath(base)
+    real = os.path.realpath(os.path.join(root, name))
+    return os.path.join(base, name) if real != root and os.path.commonpath([root, real]) == root else None
+
+
 def copy_grids(doc, base, out, pages):
     """The grids the results file names, copied beside the page, with their cells' links to trial pages (from
     IMAGE.map.json beside each image, as percentages of the image so that they scale with it)."""
@@ -1012,8 +1030,11 @@ def copy_grids(doc, base, out, pages):
     names += [(f, f"{scene}: every algorithm entry", True) for scene, f in renders.get("grid_per_scene", {}).items()]
     grids = []
     for name, title, per_scene in names:
-        src = os.path.join(base, name)
-        if not os.path.exists(src):
+        src = own_path(base, name)
+        if src is None or not src.endswith(".png"):
+            print(f"report: warning: render grid {name!r} is not a PNG inside {base}; left out", file=sys.stderr)
+            continue
+        if not os.path.isfile(src):
             print(f"report: warning: render grid {src} is missing", file=sys.stderr)
             continue
         os.makedirs(os.path.join(out, "renders"), exist_ok=True)
@@ -1044,8 +1065,9 @@ def grid_html(g):
 def trial_dir_of(c, base):
     """The trial's directory in the results directory: where its render (or record) is."""
     render = c.t.get("render") or {}
-    if render.get("png"):
-        return os.path.dirname(os.path.join(base, render["png"]))
+    png = own_path(base, render.get("png"))
+    if png:
+        return os.path.dirname(png)
     d = os.path.join(base, "trials", *c.id().split("/"))
     return d if os.path.isdir(d) else None
 
@@ -1068,8 +1090,8 @@ def write_trial_pages(cells, base, out):
         verdict = VERDICT_WORDS.get(c.verdict, c.verdict) if c.verdict else "not judged"
         parts.append(f"<p>Status: {e(c.status)}. Verdict: {e(verdict)}" +
                      (f" ({e('; '.join(c.reasons))})" if c.reasons else "") + ".</p>")
-        if render.get("png") and render.get("status") == "ok":
-            png = os.path.join(base, render["png"])
+        png = own_path(base, render.get("png"))
+        if png and render.get("status") == "ok":
             shares = ", ".join(f"{label} {render[k]:.3f}" for k, label in
                                (("visible_share", "plant points visible"), ("plant_pixel_share", "plant pixels"))
                                if isinstance(render.get(k), (int, float)))

@@ -1,7 +1,10 @@
 #include "harness/record/files.hpp"
 
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cstring>
@@ -14,6 +17,7 @@
 
 #include "core/errors.hpp"
 #include "core/json_util.hpp"
+#include "core/utf8.hpp"
 
 namespace growbench {
 
@@ -31,7 +35,18 @@ bool is_special_file(const std::string& path) {
 
 AtomicFile::AtomicFile(std::string path)
     : path_(std::move(path)), tmp_(is_special_file(path_) ? path_ : path_ + ".tmp"), f_(nullptr, &std::fclose) {
-  f_.reset(std::fopen(tmp_.c_str(), "wb"));
+  if (tmp_ == path_) {
+    f_.reset(std::fopen(tmp_.c_str(), "wb"));  // a device or pipe the user named: written in place
+  } else {
+    // A fresh file, never one found there: whatever lies at PATH.tmp (a stale one, or a symlink planted to
+    // redirect the write) is removed, and the new one is created exclusively, not following a symlink.
+    ::unlink(tmp_.c_str());
+    const int fd = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+    if (fd >= 0) {
+      f_.reset(::fdopen(fd, "wb"));
+      if (!f_) ::close(fd);
+    }
+  }
   if (!f_) throw InputError(fmt::format("{}: cannot open for writing: {}", path_, std::strerror(errno)));
 }
 
@@ -111,7 +126,23 @@ std::string safe_name(std::string s) {
   for (auto& c : s)
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.' || c == '=' || c == ','))
       c = '_';
+  if (!s.empty() && s.find_first_not_of('.') == std::string::npos) s.assign(s.size(), '_');
   return s;
+}
+
+std::string cell_id_problem(const std::string& id) {
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t end = std::min(id.find('/', start), id.size());
+    const std::string part = id.substr(start, end - start);
+    if (part.empty() || safe_name(part) != part)
+      return fmt::format(
+          "cell id \"{}\" is not a path of plain names inside the folder (expected LABEL/SCENE/sSEED, "
+          "each of [A-Za-z0-9-_.=,], none empty, '.' or '..')",
+          escape_utf8(id, true));
+    if (end == id.size()) return "";
+    start = end + 1;
+  }
 }
 
 std::string read_input_file(const std::string& path) {

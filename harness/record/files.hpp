@@ -60,8 +60,14 @@ inline std::uint64_t write_file_atomic(const std::string& path, std::string_view
 void rename_into_place(const std::string& tmp, const std::string& path);
 
 // `s` with every character outside [A-Za-z0-9-_.=,] replaced by '_': a file or folder name for a label,
-// scene or sweep value.
+// scene or sweep value. A name of dots only ("..") becomes underscores, so that it names a folder inside
+// its parent, never the parent itself.
 std::string safe_name(std::string s);
+
+// Why `id` cannot name a cell's folder under trials/, or "" if it can: a cell id is safe_name parts
+// joined by '/' (LABEL/SCENE/sSEED[/SWEEP]), none empty or made of dots, so that no results file, journal
+// or baseline can point a writer outside its folder.
+std::string cell_id_problem(const std::string& id);
 
 // The whole of an input file: InputError "PATH: cannot open: REASON", "PATH: is a directory, expected a
 // file" (or a device), or "PATH: cannot read: REASON". A pipe is read to its end.

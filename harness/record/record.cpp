@@ -416,9 +416,16 @@ void csv_fields(const T& v, const std::string& prefix, CsvRow& out) {
   });
 }
 
+// Text as a spreadsheet shows it rather than runs it: one starting with = + - @ (or a tab or CR) would be
+// read as a formula, so it gets a leading apostrophe, which spreadsheets take as "text".
+std::string csv_text(std::string s) {
+  if (!s.empty() && std::string_view("=+-@\t\r").find(s.front()) != std::string_view::npos) s.insert(0, 1, '\'');
+  return s;
+}
+
 // A value as the JSON has it, so that the CSV and results.json agree digit for digit.
 std::string csv_scalar(const json& j) {
-  return j.is_string() ? j.get<std::string>() : j.dump(-1, ' ', false, json::error_handler_t::replace);
+  return j.is_string() ? csv_text(j.get<std::string>()) : j.dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
 // Each scalar reachable from `v` as a column named by its dotted path; arrays are not columns, but for a
@@ -428,7 +435,7 @@ void csv_cells(const T& v, const std::string& name, CsvRow& out) {
   if constexpr (is_optional<T>::value) {
     if (v) csv_cells(*v, name, out);
   } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
-    if (!v.empty()) out.emplace_back(name, fmt::format("{}", fmt::join(v, "; ")));  // a list of reasons, say
+    if (!v.empty()) out.emplace_back(name, csv_text(fmt::format("{}", fmt::join(v, "; "))));  // reasons, say
   } else if constexpr (is_vector<T>::value || is_std_array<T>::value) {
   } else if constexpr (is_string_map<T>::value) {
     for (const auto& [k, x] : v) csv_cells(x, name + "." + k, out);
@@ -643,7 +650,11 @@ TrialRecord read_trial_record(const std::string& path) {
 ResultsFile results_from_json(const json& j, const std::string& path) {
   check_kind(j, kResultsKind, path, "growbench results file");
   check_version(j, path);
-  return from_json<ResultsFile>(j, path);
+  ResultsFile r = from_json<ResultsFile>(j, path);
+  for (std::size_t i = 0; i < r.trials.size(); ++i)
+    if (const std::string why = cell_id_problem(r.trials[i].id); !why.empty())
+      throw InputError(fmt::format("{}: at /trials/{}/id: {}", path, i, why));
+  return r;
 }
 
 ResultsFile read_results(const std::string& path) {
@@ -680,6 +691,8 @@ std::vector<JournalEntry> read_journal(const std::string& path) {
       continue;  // a line cut short by a kill: its trial runs again
     }
     out.push_back(from_json<JournalEntry>(j, fmt::format("{}:{}", path, line_no)));
+    if (const std::string why = cell_id_problem(out.back().id); !why.empty())
+      throw InputError(fmt::format("{}:{}: at /id: {}", path, line_no, why));
   }
   return out;
 }

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/errors.hpp"
+#include "core/json_util.hpp"
 #include "harness/record/files.hpp"
 #include "harness/record/record.hpp"
 #include "test_util.hpp"
@@ -356,6 +357,54 @@ TEST(Record, CsvColumnsAreJsonPaths) {
   EXPECT_EQ(lines[2].find("fedcba9876543210,"), lines[2].find("fedcba9876543210,"));
   EXPECT_EQ(lines[2].find("fedcba9876543210"), std::string::npos) << "a failed row shows no plant: " << lines[2];
   EXPECT_NE(lines[2].find("\"signal 11, \"\"SIGSEGV\"\"\""), std::string::npos) << lines[2];
+}
+
+// A label or message that a spreadsheet would run as a formula is written as text; numbers stay numbers.
+TEST(Record, CsvTextThatLooksLikeAFormulaIsWrittenAsText) {
+  ResultsFile r = small_results();
+  r.trials[0].label = "=HYPERLINK(\"http://x\")";
+  r.trials[0].scene = "@SUM(A1)";
+  r.trials[0].results.plant->metrics = json{{"coverage", -0.5}, {"note", "-2+3"}};
+  const std::string csv = results_csv(r);
+  EXPECT_NE(csv.find(",\"'=HYPERLINK(\"\"http://x\"\")\","), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",'@SUM(A1),"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",'-2+3"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",-0.5"), std::string::npos) << csv;
+  EXPECT_EQ(csv.find(",="), std::string::npos) << csv;
+  EXPECT_EQ(csv.find(",@"), std::string::npos) << csv;
+}
+
+// Every cell id a results file or journal gives names a folder inside it: render and report write there.
+TEST(Record, ACellIdThatLeavesItsFolderIsRefused) {
+  EXPECT_EQ(cell_id_problem("a/wall/s1"), "");
+  EXPECT_EQ(cell_id_problem("spacecol/wall/s2/point_count=10,radius=0.5"), "");
+  for (const char* id :
+       {"../../s1", "a/../s1", "/etc/s1", "a//s1", "a/./s1", "a/wall/", "", "a/w all/s1", "a/wall\n#x/s1"})
+    EXPECT_NE(cell_id_problem(id), "") << id;
+  EXPECT_EQ(safe_name(".."), "__");
+  EXPECT_EQ(safe_name("."), "_");
+  EXPECT_EQ(safe_name(""), "");
+  EXPECT_EQ(safe_name("../x"), ".._x");
+  const auto dir = test::temp_dir("cell_ids");
+  nlohmann::json j = to_json(small_results());
+  j["trials"][0]["id"] = "../../victim/s1";
+  const std::string path = test::write_text(dir / "results.json", j.dump());
+  EXPECT_EQ(test::error_of([&] { read_results(path); }),
+            path +
+                ": at /trials/0/id: cell id \"../../victim/s1\" is not a path of plain names inside the folder "
+                "(expected LABEL/SCENE/sSEED, each of [A-Za-z0-9-_.=,], none empty, '.' or '..')");
+}
+
+// A symlink planted where a file's temporary copy goes does not redirect the write: the link is replaced,
+// and its target is left alone.
+TEST(Record, AWriteDoesNotFollowALinkPlantedAtItsTemporaryName) {
+  const auto dir = test::temp_dir("planted_tmp");
+  const std::string victim = test::write_text(dir / "victim.txt", "untouched");
+  std::filesystem::create_symlink(victim, dir / "results.json.tmp");
+  write_file_atomic((dir / "results.json").string(), "{}", 2);
+  EXPECT_EQ(read_text_file(victim), "untouched");
+  EXPECT_EQ(read_text_file((dir / "results.json").string()), "{}");
+  EXPECT_FALSE(std::filesystem::exists(std::filesystem::symlink_status(dir / "results.json.tmp")));
 }
 
 // A spec made in code is held to the declared ranges, as the command line and suite files are.

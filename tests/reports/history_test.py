@@ -75,5 +75,29 @@ if len(sys.argv) == 3:
     check(os.path.exists(os.path.join(work, "plot", "test_cpu_r_-2t", "t", "growth_wall_s.png")), "the figure")
     check(os.path.exists(os.path.join(work, "plot", "index.html")), "index.html")
 
+    # Hostile history files (written by hand, not by history add): a machine and suite that would lead out
+    # of --out, commits and a cell carrying HTML and TeX. Nothing is written outside --out, nothing is
+    # injected into index.html, and matplotlib draws the TeX as text rather than failing on it.
+    escape_to = os.path.join(work, "outside")
+    hostile = os.path.join(work, "hostile", "m", "s")
+    os.makedirs(hostile)
+    for i, commit in enumerate(["<script>alert(1)</script>", "$\\frac{$", "<img src=x onerror=alert(2)>"]):
+        doc = {"kind": "growbench-history", "schema_version": 1, "commit": commit, "commit_time": i,
+               "machine": "../..", "suite": escape_to, "runs": [{"date": f"d{i}", "cells": {
+                   "$x^{$/<b>/s1": {"growth_wall_s": 0.01 * (1 + i), "geometry_hash": f"h{i}"}}}]}
+        json.dump(doc, open(os.path.join(hostile, f"c{i}.json"), "w"))
+    plot = os.path.join(work, "hostile_out", "plot")
+    out = subprocess.run([growbench, "history", "plot", "--dir", os.path.join(work, "hostile"), "--out", plot],
+                         capture_output=True, text=True)
+    check(out.returncode == 0, f"history plot of hostile names: {out.stdout}{out.stderr}")
+    check(os.listdir(os.path.join(work, "hostile_out")) == ["plot"], "nothing beside --out")
+    check(not os.path.exists(escape_to), "nothing at the absolute suite name")
+    page = open(os.path.join(plot, "index.html"), encoding="utf-8").read()
+    check("<script>" not in page and "<img src=x" not in page and "<b>" not in page,
+          "no element injected into index.html")
+    check("at &lt;img src=x onerror=alert(2)&gt;" in page, "the commit is shown, escaped")
+    written = [os.path.relpath(os.path.join(d, f), plot) for d, _, fs in os.walk(plot) for f in fs]
+    check(any(w.endswith("growth_wall_s.png") for w in written), f"the hostile group's figure: {written}")
+
 print("history tests:", "FAILED" if failures else "OK")
 sys.exit(1 if failures else 0)

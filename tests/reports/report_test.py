@@ -155,8 +155,13 @@ class Tables(unittest.TestCase):
             report.write_markdown(os.path.join(d, "t.md"), rows, "c")
             md = read(os.path.join(d, "t.md")).splitlines()
             self.assertEqual(md[0].count("|"), len(report.TABLE_HEAD) + 1)
-            self.assertTrue(md[2].startswith("| ivy_luft | wall | 1 seed x 2 reps | - | 550.0 ms range [500.0 ms, "
-                                             "600.0 ms] |"), md[2])
+            self.assertTrue(md[2].startswith("| ivy_luft | wall | 1 seed x 2 reps | - | 550.0 ms range \\[500.0 ms, "
+                                             "600.0 ms\\] |"), md[2])
+        # Free text from a suite is shown as written: no HTML element, markup or line break gets through.
+        self.assertEqual(report.md_text("<script>x</script> | *a*\n`b`"),
+                         "&lt;script&gt;x&lt;/script&gt; \\| \\*a\\* \\`b\\`")
+        self.assertEqual(report.paper_tables.escape("$\\frac{$^\n\\end{table}<b>"),
+                         "\\$\\textbackslash{}frac\\{\\$\\^{} \\textbackslash{}end\\{table\\}\\textless{}b\\textgreater{}")
 
     def test_bad_results_are_clear_errors(self):
         with tempfile.TemporaryDirectory() as d:
@@ -425,6 +430,34 @@ class Page(unittest.TestCase):
         page, _ = self.write(document([trial("a", "wall", 1, [0.01], 1000)]))
         self.assertNotIn("machine-banner", page)
         self.assertNotIn("load average", page)
+
+    def test_a_results_file_names_only_its_own_renders(self):
+        # Grids and a trial's render named outside the results folder (absolute, '..', a symlink out) are left
+        # out, neither copied nor linked; the folder's own grid is copied. A label of TeX is drawn as text.
+        with tempfile.TemporaryDirectory() as d:
+            res = os.path.join(d, "res")
+            os.makedirs(res)
+            write(os.path.join(d, "secret.png"), "secret")
+            write(os.path.join(res, "grid.png"), "grid")
+            os.symlink(os.path.join(d, "secret.png"), os.path.join(res, "link.png"))
+            t = trial("$\\frac{$", "wall", 1, [0.01], 1000)
+            t["render"] = {"png": "../secret.png", "status": "ok"}
+            doc = document([t, trial("b", "wall", 1, [0.02], 900)])
+            doc["renders"] = {"grid": "../secret.png", "grid_per_scene": {
+                "wall": "/etc/passwd", "ground": "link.png", "column": "grid.png", "rock": "trials"}}
+            path = os.path.join(res, "results.json")
+            with open(path, "w") as f:
+                json.dump(doc, f)
+            out = os.path.join(d, "out")
+            report.write_report(doc, path, out, ["png"])
+            self.assertEqual(os.listdir(os.path.join(out, "renders")), ["grid.png"])
+            pages = [read(os.path.join(out, "index.html"))] + [
+                read(os.path.join(out, "trials", f)) for f in os.listdir(os.path.join(out, "trials"))]
+            for page in pages:
+                self.assertNotIn("secret", page)
+                self.assertNotIn("passwd", page)
+                self.assertNotIn("link.png", page)
+            self.assertTrue(os.path.exists(os.path.join(out, "fig-time-vs-size.png")))
 
     def test_noisy_repetitions_banner(self):
         steady, noisy = [0.010, 0.0101, 0.0102], [0.01, 0.02, 0.03]  # CV 1%, 50%
