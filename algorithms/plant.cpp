@@ -10,6 +10,8 @@
 #include <fmt/format.h>
 #include <xxhash.h>
 
+#include "scenes/scene.hpp"
+
 namespace growbench {
 
 const char* to_string(OrganKind k) {
@@ -133,18 +135,24 @@ std::string Plant::geometry_hash() const {
 }
 
 std::string Plant::validate() const {
-  auto finite = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+  // Within the scene's bounds, so that every query, mesher and exporter takes them (NaN fails too).
+  auto near = [](const glm::vec3& v) { return glm::all(glm::lessThanEqual(glm::abs(v), glm::vec3(kMaxCoordinate))); };
+  auto at = [](const glm::vec3& v) { return fmt::format("({}, {}, {})", v.x, v.y, v.z); };
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     const auto& n = nodes[i];
-    if (!finite(n.position)) return fmt::format("node {} has a non-finite position", i);
-    if (!std::isfinite(n.radius) || n.radius < 0.0f) return fmt::format("node {} has radius {}", i, n.radius);
+    if (!near(n.position))
+      return fmt::format("node {} lies at {}, not within {:g} m of the origin", i, at(n.position), kMaxCoordinate);
+    if (!(n.radius >= 0.0f && n.radius <= kMaxCoordinate)) return fmt::format("node {} has radius {}", i, n.radius);
     if (n.parent != kNoParent && (n.parent < 0 || static_cast<std::size_t>(n.parent) >= i))
       return fmt::format("node {} has parent {} (parents must precede children)", i, n.parent);
   }
   for (std::size_t i = 0; i < organs.size(); ++i) {
     const auto& o = organs[i];
-    if (!finite(o.position) || !std::isfinite(o.size) || o.size < 0.0f)
-      return fmt::format("organ {} has a non-finite position or a bad size", i);
+    if (!near(o.position) || !(o.size >= 0.0f && o.size <= kMaxCoordinate))
+      return fmt::format("organ {} lies at {} with size {} (expected within {:g} m of the origin, size >= 0)", i,
+                         at(o.position), o.size, kMaxCoordinate);
+    if (!std::isfinite(o.stamp[0]) || !std::isfinite(o.stamp[1]) || !std::isfinite(o.stamp[2]))
+      return fmt::format("organ {} has a non-finite stamp", i);
     // Exporters and the mesher turn organs by this quaternion as a rotation: one that is not unit would
     // scale a meshed organ but only turn an instanced one. The tolerance covers float rounding.
     const glm::quat& q = o.orientation;
@@ -155,10 +163,15 @@ std::string Plant::validate() const {
       return fmt::format("organ {} refers to node {} of {}", i, o.node, nodes.size());
     if (o.shape != kKindShape && o.shape >= organ_shapes.size())
       return fmt::format("organ {} has shape {} of {}", i, o.shape, organ_shapes.size());
-    if (!finite(o.tint) || glm::any(glm::lessThan(o.tint, glm::vec3(0.0f))) ||
+    if (!near(o.tint) || glm::any(glm::lessThan(o.tint, glm::vec3(0.0f))) ||
         glm::any(glm::greaterThan(o.tint, glm::vec3(4.0f))))
       return fmt::format("organ {} has tint ({}, {}, {}) outside [0, 4]", i, o.tint.x, o.tint.y, o.tint.z);
   }
+  for (std::size_t i = 0; i < polygons.size(); ++i)
+    for (std::size_t k = 0; k < polygons[i].vertices.size(); ++k)
+      if (!near(polygons[i].vertices[k]))
+        return fmt::format("polygon {} vertex {} lies at {}, not within {:g} m of the origin", i, k,
+                           at(polygons[i].vertices[k]), kMaxCoordinate);
   if (organ_shapes.size() >= kKindShape)
     return fmt::format("{} organ shapes (at most {})", organ_shapes.size(), kKindShape - 1);
   for (std::size_t i = 0; i < organ_shapes.size(); ++i)
@@ -168,15 +181,19 @@ std::string Plant::validate() const {
     // A plain file name: renders hand it to POV-Ray, which reads only below its working directory.
     if (d.image.empty() || d.image.find_first_of("/\\\"") != std::string::npos || d.image.front() == '.')
       return fmt::format("decal {} has image name '{}' (expected a plain file name)", i, d.image);
-    if (d.mesh < kPlanarDecal || !finite(d.origin) || !finite(d.u_axis) || !finite(d.v_axis))
+    if (d.mesh < kPlanarDecal || !near(d.origin) || !near(d.u_axis) || !near(d.v_axis))
       return fmt::format("decal {} has mesh {} or a non-finite mapping", i, d.mesh);
   }
   if (!node_groups.empty() && node_groups.size() != nodes.size())
     return fmt::format("{} node groups for {} nodes", node_groups.size(), nodes.size());
-  for (const auto& a : node_attributes)
+  for (const auto& a : node_attributes) {
     if (a.components < 1 || a.values.size() != nodes.size() * static_cast<std::size_t>(a.components))
       return fmt::format("attribute '{}' has {} values for {} nodes of {} components", a.name, a.values.size(),
                          nodes.size(), a.components);
+    const auto v = std::find_if_not(a.values.begin(), a.values.end(), [](float x) { return std::isfinite(x); });
+    if (v != a.values.end())
+      return fmt::format("attribute '{}' has the non-finite value {} at {}", a.name, *v, v - a.values.begin());
+  }
   if (!node_tubes.empty() && node_tubes.size() != nodes.size())
     return fmt::format("{} node tubes for {} nodes", node_tubes.size(), nodes.size());
   for (std::size_t i = 0; i < node_tubes.size(); ++i) {

@@ -126,6 +126,25 @@ Aabb Scene::bounds() const {
   return b;
 }
 
+std::string Scene::out_of_bounds() const {
+  const auto far = [](const glm::vec3& p) {
+    return !(glm::all(glm::lessThanEqual(glm::abs(p), glm::vec3(kMaxCoordinate))));  // NaN is far too
+  };
+  const auto at = [](const glm::vec3& p) { return fmt::format("({}, {}, {})", p.x, p.y, p.z); };
+  for (const auto& m : meshes)
+    for (std::size_t i = 0; i < m.vertices.size(); ++i)
+      if (far(m.vertices[i])) return fmt::format("mesh '{}' vertex {} at {}", m.name, i + 1, at(m.vertices[i]));
+  for (std::size_t i = 0; i < seeds.size(); ++i)
+    if (far(seeds[i].position)) return fmt::format("seed {} at {}", i + 1, at(seeds[i].position));
+  if (light.kind == Light::Kind::Point && far(light.position))
+    return fmt::format("the point light at {}", at(light.position));
+  if (envelope && (far(envelope->bounds().min) || far(envelope->bounds().max))) return "the envelope";
+  for (std::size_t i = 0; i < zones.size(); ++i)
+    if (far(zones[i].shape.bounds().min) || far(zones[i].shape.bounds().max)) return fmt::format("zone {}", i + 1);
+  if (far(camera.position) || far(camera.look_at)) return "the camera";
+  return "";
+}
+
 bool Scene::has_climbable() const {
   for (const auto& m : meshes)
     if (m.climbable) return true;

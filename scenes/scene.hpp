@@ -15,6 +15,11 @@
 
 namespace growbench {
 
+// The farthest a scene's coordinates may lie from the origin, in metres. Beyond it a float keeps no
+// useful precision for growth, and far beyond it Embree refuses the rays (it aborts at about 1.8e18);
+// scene files, meshes, lights and --seed-at are refused past it, naming what lies there.
+inline constexpr float kMaxCoordinate = 1e9f;
+
 struct Aabb {
   glm::vec3 min{std::numeric_limits<float>::max()};
   glm::vec3 max{-std::numeric_limits<float>::max()};
@@ -117,6 +122,8 @@ struct Scene {
   Camera camera;
 
   [[nodiscard]] Aabb bounds() const;
+  // What lies beyond kMaxCoordinate ("seed 2 at (0, 1e+19, 0)"), or "" when nothing does.
+  [[nodiscard]] std::string out_of_bounds() const;
   // Whether any mesh is climbable: a scene of ground alone (envelope) offers nothing to climb.
   [[nodiscard]] bool has_climbable() const;
   [[nodiscard]] std::size_t triangle_count() const;

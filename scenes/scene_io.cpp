@@ -248,7 +248,8 @@ class JsonScene : public JsonPathReader {
   }
   glm::vec3 vec3(const json& j, const std::string& path) const {
     if (!j.is_array() || j.size() != 3) fail(path, fmt::format("expected an array of three numbers, got {}", j.dump()));
-    return {number(j[0], path + "/0"), number(j[1], path + "/1"), number(j[2], path + "/2")};
+    const float m = kMaxCoordinate;
+    return {number(j[0], path + "/0", -m, m), number(j[1], path + "/1", -m, m), number(j[2], path + "/2", -m, m)};
   }
   std::string string(const json& j, const std::string& path) const {
     if (!j.is_string()) fail(path, fmt::format("expected a string, got {}", j.dump()));
@@ -530,6 +531,11 @@ Scene load_scene_in(const std::string& spec, const std::vector<std::string>& ass
     for (const auto& a : assignments) p.set_assignment(a);
     s = it->build(p);
   }
+  if (const std::string far = s.out_of_bounds(); !far.empty())
+    throw InputError(
+        fmt::format("scene '{}': {} lies beyond {:g} m of the origin; expected coordinates within "
+                    "[-{:g}, {:g}] (a mesh in other units can be scaled by a scene file's 'transform')",
+                    spec, far, kMaxCoordinate, kMaxCoordinate, kMaxCoordinate));
   s.source = spec;
   return s;
 }

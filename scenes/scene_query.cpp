@@ -20,6 +20,15 @@ namespace growbench {
 
 namespace {
 
+// Embree asserts (and aborts the process) on a ray whose origin or direction has a component beyond
+// FLT_LARGE (about 1.8e18) or NaN, or whose interval is NaN. Such a ray is answered here, without
+// Embree, as one that hits nothing: no input, a plugin's or a grammar's, can end the process.
+bool embree_takes(const glm::vec3& o, const glm::vec3& d, float tmin, float tmax) {
+  constexpr float large = 1.8e18f;
+  const glm::vec3 big = glm::max(glm::abs(o), glm::abs(d));
+  return big.x <= large && big.y <= large && big.z <= large && !std::isnan(tmin) && !std::isnan(tmax);
+}
+
 RTCRay make_ray(const glm::vec3& o, const glm::vec3& d, float tmin, float tmax) {
   RTCRay ray{};
   ray.org_x = o.x;
@@ -112,6 +121,7 @@ struct BvhScene {
   BvhScene& operator=(const BvhScene&) = delete;
 
   RayHit ray(const glm::vec3& o, const glm::vec3& d, float tmin, float tmax) const {
+    if (!embree_takes(o, d, tmin, tmax)) return {};
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRayHit rh{};
@@ -131,6 +141,7 @@ struct BvhScene {
   }
 
   bool occluded(const glm::vec3& o, const glm::vec3& d, float tmin, float tmax) const {
+    if (!embree_takes(o, d, tmin, tmax)) return false;
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRay ray = make_ray(o, d, tmin, tmax);
@@ -495,6 +506,7 @@ void BoxIndex::visit_segment(const glm::vec3& o, const glm::vec3& d, Visitor vis
   // A point is a ray of length zero. Its direction (1, 1, 1) has reciprocal 1, so the slab tests
   // subtract exactly and a box holding p is never missed.
   const bool point = d == glm::vec3(0.0f);
+  if (!embree_takes(o, d, 0.0f, 1.0f)) return;
   RTCRay ray = make_ray(o, point ? glm::vec3(1.0f) : d, 0.0f, point ? 0.0f : 1.0f);
   rtcOccluded1(impl_->scene, &c.context, &ray);
 }
@@ -574,6 +586,7 @@ Occluder::Occluder(void* device, std::vector<Capsule> capsules, std::vector<Tria
 Occluder::~Occluder() = default;
 
 bool Occluder::occluded(const glm::vec3& o, const glm::vec3& d, float tmax, std::uint32_t ignore, float tmin) const {
+  if (!embree_takes(o, d, tmin, tmax)) return false;
   OccluderContext c{{}, ignore, &owners_};
   rtcInitIntersectContext(&c.context);
   RTCRay ray = make_ray(o, d, tmin, tmax);
@@ -645,6 +658,8 @@ bool SceneQuery::occluded(const glm::vec3& origin, const glm::vec3& dir, float t
 
 bool SceneQuery::light_visible(const glm::vec3& p, float bias) const {
   const glm::vec3 d = scene_.light.towards(p);
+  // A point Embree cannot take (not finite, or far beyond any scene) is in no light.
+  if (!embree_takes(p, d, bias, scene_.light.distance(p))) return false;
   return !occluded(p, d, scene_.light.distance(p), bias);
 }
 

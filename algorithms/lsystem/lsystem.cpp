@@ -455,9 +455,10 @@ class LSystem final : public GrowthAlgorithm {
   void finish() override {
     if (const std::string bad = plant_.validate(); !bad.empty()) {
       const std::string grammar = setup_.params.text("grammar");
-      throw InputError(fmt::format(
-          "L-system{}: the plant its rules drew is invalid ({}): an expression divided by zero or overflowed",
-          grammar.empty() ? "" : fmt::format(" grammar '{}'", grammar), bad));
+      throw InputError(
+          fmt::format("L-system{}: the plant its rules drew is invalid ({}): an expression divided by zero, overflowed "
+                      "or drew too far",
+                      grammar.empty() ? "" : fmt::format(" grammar '{}'", grammar), bad));
     }
   }
 

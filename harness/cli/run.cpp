@@ -37,7 +37,7 @@ struct RunArgs {
 
 // X,Y,Z as a point, as given (the trial rounds it to the float a scene's positions have).
 std::array<double, 3> parse_point(const std::string& text) {
-  Params p("--seed-at", {{"at", ParamType::Vec3, glm::dvec3(0.0), -1e9, 1e9, "m", "", {}}});
+  Params p("--seed-at", {{"at", ParamType::Vec3, glm::dvec3(0.0), -kMaxCoordinate, kMaxCoordinate, "m", "", {}}});
   p.set("at", text);
   const glm::dvec3 v = p.vec3("at");
   return {v.x, v.y, v.z};

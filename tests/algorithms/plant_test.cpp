@@ -38,7 +38,18 @@ TEST(Plant, LengthHashAndValidation) {
   EXPECT_NE(p.validate().find("node 3"), std::string::npos);
   Plant q = y_plant();
   q.nodes[2].position.y = std::numeric_limits<float>::quiet_NaN();
-  EXPECT_NE(q.validate().find("non-finite"), std::string::npos);
+  EXPECT_EQ(q.validate(), "node 2 lies at (0, nan, 0), not within 1e+09 m of the origin");
+  // Finite but beyond the scene's bounds: Embree aborted the process on rays from there.
+  q.nodes[2].position.y = 2e18f;
+  EXPECT_EQ(q.validate(), "node 2 lies at (0, 2e+18, 0), not within 1e+09 m of the origin");
+  q = y_plant();
+  q.polygons.push_back({{{0, 0, 0}, {1, 0, 0}, {0, std::numeric_limits<float>::quiet_NaN(), 0}}});
+  EXPECT_EQ(q.validate(), "polygon 0 vertex 2 lies at (0, nan, 0), not within 1e+09 m of the origin");
+  q = y_plant();
+  q.node_attributes.push_back({"Cd", 1, std::vector<float>(q.nodes.size(), 0.5f)});
+  EXPECT_EQ(q.validate(), "");
+  q.node_attributes[0].values[1] = std::numeric_limits<float>::infinity();
+  EXPECT_EQ(q.validate(), "attribute 'Cd' has the non-finite value inf at 1");
   Plant r = y_plant();
   r.organs.push_back({{0, 0, 0}, {1, 0, 0, 0}, 0.1f, OrganKind::Leaf, 9});
   EXPECT_NE(r.validate().find("organ 0"), std::string::npos);

@@ -171,6 +171,14 @@ TEST(JsonScene, ErrorsNameFileAndJsonPath) {
        "at /light/type: unknown light type 'moon'"},
       {R"({"schema_version": 1, "meshes": [{"obj": "nope.obj"}]})", "at /meshes/0/obj:"},
       {"{\n  \"schema_version\": 1,\n  \"meshes\": [,]\n}", "s.json:3:"},
+      // Coordinates beyond kMaxCoordinate: Embree aborted on rays from a seed at 1e19 or to a light at 1e30.
+      {R"({"schema_version": 1, "base": "wall", "seeds": [{"position": [0, 1e19, 0]}]})",
+       "at /seeds/0/position/1: expected a number in [-1000000000, 1000000000], got 1e+19"},
+      {R"({"schema_version": 1, "base": "wall", "light": {"type": "point", "position": [0, 1e30, 0]}})",
+       "at /light/position/1: expected a number in [-1000000000, 1000000000]"},
+      {R"({"schema_version": 1, "meshes": [{"box": {"min": [0,0,0], "max": [1,1,1]}, "transform": {"scale": 1e12}}],
+          "seeds": [{"position": [0,0,0]}]})",
+       "vertex 2 at (1000000000000, 0, 0) lies beyond 1e+09 m of the origin"},
   };
   for (const auto& c : cases) {
     const std::string f = test::write_text(dir / "s.json", c.text);

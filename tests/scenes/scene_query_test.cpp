@@ -333,6 +333,26 @@ TEST(SceneQuery, OcclusionBehindAWall) {
   EXPECT_FALSE(q.light_visible({0, 1, -0.15f}));
 }
 
+// Embree aborts the process on a ray it cannot take (a component beyond about 1.8e18, or NaN): such a
+// ray hits nothing, and such a point is in no light, whatever asked.
+TEST(SceneQuery, RaysEmbreeCannotTakeHitNothingInsteadOfAborting) {
+  const Scene s = load_scene("wall");
+  SceneQuery q(s, {.build_sdf = false});
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  for (const glm::vec3 o : {glm::vec3(0, 2e18f, 1), glm::vec3(nan, 1, 1), glm::vec3(0, 1, inf)}) {
+    EXPECT_FALSE(q.occluded(o, {0, 0, -1}));
+    EXPECT_FALSE(q.ray(o, {0, 0, -1}).hit);
+    EXPECT_FALSE(q.light_visible(o));
+  }
+  EXPECT_FALSE(q.ray({0, 1, 1}, {0, 0, -3e18f}).hit);
+  EXPECT_FALSE(q.ray({0, 1, 1}, {0, 0, -1}, nan).hit);
+  const auto occ = q.occluder({{{0, 1, 0.5f}, {1, 1, 0.5f}, 0.1f, 0.1f}}, {});
+  EXPECT_TRUE(occ->occluded({0.5f, 1, 1}, {0, 0, -1}, 2.0f));
+  EXPECT_FALSE(occ->occluded({0.5f, 2e18f, 1}, {0, 0, -1}, 2.0f));
+  // A far origin within Embree's range is still traced.
+  EXPECT_TRUE(q.occluded({0, 1, 1e6f}, {0, 0, -1}));
+}
+
 // The scan is sealed when it is loaded: Embree, the distance field and the inside test see one solid.
 TEST(SceneQuery, InsideOutsideOfTheSealedBunnyMatchesRayParity) {
   EXPECT_FALSE(load_obj(mesh_path("stanford-bunny")).is_closed())
