@@ -109,6 +109,16 @@ TriangleMesh load_obj(const std::string& path) {
     }
   }
   if (m.triangles.empty()) throw InputError(fmt::format("{}: the OBJ file has no faces", path));
+  // A mesh of nothing but lines and points has no surface to grow on, to climb or to render.
+  const auto has_area = [&](const glm::uvec3& t) {
+    const glm::dvec3 a(m.vertices[t.x]), b(m.vertices[t.y]), c(m.vertices[t.z]);
+    return glm::length(glm::cross(b - a, c - a)) > 0.0;
+  };
+  if (std::none_of(m.triangles.begin(), m.triangles.end(), has_area))
+    throw InputError(
+        fmt::format("{}: every face has zero area (its corners coincide or lie on one line); expected "
+                    "at least one face with an area",
+                    path));
   if (!every_face_uv) {
     m.uvs.clear();
     m.uv_triangles.clear();

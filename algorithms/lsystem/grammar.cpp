@@ -263,8 +263,15 @@ class LineParser {
     r.pred = std::move(preds[0]);
     r.has_context = !r.left.empty() || !r.right.empty();
 
+    // One name, one value: with A(x,x) the rule would read one of two arguments and drop the other.
     auto add_formals = [&](const Pattern& p) {
-      for (const auto& f : p.formals) r.formals.push_back(f);
+      for (const auto& f : p.formals) {
+        if (std::find(r.formals.begin(), r.formals.end(), f) != r.formals.end())
+          fail(line.column, fmt::format("the parameter name '{}' appears twice in the rule's predecessor and "
+                                        "contexts; expected a different name for each parameter",
+                                        f));
+        r.formals.push_back(f);
+      }
     };
     add_formals(r.pred);
     for (const auto& p : r.left) add_formals(p);

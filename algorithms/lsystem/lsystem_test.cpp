@@ -279,6 +279,9 @@ TEST(LSystemErrors, NameSourceLineColumnAndWhatWasExpected) {
   EXPECT_NE(err("A", "A = B(foo(1))").find("unknown function 'foo'"), std::string::npos);
   EXPECT_NE(err("A", "A = B(1,2,3,4,5,6)").find("at most 5"), std::string::npos);
   EXPECT_NE(err("A", "A = B : 2 + ").find("the probability"), std::string::npos);
+  // A repeated name bound two arguments to one name, silently: the rule grew with one of them.
+  EXPECT_NE(err("A(1,2)", "A(x,x) = F(x)").find("the parameter name 'x' appears twice"), std::string::npos);
+  EXPECT_NE(err("A(1)B(2)", "A(x) > B(x) = F(x)").find("'x' appears twice"), std::string::npos);
   EXPECT_NE(err("", "A = B").find("premise is empty"), std::string::npos);
 
   const auto dir = test::temp_dir("lsys-errors");

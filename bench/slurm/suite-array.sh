@@ -63,8 +63,13 @@ command -v sbatch > /dev/null || die "sbatch not found (this script submits Slur
 # The jobs run elsewhere (another node, OUT_DIR as their directory): absolute paths only.
 gb=$(cd "$(dirname "$gb")" && pwd)/$(basename "$gb")
 suite=$(cd "$(dirname "$suite")" && pwd)/$(basename "$suite")
+# Slurm reads --output as a pattern (%j, %a; a backslash stops it), and a control character would end the
+# lines of the script sbatch --wrap writes: the folder must name itself.
+unsafe_path() { [[ "$1" == *%* || "$1" == *\\* || "$1" =~ [[:cntrl:]] ]]; }
+! unsafe_path "$out" || die "OUT_DIR: '$out' holds '%', '\\' or a control character, which Slurm would read as part of a pattern; choose a folder name without them"
 mkdir -p "$out/logs"
 out=$(cd "$out" && pwd)
+! unsafe_path "$out" || die "OUT_DIR: its absolute path '$out' holds '%', '\\' or a control character, which Slurm would read as part of a pattern; run from a folder without them"
 
 # Single-quotes a word for the /bin/sh script that sbatch --wrap writes (any character is safe inside '').
 q() { printf "'%s'" "${1//\'/\'\\\'\'}"; }

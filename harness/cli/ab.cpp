@@ -47,7 +47,8 @@ Command add_ab(CLI::App& app) {
   cmd->add_option("--plugin-b", o.b_plugins,
                   "side B loads this plugin file instead of --plugin's and the suite's (repeatable): A/B of two "
                   "builds of one plugin");
-  cmd->add_option("-o,--out", o.out_dir, "output directory: ab.json and the trials (default: out/ab/SUITE)");
+  cmd->add_option("-o,--out", o.out_dir, "output directory: ab.json and the trials (default: out/ab/SUITE)")
+      ->check(path_named("an output folder"));
   cmd->add_option("--effect", o.effect, "the smallest median ratio B/A to detect")
       ->default_val(1.03)
       ->check(number_in(1, 100, true));

@@ -43,6 +43,9 @@ struct Command {
 // "-1", which CLI11 would wrap around to the largest value, is refused.
 CLI::Validator number_in(double lo, double hi, bool lo_open = false, bool zero_or = false);
 CLI::Validator integer_in(long long lo, unsigned long long hi);
+// A path given on the command line: not empty (run -o '' wrote into the current folder's default) and
+// without control characters, which no file name a report, a render or Slurm writes may carry.
+CLI::Validator path_named(const std::string& what);
 
 // Adds the option FLAGS bound to the trial spec's field KEY (harness/record/trial_spec.hpp), checked against
 // its declared range or names, with the declaration's doc as help unless `help` is given.

@@ -46,6 +46,17 @@ CLI::Validator integer_in(long long lo, unsigned long long hi) {
           "INTEGER in " + range};
 }
 
+CLI::Validator path_named(const std::string& what) {
+  return {[=](std::string& text) -> std::string {
+            if (text.empty()) return fmt::format("expected {}, got an empty name", what);
+            for (const char c : text)
+              if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+                return fmt::format("expected {} without control characters (a line break or a tab)", what);
+            return {};
+          },
+          "PATH"};
+}
+
 Outcome script_status(int status, const std::string& script) {
   if (status == exit_status(Outcome::ok)) return Outcome::ok;
   if (status == exit_status(Outcome::invalid_input)) return Outcome::invalid_input;

@@ -30,7 +30,9 @@ Command add_history(CLI::App& app) {
   auto* plot = cmd->add_subcommand(
       "plot", "Plot every metric over commits per machine and suite, change points marked (PNG, PDF, index.html)");
   plot->add_option("--dir", a->dir, "the history directory")->default_val("out/history");
-  plot->add_option("-o,--out", a->out, "output directory")->default_val("out/history-report");
+  plot->add_option("-o,--out", a->out, "output directory")
+      ->check(path_named("an output folder"))
+      ->default_val("out/history-report");
   return {cmd, [a, add] {
             if (*add) {
               fmt::print("appended to {}\n", history_add(a->results, a->dir, a->machine));

@@ -3,6 +3,7 @@
 // outcomes into exit statuses (core/outcome.hpp, README "Exit status"): bad input and command-line errors 2,
 // anything else, being a bug, 3 with a request for a report.
 #include <exception>
+#include <functional>
 #include <new>
 
 #include <CLI/CLI.hpp>
@@ -54,7 +55,18 @@ int main(int argc, char** argv) {
   try {
     CLI::App app{"growbench: grow, measure and compare procedural plant growth algorithms on standard scenes"};
     app.require_subcommand(1);
-    app.set_version_flag("--version", "growbench 0.1.0");
+    app.set_version_flag("--version", std::function<std::string()>(gb::version_line));
+    // Every error the parser finds reads as the commands' own do, and names the help to read.
+    app.failure_message([](const CLI::App* a, const CLI::Error& e) {
+      std::string help = "growbench";
+      for (const CLI::App* sub = a; sub;) {
+        const auto chosen = sub->get_subcommands();
+        if (chosen.empty()) break;
+        sub = chosen.front();
+        help += " " + sub->get_name();
+      }
+      return fmt::format("growbench: error: {}\nRun `{} --help` for more information.\n", e.what(), help);
+    });
     // In the order --help lists them (a braced list is evaluated in order).
     const cli::Command commands[] = {cli::add_list(app),    cli::add_scenes(app),   cli::add_run(app),
                                      cli::add_suite(app),   cli::add_history(app),  cli::add_render(app),

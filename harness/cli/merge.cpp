@@ -25,7 +25,16 @@ struct MergeArgs {
 
 Outcome merge_shards(const MergeArgs& a) {
   std::vector<ResultsFile> shards;
-  for (const auto& f : a.inputs) shards.push_back(read_results(f));
+  for (const auto& f : a.inputs) {
+    const nlohmann::json j = read_json_file(f);
+    // A file without its shard would be taken for shard 0 of 1: which part of the suite it holds is unknown.
+    if (!j.is_object() || !j.contains("shard"))
+      throw InputError(
+          fmt::format("{}: no 'shard' key, so which shard of its suite it holds is unknown; expected "
+                      "the results of `growbench suite --shard I/N`",
+                      f));
+    shards.push_back(results_from_json(j, f));
+  }
   const ResultsFile merged = merge_results(shards, a.inputs, a.mixed);
   make_directories(std::filesystem::path(a.out).parent_path().string());
   write_file_atomic(a.out, json_text(to_json(merged), 1));
@@ -44,7 +53,7 @@ Command add_merge(CLI::App& app) {
       "merge", "Join the results of a suite's shards (--shard I/N) into one results file, in the unsharded order");
   auto a = std::make_shared<MergeArgs>();
   cmd->add_option("shards", a->inputs, "results.json of every shard")->required();
-  cmd->add_option("-o,--out", a->out, "the merged results.json")->required();
+  cmd->add_option("-o,--out", a->out, "the merged results.json")->check(path_named("a file name"))->required();
   cmd->add_flag("--mixed-machines", a->mixed,
                 "merge shards that ran on different CPU models or builds (their timings are not comparable; the "
                 "merged context is marked mixed_machines)");

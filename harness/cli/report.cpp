@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "harness/record/files.hpp"
 #include "harness/cli/command.hpp"
 #include "harness/record/record.hpp"
 #include "harness/report/report.hpp"
@@ -23,6 +24,7 @@ Outcome report(ReportArgs& a) {
   // Read first as the typed record: a file that does not fit is refused here with its JSON path, before
   // Python starts.
   (void)read_results(a.results);
+  const FolderLock lock = FolderLock::take(a.out, "report");
   std::vector<std::string> extra;
   if (!a.pareto_metric.empty()) extra = {"--pareto-metric", a.pareto_metric};
   return script_status(run_report(a.results, a.out, extra), "reports/report.py");
@@ -35,7 +37,8 @@ Command add_report(CLI::App& app) {
       "report", "Figures (PNG, PDF), LaTeX and Markdown tables and index.html from a results file alone");
   auto a = std::make_shared<ReportArgs>();
   cmd->add_option("results", a->results, "results.json written by `growbench suite`")->required();
-  cmd->add_option("-o,--out", a->out, "report directory (default: report/ beside the results file)");
+  cmd->add_option("-o,--out", a->out, "report directory (default: report/ beside the results file)")
+      ->check(path_named("a report folder"));
   cmd->add_option("--pareto-metric", a->pareto_metric,
                   "the quality metric of the quality-against-cost figures (one per scene of a suite with sweeps; "
                   "default coverage): any metric of the results file, e.g. attached_fraction, leaf_light_exposure");

@@ -17,6 +17,7 @@
 #include <fmt/format.h>
 
 #include "core/params.hpp"
+#include "harness/record/files.hpp"
 #include "harness/cli/command.hpp"
 #include "harness/record/record.hpp"
 #include "harness/render/render_results.hpp"
@@ -124,6 +125,7 @@ Outcome run_one(RunArgs& a) {
     fmt::print(stderr, "{}growing: step {}, {} nodes, {:.1f} s{}", tty ? "\r" : "", p.step, p.nodes, p.growth_seconds,
                tty ? "   " : "\n");
   };
+  const FolderLock lock = FolderLock::take(a.out_dir, "run");
   const TrialRecord rec = run_trial_record(spec, progress);
   if (!a.quiet && isatty(STDERR_FILENO)) fmt::print(stderr, "\r{:60}\r", "");
   print_record(rec, spec, a.out_dir);
@@ -165,7 +167,8 @@ Command add_run(CLI::App& app) {
   run->add_option("--organ", spec.organs,
                   "organ pass after growth, key=value (repeatable): placement=avoid, variation, fallbacks; "
                   "`growbench list organs` lists them");
-  run->add_option("-o,--out", a->out_dir, "output directory (default: out/ALGORITHM-SCENE)");
+  run->add_option("-o,--out", a->out_dir, "output directory (default: out/ALGORITHM-SCENE)")
+      ->check(path_named("an output folder"));
   run->add_flag("-q,--quiet", a->quiet, "no progress line");
   CLI::Option* render =
       run->add_option("--render", a->render, "render the plant with POV-Ray afterwards: preview or paper (render.png)");

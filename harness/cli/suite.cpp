@@ -107,7 +107,8 @@ Command add_suite(CLI::App& app) {
       "suite", "Run a suite: algorithms x scenes x seeds x sweeps x repetitions, each trial in its own process");
   auto a = std::make_shared<SuiteArgs>();
   cmd->add_option("file", a->file, "suite file (e.g. bench/suites/quick.json)")->required();
-  cmd->add_option("-o,--out", a->out, "results directory (default: out/suites/NAME)");
+  cmd->add_option("-o,--out", a->out, "results directory (default: out/suites/NAME)")
+      ->check(path_named("a results folder"));
   add_plugin_option(cmd, a->plugins);
   cmd->add_flag("--resume", a->resume, "continue an interrupted run in --out, skipping finished trials");
   cmd->add_flag("--plan", a->plan,

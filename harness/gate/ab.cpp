@@ -357,7 +357,7 @@ json doc_of(Findings&& f, const Suite& suite, const AbOptions& o, const Binaries
 AbResult run_ab(const Suite& suite, const AbOptions& o) {
   check_options(o);
   const fs::path out = o.out_dir.empty() ? fs::path("out/ab") / suite.name : fs::path(o.out_dir);
-  make_directories(out.string());
+  const FolderLock lock = FolderLock::take(out.string(), "ab");
   const Binaries bins = {fs::absolute(o.a_binary).string(), fs::absolute(o.b_binary).string()};
   std::vector<Cell> cells = make_cells(suite, out, o.b_plugins);
 

@@ -1,6 +1,7 @@
 #include "harness/record/files.hpp"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -10,6 +11,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -95,6 +98,74 @@ void make_directories(const std::string& path) {
   if (path.empty() || std::filesystem::is_directory(path, ec)) return;
   std::filesystem::create_directories(path, ec);
   if (ec) throw InputError(fmt::format("{}: cannot create the directory: {}", path, ec.message()));
+}
+
+namespace {
+// The folders this process holds locks on (by canonical path), so that it never refuses itself.
+std::mutex g_locks_mutex;
+std::set<std::string>& held_locks() {
+  static std::set<std::string> held;
+  return held;
+}
+}  // namespace
+
+FolderLock FolderLock::take(const std::string& dir, std::string_view command) {
+  make_directories(dir);
+  std::error_code ec;
+  const std::string key = std::filesystem::weakly_canonical(dir, ec).string();
+  FolderLock lock;
+  {
+    std::lock_guard guard(g_locks_mutex);
+    if (held_locks().count(key) != 0) return lock;  // this process writes here already
+  }
+  const std::string path = (std::filesystem::path(dir) / ".growbench-lock").string();
+  lock.fd_ = open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
+  if (lock.fd_ < 0) throw InputError(fmt::format("{}: cannot create the lock file: {}", path, std::strerror(errno)));
+  if (flock(lock.fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int err = errno;
+    char holder[200] = {};
+    const ssize_t n = pread(lock.fd_, holder, sizeof holder - 1, 0);
+    std::string who(holder, static_cast<std::size_t>(std::max<ssize_t>(n, 0)));
+    while (!who.empty() && (who.back() == '\n' || who.back() == ' ')) who.pop_back();
+    if (err != EWOULDBLOCK) throw InputError(fmt::format("{}: cannot lock: {}", path, std::strerror(err)));
+    throw InputError(
+        fmt::format("{}: another growbench is writing in this folder ({}); wait for it to end, or give "
+                    "another output folder",
+                    dir, who.empty() ? "unknown process" : escape_utf8(who, true)));
+  }
+  const std::string me = fmt::format("pid {}: growbench {}\n", getpid(), command);
+  // Only a description for a refusal: the lock holds without it.
+  [[maybe_unused]] const int cut = ftruncate(lock.fd_, 0);
+  [[maybe_unused]] const ssize_t put = pwrite(lock.fd_, me.data(), me.size(), 0);
+  lock.key_ = key;
+  std::lock_guard guard(g_locks_mutex);
+  held_locks().insert(key);
+  return lock;
+}
+
+FolderLock::FolderLock(FolderLock&& o) noexcept : fd_(o.fd_), key_(std::move(o.key_)) {
+  o.fd_ = -1;
+  o.key_.clear();
+}
+
+FolderLock& FolderLock::operator=(FolderLock&& o) noexcept {
+  if (this != &o) {
+    FolderLock gone(std::move(*this));
+    fd_ = o.fd_;
+    key_ = std::move(o.key_);
+    o.fd_ = -1;
+    o.key_.clear();
+  }
+  return *this;
+}
+
+FolderLock::~FolderLock() {
+  if (fd_ < 0) return;
+  {
+    std::lock_guard guard(g_locks_mutex);
+    held_locks().erase(key_);
+  }
+  close(fd_);  // drops the flock once no forked child holds the descriptor too (it is close-on-exec)
 }
 
 void append_to_file(const std::string& path, std::string_view text) {

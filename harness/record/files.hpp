@@ -47,6 +47,28 @@ class AtomicFile {
 // the directory: REASON" when it cannot (a file in the way, no permission).
 void make_directories(const std::string& path);
 
+// One writer per output folder: while a FolderLock on a folder lives, no other growbench process can take
+// one there (two suites on one --out, a suite and its --resume, or a render during a suite interleaved
+// their writes). The lock is an flock on DIR/.growbench-lock, which the kernel drops when the holder's
+// processes end, however they end; the file names the holder (pid and command) for the refusal. A
+// process that already holds a folder's lock takes it again as a no-op (run then renders its folder).
+class FolderLock {
+ public:
+  FolderLock() = default;
+  // Creates `dir` if needed and locks it for `command`; InputError "DIR: another growbench is writing here
+  // (...)" when another process holds it.
+  static FolderLock take(const std::string& dir, std::string_view command);
+  FolderLock(FolderLock&& o) noexcept;
+  FolderLock& operator=(FolderLock&& o) noexcept;
+  FolderLock(const FolderLock&) = delete;
+  FolderLock& operator=(const FolderLock&) = delete;
+  ~FolderLock();
+
+ private:
+  int fd_ = -1;
+  std::string key_;  // the folder's canonical path, while this object holds it
+};
+
 // Appends `text` to `path` (created if absent), flushed and closed; InputError "PATH: cannot write: REASON".
 void append_to_file(const std::string& path, std::string_view text);
 

@@ -651,9 +651,17 @@ ResultsFile results_from_json(const json& j, const std::string& path) {
   check_kind(j, kResultsKind, path, "growbench results file");
   check_version(j, path);
   ResultsFile r = from_json<ResultsFile>(j, path);
-  for (std::size_t i = 0; i < r.trials.size(); ++i)
-    if (const std::string why = cell_id_problem(r.trials[i].id); !why.empty())
+  for (std::size_t i = 0; i < r.trials.size(); ++i) {
+    const SuiteCell& c = r.trials[i];
+    if (const std::string why = cell_id_problem(c.id); !why.empty())
       throw InputError(fmt::format("{}: at /trials/{}/id: {}", path, i, why));
+    // An ok cell's figures are its samples': without them every comparison of it would be empty.
+    if (c.status == "ok" && c.samples.empty())
+      throw InputError(
+          fmt::format("{}: at /trials/{}/samples: cell '{}' is ok but has no samples; expected one "
+                      "per repetition",
+                      path, i, c.id));
+  }
   return r;
 }
 

@@ -524,6 +524,8 @@ RenderSummary render_directory_record(const std::string& dir_arg, const RenderDi
   if (!suite && !fs::exists(dir / "record.json"))
     throw InputError(
         fmt::format("{}: neither a suite results directory (results.json) nor a run directory (record.json)", dir_arg));
+  // Read, rendered and written back under the lock: no suite can rewrite what this render read.
+  const FolderLock lock = FolderLock::take(dir_arg, "render");
   ResultsFile results;
   TrialRecord record;
   RenderTargets targets;

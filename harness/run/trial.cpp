@@ -6,6 +6,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -15,6 +16,7 @@
 #include <fstream>
 #include <map>
 #include <new>
+#include <optional>
 #include <stdexcept>
 #include <string_view>
 #include <thread>
@@ -207,8 +209,18 @@ struct CurveSampler {
   }
 };
 
+// The work a slow:N fault adds, or nothing when `fault` is not one.
+std::optional<std::uint64_t> slow_fault_iterations(const std::string& fault) {
+  if (fault.rfind("slow:", 0) != 0) return std::nullopt;
+  std::uint64_t n = 0;
+  const char* last = fault.data() + fault.size();
+  const auto r = std::from_chars(fault.data() + 5, last, n);
+  if (r.ec != std::errc() || r.ptr != last || fault.size() == 5) return std::nullopt;
+  return n;
+}
+
 void inject_fault(const std::string& fault) {
-  if (fault.empty()) return;
+  if (const std::string bad = fault_problem(fault); !bad.empty()) throw InputError(bad);
   if (fault == "crash") {
     std::signal(SIGSEGV, SIG_DFL);  // a plain crash, past any handler a sanitizer installed
     std::raise(SIGSEGV);
@@ -223,26 +235,25 @@ void inject_fault(const std::string& fault) {
     }
   }
   if (fault == "throw") throw std::runtime_error("injected internal error");
-  if (fault.rfind("slow:", 0) == 0) {
+  if (const auto n = slow_fault_iterations(fault)) {
     // A planted slowdown for testing the regression gates: this much extra work in the growth phase,
     // the plant unchanged.
-    std::uint64_t n = 0;
-    try {
-      n = std::stoull(fault.substr(5));
-    } catch (const std::exception&) {
-      throw InputError(fmt::format("fault '{}': expected slow:N with N a count of iterations", fault));
-    }
     volatile std::uint64_t sink = 0;
     std::uint64_t h = 0x9E3779B97F4A7C15ull;
-    for (std::uint64_t i = 0; i < n; ++i) h = (h ^ (h >> 31)) * 0xBF58476D1CE4E5B9ull + i;
+    for (std::uint64_t i = 0; i < *n; ++i) h = (h ^ (h >> 31)) * 0xBF58476D1CE4E5B9ull + i;
     sink = h;
     (void)sink;
-    return;
   }
-  throw InputError(fmt::format("unknown fault '{}'; expected crash, hang, oom, throw or slow:N", fault));
 }
 
 }  // namespace
+
+std::string fault_problem(const std::string& fault) {
+  if (fault.empty() || fault == "crash" || fault == "hang" || fault == "oom" || fault == "throw" ||
+      slow_fault_iterations(fault))
+    return "";
+  return fmt::format("unknown fault '{}'; expected crash, hang, oom, throw or slow:N (N a count of iterations)", fault);
+}
 
 bool is_out_of_memory(const std::exception& e) {
   if (dynamic_cast<const std::bad_alloc*>(&e)) return true;
@@ -269,28 +280,43 @@ std::optional<std::array<double, 3>> load_average() {
   return std::nullopt;
 }
 
-RunContext run_context_record() {
-  const std::time_t now = std::time(nullptr);
-  char date[32];
-  std::strftime(date, sizeof(date), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-  RunContext c;
+SourceCommit source_commit() {
+  SourceCommit c;
   // The commit the binary was configured at; the source tree's current state when it is reachable.
-  c.growbench_commit = GROWBENCH_GIT_COMMIT;
+  c.commit = GROWBENCH_GIT_COMMIT;
   // Not for an installed copy: the checkout may have moved on since it was built.
   if (running_from_build_tree() && std::filesystem::exists(std::string(GROWBENCH_SOURCE_DIR) + "/.git")) {
     const std::string commit =
         run_command(fmt::format("git -C '{}' rev-parse --short=12 HEAD 2>/dev/null", GROWBENCH_SOURCE_DIR));
-    if (!commit.empty()) c.growbench_commit = commit;
+    if (!commit.empty()) c.commit = commit;
     // Committer time (Unix seconds): orders a history by commit.
     const std::string ct =
         run_command(fmt::format("git -C '{}' show -s --format=%ct HEAD 2>/dev/null", GROWBENCH_SOURCE_DIR));
-    if (!ct.empty() && ct.find_first_not_of("0123456789") == std::string::npos) c.commit_time = std::stoll(ct);
+    if (!ct.empty() && ct.find_first_not_of("0123456789") == std::string::npos) c.time = std::stoll(ct);
     c.dirty = run_command(
                   fmt::format("git -C '{}' status --porcelain --untracked-files=no 2>/dev/null", GROWBENCH_SOURCE_DIR))
                       .empty()
                   ? "false"
                   : "true";
   }
+  return c;
+}
+
+std::string version_line() {
+  const SourceCommit c = source_commit();
+  return fmt::format("growbench {} (commit {}{}, built at {}, {})", GROWBENCH_VERSION, c.commit,
+                     c.dirty == "true" ? " with uncommitted changes" : "", GROWBENCH_GIT_COMMIT, GROWBENCH_BUILD_TYPE);
+}
+
+RunContext run_context_record() {
+  const std::time_t now = std::time(nullptr);
+  char date[32];
+  std::strftime(date, sizeof(date), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  RunContext c;
+  const SourceCommit commit = source_commit();
+  c.growbench_commit = commit.commit;
+  c.commit_time = commit.time;
+  c.dirty = commit.dirty;
   c.configured_commit = GROWBENCH_GIT_COMMIT;
   c.build_type = GROWBENCH_BUILD_TYPE;
   c.compiler = fmt::format("g++ {}", __VERSION__);

@@ -40,6 +40,14 @@ Outcome outcome_of(const std::exception& e);
 
 // The build and machine this binary runs on (commit and dirty flag, compiler, flags, build type,
 // dependency versions, CPU model, cores, date).
+// The commit of the source this binary runs from, as run_context_record gives it.
+struct SourceCommit {
+  std::string commit, dirty = "unknown";
+  std::optional<std::int64_t> time;
+};
+SourceCommit source_commit();
+// What --version prints: the version, the source commit (and whether it had changes) and the configured one.
+std::string version_line();
 RunContext run_context_record();
 // /proc/loadavg's 1, 5 and 15 minute load averages, when readable.
 std::optional<std::array<double, 3>> load_average();
@@ -47,6 +55,8 @@ nlohmann::json run_context();  // to_json of the above
 
 // A trial spec as a suite hands it to a trial's process (harness/record/trial_spec.hpp): InputError naming the JSON
 // path ("the trial spec: at seed: ...") or the file for a bad spec.
+// Why `fault` (TrialSpec::fault) is not one a trial can inject, or "" when it is (or is empty).
+std::string fault_problem(const std::string& fault);
 TrialSpec trial_spec_from_json(const nlohmann::json& j);
 TrialSpec read_trial_spec(const std::string& path);
 

@@ -33,6 +33,7 @@
 #include "harness/record/record.hpp"
 #include "harness/run/ordered_pool.hpp"
 #include "harness/run/process.hpp"
+#include "harness/run/trial.hpp"
 #include "harness/stats/stats.hpp"
 #include "scenes/scene_library.hpp"
 
@@ -241,7 +242,10 @@ class SuiteReader : public JsonPathReader {
       a.name = e["name"].get<std::string>();
       a.label = string_field(e, path, "label", "", "the entry's label");
       read_settings_into(e, path, a.spec);
-      if (e.contains("fault")) read_spec_field(a.spec, "fault", e["fault"], file(), path + "/fault");
+      if (e.contains("fault")) {
+        read_spec_field(a.spec, "fault", e["fault"], file(), path + "/fault");
+        if (const std::string bad = fault_problem(a.spec.fault); !bad.empty()) fail(path + "/fault", bad);
+      }
       if (e.contains("leaf_obj")) {
         if (!e["leaf_obj"].is_string()) fail(path + "/leaf_obj", "expected the path of an OBJ file");
         a.spec.leaf_obj = relative_to_suite(e["leaf_obj"].get<std::string>());
@@ -634,12 +638,21 @@ ResultsFile merge_results(const std::vector<ResultsFile>& shards, const std::vec
     merged.shards->push_back({i, names[a], shards[a].context});
     total += shards[a].trials.size();
   }
+  // Of a suite of `total` cells, shard i holds ceil((total - i) / count).
+  const auto n = static_cast<std::size_t>(count);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t a = slot[i], has = shards[a].trials.size(), given = (total - std::min(total, i) + n - 1) / n;
+    if (has != given)
+      throw InputError(fmt::format("{}: shard {}/{} has {} cells, but a suite of {} cells in {} shards gives it {}",
+                                   names[a], i, count, has, total, count, given));
+  }
+  std::set<std::string> ids;
   for (std::size_t k = 0; k < total; ++k) {
-    const std::vector<SuiteCell>& trials = shards[slot[k % static_cast<std::size_t>(count)]].trials;
-    const std::size_t at = k / static_cast<std::size_t>(count);
-    if (at >= trials.size())
-      throw InputError(fmt::format("merge: shard {} has fewer cells than its suite gives it", k % count));
-    merged.trials.push_back(trials[at]);
+    const SuiteCell& cell = shards[slot[k % n]].trials[k / n];
+    if (!ids.insert(cell.id).second)
+      throw InputError(fmt::format("{}: cell '{}' is in the merged results twice; expected each cell in one shard",
+                                   names[slot[k % n]], cell.id));
+    merged.trials.push_back(cell);
   }
   if (!differ.empty()) merged.context.mixed_machines = true;
   merged.renders.reset();    // per-shard render summaries do not describe the merged grid
@@ -748,12 +761,14 @@ class SuiteRun {
     out_ = o.out_dir.empty() ? fs::path("out/suites") / suite_.name : fs::path(o.out_dir);
     results_path_ = out_ / "results.json";
     journal_path_ = out_ / "journal.jsonl";
-    make_directories((out_ / "trials").string());
     launcher_ = o.launcher;
     if (!o.instructions && !launcher_) {
       own_launcher_ = start_trial_launcher();
       launcher_ = own_launcher_.get();
     }
+    // After the launcher starts, so that its processes do not hold the lock's descriptor.
+    lock_ = FolderLock::take(out_.string(), o.resume ? "suite --resume" : "suite");
+    make_directories((out_ / "trials").string());
   }
 
   std::string run() {
@@ -1107,6 +1122,7 @@ class SuiteRun {
   std::string valgrind_, self_exe_;
   fs::path out_, results_path_, journal_path_;
   std::unique_ptr<Launcher> own_launcher_;
+  FolderLock lock_;  // released before the launcher ends (members end in reverse order)
   Launcher* launcher_ = nullptr;
   ResultsFile results_;
   std::map<std::string, std::size_t> index_;  // cell id -> index in results_.trials

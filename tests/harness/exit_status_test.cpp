@@ -3,18 +3,22 @@
 // internal error with a request for a bug report.
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <set>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "harness/record/files.hpp"
 #include "harness/record/record.hpp"
 #include "test_util.hpp"
 
@@ -139,6 +143,94 @@ TEST(ExitStatus, BadInputIsTwoForEveryCommandWithItsSourceNamed) {
     EXPECT_TRUE(has(r.out, c.expect)) << c.args << ": " << r.out;
     EXPECT_FALSE(has(r.out, "internal error")) << c.args << ": " << r.out;
   }
+}
+
+// Inputs that were accepted with exit 0 (or aborted the process) although they cannot work: each is now
+// refused with 2 and says what was expected.
+TEST(ExitStatus, InputsThatCannotWorkAreTwoNotZeroOrAnAbort) {
+  const auto dir = test::temp_dir("exit_wrong");
+  const std::string d = dir.string();
+  const json ok = json::parse(std::ifstream(write_results(dir / "ok.json", "0123456789abcdef")));
+  auto variant = [&](const std::string& name, const std::function<void(json&)>& change) {
+    json j = ok;
+    change(j);
+    return test::write_text(dir / name, j.dump());
+  };
+  const std::string no_samples = variant("no_samples.json", [](json& j) { j["trials"][0]["samples"] = json::array(); });
+  const std::string no_shard = variant("no_shard.json", [](json& j) { j.erase("shard"); });
+  const std::string big = variant("big.json", [](json& j) {
+    j["shard"] = {{"index", 0}, {"count", 2}};
+    j["trials"].push_back(j["trials"][0]);
+    j["trials"][1]["id"] = "spacecol/wall/s2";
+  });
+  const std::string empty = variant("empty.json", [](json& j) {
+    j["shard"] = {{"index", 1}, {"count", 2}};
+    j["trials"] = json::array();
+  });
+  const std::string twice0 = variant("twice0.json", [](json& j) { j["shard"] = {{"index", 0}, {"count", 2}}; });
+  const std::string twice1 = variant("twice1.json", [](json& j) { j["shard"] = {{"index", 1}, {"count", 2}}; });
+  const std::string clash = test::write_text(dir / "clash.lsys", "premise: A(1,2)\nA(x,x) = F(x) A(x,x)\n");
+  const std::string flat = test::write_text(dir / "flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
+  const std::string fault =
+      test::write_text(dir / "fault.json",
+                       R"({"schema_version": 1, "name": "f", "algorithms": [{"name": "spacecol", "fault": "explode"}],
+          "scenes": ["wall"], "seeds": [1]})");
+  const struct {
+    std::string args, expect;
+  } cases[] = {
+      {"run -a lsystem -s wall --set 'premise=F(2e18)J' --set generations=0 -o " + d + "/far",
+       "node 1 lies at (-1, 2e+18, 0.13), not within 1e+09 m of the origin"},
+      {"run -a lsystem -s wall --set grammar=" + clash + " -o " + d + "/clash", "the parameter name 'x' appears twice"},
+      {"run -a ivy -s mesh:" + flat + " -o " + d + "/flat", flat + ": every face has zero area"},
+      {"suite " + fault + " -o " + d + "/fault", "at /algorithms/0/fault: unknown fault 'explode'"},
+      {"run -a spacecol -s wall -o ''", "--out: expected an output folder, got an empty name"},
+      {"compare " + no_samples + " " + d + "/ok.json",
+       "at /trials/0/samples: cell 'spacecol/wall/s1' is ok but has no"},
+      {"summary " + no_samples, "is ok but has no samples"},
+      {"merge " + no_shard + " -o " + d + "/m.json", "no_shard.json: no 'shard' key, so which shard"},
+      {"merge " + big + " " + empty + " -o " + d + "/m.json",
+       "shard 0/2 has 2 cells, but a suite of 2 cells in 2 shards gives it 1"},
+      {"merge " + twice0 + " " + twice1 + " -o " + d + "/m.json",
+       "cell 'spacecol/wall/s1' is in the merged results twice"},
+  };
+  for (const auto& c : cases) {
+    const auto r = growbench(c.args);
+    EXPECT_EQ(r.status, 2) << c.args << ": " << r.out;
+    EXPECT_TRUE(has(r.out, "growbench: error: ")) << c.args << ": " << r.out;
+    EXPECT_TRUE(has(r.out, c.expect)) << c.args << ": " << r.out;
+  }
+  EXPECT_FALSE(fs::exists(dir / "m.json"));
+}
+
+// Two writers on one folder interleaved their files: duplicated (id, repetition) pairs, a good trial
+// recorded as invalid_input, a render rewriting results.json with every cell pending. A second writer is
+// now refused with 2, naming the one at work, and the folder is free again when it ends.
+TEST(ExitStatus, ASecondWriterOnAFolderIsTwoUntilTheFirstEnds) {
+  const auto dir = test::temp_dir("exit_lock");
+  const std::string out = (dir / "out").string();
+  const std::string suite = test::write_text(
+      dir / "tiny.json",
+      R"({"schema_version": 1, "name": "tiny", "algorithms": [{"name": "spacecol", "params": {"point_count": 300}}],
+          "scenes": ["wall"], "seeds": [1], "repetitions": 1})");
+  const std::string results = write_results(dir / "results.json", "0123456789abcdef");
+  {
+    const FolderLock held = FolderLock::take(out, "suite");
+    const FolderLock again = FolderLock::take(out, "render");  // this process holds it already: no refusal
+    fs::copy_file(results, out + "/results.json");
+    const std::string holder =
+        fmt::format("{}: another growbench is writing in this folder (pid {}: growbench suite)", out, ::getpid());
+    for (const std::string& args :
+         {"suite " + suite + " -o " + out, "suite " + suite + " --resume -o " + out, "render " + out,
+          "run -a spacecol -s wall --set point_count=300 -o " + out, "report " + results + " -o " + out}) {
+      const auto r = growbench(args);
+      EXPECT_EQ(r.status, 2) << args << ": " << r.out;
+      EXPECT_TRUE(has(r.out, holder)) << args << ": " << r.out;
+    }
+    EXPECT_EQ(read_input_file(out + "/results.json"), read_input_file(results));  // untouched
+  }
+  fs::remove(out + "/results.json");
+  const auto r = growbench("suite " + suite + " -o " + out + " --quiet");
+  EXPECT_EQ(r.status, 0) << r.out;
 }
 
 TEST(ExitStatus, SuccessIsZeroAndOnlyARegressionIsOne) {

@@ -101,6 +101,13 @@ grep -q "shards 1 of 2" "$W/resubmit.txt" || fail "--resubmit-failed did not sub
 [[ $(grep -c "^suite-array: job [0-9]*, shard 0/2" "$W/sharded/logs/shard-0.log") -eq 1 ]] || fail "shard 0 ran again"
 echo "slurm_test: resubmitting the interrupted shard took $(took "$t")"
 
+# A folder whose name Slurm would read as a pattern is refused before anything is submitted.
+if GROWBENCH="$G" bench/slurm/suite-array.sh bench/suites/quick.json "$W/job-%j" 2 > "$W/pattern.txt" 2>&1 ||
+  ! grep -q "OUT_DIR: '$W/job-%j' holds '%'" "$W/pattern.txt" || [[ -e "$W/job-%j" ]]; then
+  cat "$W/pattern.txt" >&2
+  fail "an OUT_DIR with %j was not refused"
+fi
+
 # 3. Unsharded, directly.
 t=$(now)
 if ! "$G" suite bench/suites/quick.json --out "$W/unsharded" -q > "$W/unsharded.txt" 2>&1; then

@@ -118,6 +118,12 @@ TEST(MeshScene, BadFilesGiveClearErrors) {
   const std::string bad = test::write_text(dir / "bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
   e = error_of([&] { load_scene("mesh:" + bad); });
   EXPECT_NE(e.find("bad.obj"), std::string::npos) << e;
+  // Faces of no area (collinear or coincident corners) grew a 2-node plant on nothing, with exit 0.
+  for (const char* text : {"v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n", "v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n"}) {
+    const std::string flat = test::write_text(dir / "flat.obj", text);
+    e = error_of([&] { load_scene("mesh:" + flat); });
+    EXPECT_NE(e.find(flat + ": every face has zero area"), std::string::npos) << e;
+  }
 }
 
 TEST(JsonScene, LoadsMeshesSeedsLightEnvelopeZonesCamera) {
