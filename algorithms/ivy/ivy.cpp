@@ -94,7 +94,11 @@ const AlgorithmInfo kInfo = {
                 .doc("luft: mirror across every entered face, repeat, the root dies after more than 5 passes; blender: "
                      "one ray, mirror across the first face if entering, never dies"),
             param::integer("max_depth", 3).range(0, 100).doc("roots this deep (ancestor count) can still branch"),
-            param::integer("branches_per_step", 1).range(1, 1000000).doc("new roots per iteration at most (Luft: 1)"),
+            param::integer("branches_per_step", 1).range(1, 1000).doc("new roots per iteration at most (Luft: 1)"),
+            param::integer("max_roots", 10000)
+                .range(1, 1000000)
+                .doc("no new roots once this many have started: without it, many branches per iteration multiply "
+                     "the roots every iteration until memory runs out"),
             param::integer("smoothing_passes", 5)
                 .range(0, 100)
                 .doc("passes of the 11-tap [1 2 4 7 9 10 9 7 4 2 1]/56 filter over each root's adhesion vectors"),
@@ -390,6 +394,7 @@ Config make_config(const Params& p, const Scene& scene) {
                                          : LeafMode::None,
       .max_depth = static_cast<int>(p.integer("max_depth")),
       .branches_per_step = static_cast<int>(p.integer("branches_per_step")),
+      .max_roots = static_cast<std::size_t>(p.integer("max_roots")),
       .smoothing_passes = static_cast<int>(p.integer("smoothing_passes")),
       .leaf_passes = static_cast<int>(p.integer("leaf_passes")),
       .margin = 1e-5f * radius,
@@ -583,7 +588,7 @@ bool Grower::step() {
   // Branching: alive roots in index order; the first `branches_per_step` that branch start new roots.
   int started = 0;
   const std::size_t alive_now = alive_.size();
-  for (std::size_t i = 0; i < alive_now && started < cfg_.branches_per_step; ++i) {
+  for (std::size_t i = 0; i < alive_now && started < cfg_.branches_per_step && roots_.size() < cfg_.max_roots; ++i) {
     const std::uint32_t ri = alive_[i];
     if (roots_[ri].depth > cfg_.max_depth) continue;
     const std::ptrdiff_t k = pick_branch_node(roots_[ri]);

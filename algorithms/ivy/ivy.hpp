@@ -40,6 +40,7 @@ struct Config {
   LeafMode leaf_mode;
   int max_depth;
   int branches_per_step;
+  std::size_t max_roots;
   int smoothing_passes;
   int leaf_passes;
   float margin;  // slack added to query radii (1e-5 R)

@@ -446,6 +446,23 @@ TEST(IvyScenes, BlenderPresetStopsAtItsMaximumRootLength) {
   EXPECT_GT(p.leaf_count(), 100u);
 }
 
+// Many branches per iteration multiplied the roots every iteration: a million per step on the wall took
+// minutes and gigabytes. No root starts past max_roots, and a million per step is refused.
+TEST(IvyParams, RootsStopBranchingAtMaxRoots) {
+  const Scene wall = load_scene("wall");
+  const SceneQuery q(wall, {.build_sdf = false});
+  std::vector<std::pair<std::string, double>> stats;
+  const Plant p = test::grow("ivy", wall, q, {"branches_per_step=1000", "max_roots=40"}, 0, 1, 60, &stats);
+  double roots = -1.0;
+  for (const auto& [n, v] : stats)
+    if (n == "roots") roots = v;
+  EXPECT_EQ(roots, 40.0);
+  EXPECT_EQ(p.validate(), "");
+  Params params = default_params(find_algorithm("ivy"));
+  EXPECT_NE(test::error_of([&] { params.set_assignment("branches_per_step=1000000"); }).find("branches_per_step"),
+            std::string::npos);
+}
+
 TEST(IvyParams, PresetDefaultsGiveWayToExplicitValues) {
   Params p = default_params(find_algorithm("ivy"));
   EXPECT_DOUBLE_EQ(p.real("ivy_size"), 0.005);

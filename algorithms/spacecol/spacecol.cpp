@@ -45,7 +45,7 @@ const AlgorithmInfo kInfo = {
                      "auto = surface when surface=cling or the scene has no envelope, else envelope"),
             param::text("points_file")
                 .doc("text file of attraction points, one 'x y z' (or x,y,z) per line, # comments (points=file)"),
-            param::integer("point_count", 20000).range(1, 5e7).doc("number of attraction points sampled"),
+            param::integer("point_count", 20000).range(1, 1e7).doc("number of attraction points sampled"),
             param::real("surface_offset", 0.01)
                 .range(0, 10)
                 .unit("m")

@@ -184,6 +184,9 @@ TEST(ExitStatus, InputsThatCannotWorkAreTwoNotZeroOrAnAbort) {
       {"run -a ivy -s mesh:" + flat + " -o " + d + "/flat", flat + ": every face has zero area"},
       {"suite " + fault + " -o " + d + "/fault", "at /algorithms/0/fault: unknown fault 'explode'"},
       {"run -a spacecol -s wall -o ''", "--out: expected an output folder, got an empty name"},
+      // Sizes that ran for minutes: refused where they enter.
+      {"run -a spacecol -s wall --set point_count=50000000 --max-steps 2 -o " + d + "/big", "point_count"},
+      {"run -a ivy -s wall --set branches_per_step=1000000 --max-steps 20 -o " + d + "/big", "branches_per_step"},
       {"compare " + no_samples + " " + d + "/ok.json",
        "at /trials/0/samples: cell 'spacecol/wall/s1' is ok but has no"},
       {"summary " + no_samples, "is ok but has no samples"},
