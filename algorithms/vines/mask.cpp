@@ -1,3 +1,4 @@
+#include "algorithms/image_limits.hpp"
 #include "algorithms/vines/mask.hpp"
 
 #include <algorithm>
@@ -17,7 +18,7 @@ namespace growbench::vines {
 
 namespace {
 
-constexpr int kMaxSide = 16384;  // a map is looked up per attractor candidate and never needs more
+constexpr int kMaxSide = kMaxImageSide;
 
 // stb_image's terse reason for a PNG it cannot decode, in words.
 std::string decode_failure(const char* reason) {

@@ -207,6 +207,27 @@ TEST(MaskInput, TruncatedCorruptAndOversizedPngsNameTheFile) {
             "mask=" + gif + ": not a readable image: it is not a PNG (its first bytes are not the PNG signature)");
 }
 
+// A pic() image is read whole: a small file of vast pixels (a 27 KB PNG of 15000 x 15000) took gigabytes.
+// It is capped as a mask is, from its header; an image within the cap is looked up as before.
+TEST(PicImageInput, AnImageTooLargeIsRefusedFromItsHeaderAndASmallOneIsRead) {
+  const auto dir = test::temp_dir("pic_png");
+  const std::string png = tiny_png(dir);  // red, green
+  auto run = [&](const std::string& image) {
+    Params p = default_params(find_algorithm("lsystem"));
+    p.set("premise", "A");
+    p.set("rules", "A = B(pic(0.25, 0.5, 1), pic(0.75, 0.5, 2), pic(0.75, 0.5, 1))");
+    p.set("generations", "1");
+    p.set("pic_image", image);
+    return derive_lsystem(p, 1, nullptr, nullptr, 0).text;
+  };
+  EXPECT_EQ(run(write_bytes(dir / "ok.png", png)), "B(1,1,0)");
+  std::string wide = png;
+  wide.replace(16, 4, std::string("\x00\x00\x4e\x20", 4));  // 20000 x 1
+  const std::string big = write_bytes(dir / "wide.png", wide);
+  EXPECT_EQ(error_of([&] { (void)run(big); }),
+            "pic_image '" + big + "': the image is 20000 x 1 pixels; expected at most 16384 on each side");
+}
+
 // ---------- plugin parameter tables ----------
 
 growbench_instance* no_create(const growbench_host*) {
