@@ -175,7 +175,7 @@ ChildResult monitor_child(pid_t pid, std::chrono::steady_clock::time_point t0, i
   const int pidfd = static_cast<int>(syscall(SYS_pidfd_open, pid, 0));
   int status = 0;
   rusage ru{};
-  bool reaped = false;
+  bool reaped = false, ended = false;
   auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   auto kill_child = [&] {
     r.timed_out = true;
@@ -196,9 +196,15 @@ ChildResult monitor_child(pid_t pid, std::chrono::steady_clock::time_point t0, i
         break;
       }
       if (report_fd >= 0 && (pfd[1].revents & (POLLIN | POLLHUP)) != 0) read_report();
-      if ((pfd[0].revents & POLLIN) != 0) break;
+      if ((pfd[0].revents & POLLIN) != 0) {
+        ended = true;
+        break;
+      }
     }
     close(pidfd);
+    // The child has ended but is not reaped, so its pid (its group's id) cannot have been reused: whatever
+    // it started in its group (a plugin's helpers, a shell's children) ends with it.
+    if (ended) kill(-pid, SIGKILL);
   } else {
     // No pidfd (old kernel): poll wait4 every millisecond.
     while (true) {

@@ -12,9 +12,11 @@ namespace growbench {
 struct ChildLimits {
   double timeout_s = 0.0;                 // 0: none
   std::uint64_t address_space_bytes = 0;  // 0: none (RLIMIT_AS)
-  // SIGKILL the child when the forking thread dies (a suite killed with kill -9 takes its trial with it).
-  // Only for single-threaded forkers: the signal follows the thread, not the process.
-  bool die_with_parent = false;
+  // SIGKILL the child when the forking thread dies: a suite or render killed in any way (kill -9 too)
+  // takes its trials and POV-Ray processes with it, so that none writes into a folder a resumed run owns.
+  // The signal follows the thread, not the process; run_forked's thread waits for its child, so it
+  // outlives it.
+  bool die_with_parent = true;
 };
 
 struct ChildResult {

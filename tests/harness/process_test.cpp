@@ -3,6 +3,7 @@
 #include "harness/run/process.hpp"
 
 #include <signal.h>
+#include <sys/wait.h>
 #include <csignal>
 #include <unistd.h>
 
@@ -193,6 +194,65 @@ TEST(Process, AJobsProcessKilledWhileWaitingIsReplaced) {
     EXPECT_EQ(r.exit_code, 0);
     EXPECT_EQ(r.signal, 0);
   }
+}
+
+// Whether process `pid` has ended: gone, or a zombie no one has reaped yet (a container's init may not).
+bool ended(pid_t pid) {
+  if (kill(pid, 0) != 0) return true;
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string line;
+  std::getline(stat, line);
+  const auto close = line.rfind(')');
+  return close == std::string::npos || (close + 2 < line.size() && line[close + 2] == 'Z');
+}
+bool ends_within(pid_t pid, std::chrono::seconds limit) {
+  for (const auto t0 = Clock::now(); Clock::now() - t0 < limit;) {
+    if (ended(pid)) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return false;
+}
+// The pid a shell wrote to `path`, waiting for it.
+pid_t pid_from(const std::string& path) {
+  for (const auto t0 = Clock::now(); Clock::now() - t0 < std::chrono::seconds(10);) {
+    std::ifstream in(path);
+    pid_t pid = 0;
+    if (in >> pid && pid > 0) return pid;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return -1;
+}
+
+// A suite or render killed (SIGKILL too) left its POV-Ray processes running, which later overwrote the
+// render.png of a resumed run: a program run_program starts dies with the process that started it.
+TEST(Process, AProgramDiesWithTheProcessThatRanIt) {
+  const std::string file = ::testing::TempDir() + "/growbench_program_pid_" + std::to_string(getpid());
+  std::remove(file.c_str());
+  const pid_t runner = fork();
+  ASSERT_GE(runner, 0);
+  if (runner == 0) {
+    (void)run_program({"/bin/sh", "-c", "echo $$ > '" + file + "'; exec sleep 60"}, "", {}, "");
+    _exit(0);
+  }
+  const pid_t program = pid_from(file);
+  ASSERT_GT(program, 0);
+  EXPECT_FALSE(ended(program));
+  kill(runner, SIGKILL);
+  waitpid(runner, nullptr, 0);
+  EXPECT_TRUE(ends_within(program, std::chrono::seconds(5))) << "pid " << program << " outlived its runner";
+  std::remove(file.c_str());
+}
+
+// What a trial starts in its process group (a plugin's helper) ends when the trial does.
+TEST(Process, WhatAChildLeftInItsGroupEndsWithIt) {
+  const std::string file = ::testing::TempDir() + "/growbench_helper_pid_" + std::to_string(getpid());
+  std::remove(file.c_str());
+  const ChildResult r = run_program({"/bin/sh", "-c", "sleep 60 & echo $! > '" + file + "'"}, "", {}, "");
+  EXPECT_EQ(r.exit_code, 0);
+  const pid_t helper = pid_from(file);
+  ASSERT_GT(helper, 0);
+  EXPECT_TRUE(ends_within(helper, std::chrono::seconds(5))) << "pid " << helper << " outlived its trial";
+  std::remove(file.c_str());
 }
 
 }  // namespace
