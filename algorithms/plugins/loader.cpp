@@ -183,6 +183,12 @@ const growbench_plugin* open_plugin(const std::string& path) {
   std::error_code ec;
   if (!fs::exists(path, ec)) throw InputError(fmt::format("{}: no such plugin file", path));
   if (fs::is_directory(path, ec)) throw InputError(fmt::format("{}: is a directory, not a plugin file", path));
+  // dlopen would wait forever on a FIFO and read a device: a plugin is a file.
+  if (!fs::is_regular_file(path, ec))
+    throw InputError(
+        fmt::format("{}: not a regular file (a FIFO, a device or a socket); expected a plugin's "
+                    "shared library file",
+                    path));
   // RTLD_LOCAL: one plugin's symbols never satisfy another's. Never closed (see loader.hpp).
   void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!handle) {

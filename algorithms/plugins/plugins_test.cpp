@@ -172,8 +172,9 @@ TEST(CPlugin, ASuiteRecordsAMisbehavingPluginAndGoesOn) {
   const fs::path dir = test::temp_dir("plugin_suite");
   fs::copy_file(fixture("line"), dir / "line.so");
   // Without an address-space limit (AddressSanitizer), fault=oom would take the whole machine.
-  const std::string faults =
-      kAddressSpaceLimitWorks ? R"("crash", "hang", "oom", "fail", "none")" : R"("crash", "hang", "fail", "none")";
+  const std::string faults = kAddressSpaceLimitWorks
+                                 ? R"("crash", "hang", "oom", "fail", "exit3", "long_message", "none")"
+                                 : R"("crash", "hang", "fail", "exit3", "long_message", "none")";
   test::write_text(dir / "suite.json", fmt::format(R"({{"schema_version": 1, "name": "plugin_faults", "repetitions": 1,
     "warmup": 0, "timeout_s": 5, "memory_limit_mb": 1024, "plugins": ["line.so"], "scenes": ["wall"],
     "algorithms": [{{"name": "line", "sweep": {{"fault": [{}]}}}}]}})",
@@ -190,7 +191,20 @@ TEST(CPlugin, ASuiteRecordsAMisbehavingPluginAndGoesOn) {
     EXPECT_EQ(status["oom"], "out_of_memory");
   }
   EXPECT_EQ(status["fail"], "crashed");
+  // exit(3) is the trial's own code for out of memory, but the trial never reported it: not a verdict.
+  EXPECT_EQ(status["exit3"], "crashed");
+  EXPECT_EQ(status["long_message"], "crashed");
   EXPECT_EQ(status["none"], "ok");
+  for (const auto& c : res.trials) {
+    const std::string message = c.message.value_or("");
+    if (c.sweep.at("fault") == "exit3") {
+      EXPECT_NE(message.find("exited with status 3 without reporting why"), std::string::npos) << message;
+    }
+    if (c.sweep.at("fault") == "long_message") {
+      EXPECT_LT(message.size(), 5000u);
+      EXPECT_NE(message.find("(cut: the message has "), std::string::npos) << message;
+    }
+  }
   ASSERT_EQ(res.context.plugins.size(), 1u);
   EXPECT_EQ(res.context.plugins[0].path, fs::canonical(dir / "line.so").string());
 }

@@ -1,3 +1,4 @@
+#include "core/utf8.hpp"
 #include "harness/record/files.hpp"
 #include "harness/suite/suite.hpp"
 
@@ -45,6 +46,36 @@ namespace {
 
 std::string read_text(const std::string& path) {
   return read_input_file(path);
+}
+
+// A trial's message (error.txt) as a sample records it: a plugin's failure can be any size (a 64 MiB one
+// was copied into results.json whole), so at most kMaxMessageBytes of it, the cut said.
+constexpr std::size_t kMaxMessageBytes = 4096;
+std::string read_message(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(kMaxMessageBytes + 1, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  if (head.size() <= kMaxMessageBytes) return head;
+  std::error_code ec;
+  const auto size = fs::file_size(path, ec);
+  return fmt::format("{} (cut: the message has {} bytes; the whole is in {})", utf8_excerpt(head, kMaxMessageBytes),
+                     ec ? 0 : size, path.string());
+}
+
+// How many processes the kernel's OOM killer has ended in this process's cgroup (cgroup v2), if it says.
+std::optional<std::uint64_t> oom_kills() {
+  std::ifstream cg("/proc/self/cgroup");
+  std::string line, path;
+  while (std::getline(cg, line))
+    if (line.rfind("0::", 0) == 0) path = line.substr(3);
+  if (path.empty()) return std::nullopt;
+  std::ifstream events("/sys/fs/cgroup" + path + "/memory.events");
+  std::string key;
+  std::uint64_t n = 0;
+  while (events >> key >> n)
+    if (key == "oom_kill") return n;
+  return std::nullopt;
 }
 
 void write_atomic(const fs::path& path, const std::string& text) {
@@ -825,6 +856,7 @@ class SuiteRun {
     std::optional<TrialRecord> rec;
     std::string rec_error;
     double read_record_s = 0.0;
+    std::optional<std::uint64_t> oom_kills_before;  // the cgroup's count when the trial started
   };
 
   // The results of an earlier run (--resume) or fresh ones; the context is taken now, before any trial.
@@ -989,6 +1021,7 @@ class SuiteRun {
       }
       p.read_record_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
     };
+    p.oom_kills_before = oom_kills();
     p.t0 = std::chrono::steady_clock::now();
     if (o_.instructions) {
       // Under callgrind: the trial runs in a fresh growbench process (`growbench trial`), single-threaded,
@@ -1029,17 +1062,31 @@ class SuiteRun {
       outcome = Outcome::timeout;
       message = fmt::format("killed after {} s", suite_.timeout_s);
     } else if (cr.signal != 0) {
-      // SIGKILL that we did not send is the kernel's OOM killer.
-      outcome = cr.signal == SIGKILL ? Outcome::out_of_memory : Outcome::crashed;
+      // A SIGKILL this process did not send: the kernel's OOM killer when its cgroup counted a kill during the
+      // trial (or when the kernel does not say), another process's otherwise.
+      const bool oom = cr.signal == SIGKILL && (!p.oom_kills_before || oom_kills() > p.oom_kills_before);
+      outcome = oom ? Outcome::out_of_memory : Outcome::crashed;
       message = signal_name(cr.signal);
+      if (cr.signal == SIGKILL)
+        message += oom ? (p.oom_kills_before ? ", by the kernel's OOM killer" : ", probably by the kernel's OOM killer")
+                       : ", not by the kernel's OOM killer";
     } else if (outcome_of_trial_exit(cr.exit_code) == Outcome::ok && fs::exists(rec_path)) {
       if (!p.rec) {
         outcome = Outcome::crashed;
         message = fmt::format("{} is unreadable: {}", rec_path.string(), p.rec_error);
       }
+    } else if (fs::exists(err_path) && cr.exit_code != trial_exit_code(Outcome::ok)) {
+      // The trial's own report: error.txt is written only where it catches its failure, with its code.
+      message = read_message(err_path);
+      outcome = outcome_of_trial_exit(cr.exit_code);
     } else {
-      message = fs::exists(err_path) ? read_text(err_path.string()) : fmt::format("exit code {}", cr.exit_code);
-      outcome = cr.exit_code == trial_exit_code(Outcome::ok) ? Outcome::failed : outcome_of_trial_exit(cr.exit_code);
+      // An exit the trial did not report (a plugin's exit(), or an exit before the record was written):
+      // its status is not a verdict on the input.
+      outcome = Outcome::failed;
+      message = fmt::format(
+          "the trial process exited with status {} without reporting why (an exit() in the "
+          "algorithm, or before its record was written)",
+          cr.exit_code);
     }
     sample.status = std::string(status_name(outcome));
     if (!message.empty()) sample.message = message;

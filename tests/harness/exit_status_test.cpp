@@ -175,9 +175,12 @@ TEST(ExitStatus, InputsThatCannotWorkAreTwoNotZeroOrAnAbort) {
       test::write_text(dir / "fault.json",
                        R"({"schema_version": 1, "name": "f", "algorithms": [{"name": "spacecol", "fault": "explode"}],
           "scenes": ["wall"], "seeds": [1]})");
+  const std::string fifo = d + "/plugin.so";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);  // dlopen waited on it forever
   const struct {
     std::string args, expect;
   } cases[] = {
+      {"list --plugin " + fifo, fifo + ": not a regular file (a FIFO, a device or a socket)"},
       {"run -a lsystem -s wall --set 'premise=F(2e18)J' --set generations=0 -o " + d + "/far",
        "node 1 lies at (-1, 2e+18, 0.13), not within 1e+09 m of the origin"},
       {"run -a lsystem -s wall --set grammar=" + clash + " -o " + d + "/clash", "the parameter name 'x' appears twice"},
