@@ -2,6 +2,8 @@
 // that records a misbehaving plugin and goes on, and spacecol built as a plugin growing the built-in's
 // plant bit for bit on every standard scene.
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <regex>
 
 #include <fmt/format.h>
@@ -173,8 +175,8 @@ TEST(CPlugin, ASuiteRecordsAMisbehavingPluginAndGoesOn) {
   fs::copy_file(fixture("line"), dir / "line.so");
   // Without an address-space limit (AddressSanitizer), fault=oom would take the whole machine.
   const std::string faults = kAddressSpaceLimitWorks
-                                 ? R"("crash", "hang", "oom", "fail", "exit3", "long_message", "none")"
-                                 : R"("crash", "hang", "fail", "exit3", "long_message", "none")";
+                                 ? R"("crash", "hang", "oom", "fail", "exit3", "long_message", "flood", "none")"
+                                 : R"("crash", "hang", "fail", "exit3", "long_message", "flood", "none")";
   test::write_text(dir / "suite.json", fmt::format(R"({{"schema_version": 1, "name": "plugin_faults", "repetitions": 1,
     "warmup": 0, "timeout_s": 5, "memory_limit_mb": 1024, "plugins": ["line.so"], "scenes": ["wall"],
     "algorithms": [{{"name": "line", "sweep": {{"fault": [{}]}}}}]}})",
@@ -195,6 +197,14 @@ TEST(CPlugin, ASuiteRecordsAMisbehavingPluginAndGoesOn) {
   EXPECT_EQ(status["exit3"], "crashed");
   EXPECT_EQ(status["long_message"], "crashed");
   EXPECT_EQ(status["none"], "ok");
+  // 80 MiB of stderr: the log keeps 64 MiB and says what it dropped; the plant is unharmed.
+  EXPECT_EQ(status["flood"], "ok");
+  const fs::path flood_log = dir / "out" / "trials" / "line" / "wall" / "s1" / "fault=flood" / "log.txt";
+  EXPECT_LE(fs::file_size(flood_log), (64u << 20) + 8192u);
+  std::ifstream in(flood_log, std::ios::binary);
+  in.seekg(64 << 20);
+  const std::string tail{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  EXPECT_NE(tail.find("[growbench: the log passed 67108864 bytes; "), std::string::npos) << tail.substr(0, 200);
   for (const auto& c : res.trials) {
     const std::string message = c.message.value_or("");
     if (c.sweep.at("fault") == "exit3") {

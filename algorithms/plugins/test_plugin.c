@@ -4,9 +4,10 @@
  *  0 "line": a working plugin. From every seed, a straight stalk that climbs one `step` per growth step
  *    along the seed's direction until `length` nodes or a solid (host->inside) stops it; a leaf at each
  *    tip. Its `fault` parameter makes it crash, hang, exhaust memory or report errors, for the tests of
- *    how a suite records a misbehaving plugin (an exit() it never reports, a message of a megabyte).
+ *    how a suite records a misbehaving plugin (an exit() it never reports, a message of a megabyte, a flood of stderr).
  *  1 no entry point; 2 another ABI version; 3 a built-in's name; 4 a malformed parameter table. */
 #include <math.h>
+#include <stdio.h>
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,7 +18,8 @@
 #define TEST_PLUGIN_VARIANT 0
 #endif
 
-static const char* const kFaults[] = {"none", "crash", "hang", "oom", "fail", "input", "exit3", "long_message"};
+static const char* const kFaults[] = {"none",  "crash", "hang",         "oom",  "fail",
+                                      "input", "exit3", "long_message", "flood"};
 
 static const growbench_param kParams[] = {
     {"length", GROWBENCH_PARAM_INT, {20, 0.0, 0, NULL, {0, 0, 0}}, 1, 100000, "", "nodes per stalk", NULL, 0},
@@ -26,7 +28,7 @@ static const growbench_param kParams[] = {
 #else
     {"step", GROWBENCH_PARAM_REAL, {0, 0.02, 0, NULL, {0, 0, 0}}, 0.001, 1.0, "m", "length of one step", NULL, 0},
 #endif
-    {"fault", GROWBENCH_PARAM_CHOICE, {0, 0.0, 0, "none", {0, 0, 0}}, 1, 0, "", "misbehave, for tests", kFaults, 8},
+    {"fault", GROWBENCH_PARAM_CHOICE, {0, 0.0, 0, "none", {0, 0, 0}}, 1, 0, "", "misbehave, for tests", kFaults, 9},
 };
 
 static const char* const kTestParams[] = {"length=8"};
@@ -60,7 +62,7 @@ static int32_t start(growbench_instance* instance, const growbench_scene* scene,
   s->scene = scene;
   s->length = params[0].integer;
   s->step = (float)params[1].real;
-  for (s->fault = 0; s->fault < 8 && strcmp(kFaults[s->fault], params[2].text) != 0; ++s->fault) {
+  for (s->fault = 0; s->fault < 9 && strcmp(kFaults[s->fault], params[2].text) != 0; ++s->fault) {
   }
   if (s->fault == 5) {
     s->host->fail(s->host->context, "fault=input: this scene will not do");
@@ -109,6 +111,12 @@ static int32_t step(growbench_instance* instance) {
   if (s->fault == 4) {
     s->host->fail(s->host->context, "fault=fail: gave up");
     return -GROWBENCH_ERROR;
+  }
+  if (s->fault == 8 && s->steps == 0) { /* 80 MiB of stderr, then a plant as usual */
+    static char line[1 << 16];
+    int k;
+    memset(line, 'y', sizeof line);
+    for (k = 0; k < 1280; ++k) fwrite(line, 1, sizeof line, stderr);
   }
   if (s->fault == 6) exit(3); /* the trial's code for out of memory, which it never reported */
   if (s->fault == 7) {

@@ -10,6 +10,7 @@
 #include <limits.h>
 #include <sys/prctl.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -86,7 +87,7 @@ int process_thread_count() {
 
 namespace {
 ChildResult monitor_child(pid_t pid, std::chrono::steady_clock::time_point t0, int report_fd, const ChildLimits& limits,
-                          const std::function<void(const std::string&)>& on_report);
+                          const std::function<void(const std::string&)>& on_report, const std::string& log_path);
 
 // In a job's child, before its body: output appended to log_path (when given), the address-space
 // limit. Async-signal-safe calls only.
@@ -144,15 +145,47 @@ ChildResult run_forked(const std::function<int(int report_fd)>& body, const Chil
     _exit(code);  // no atexit handlers or static destructors of the parent's state
   }
   if (report[1] >= 0) close(report[1]);
-  return monitor_child(pid, t0, report[0], limits, on_report);
+  return monitor_child(pid, t0, report[0], limits, on_report, log_path);
 }
 
 namespace {
 
+// A child's log (its stdout and stderr, appended to a file) is kept to kMaxLogBytes: past it, what follows
+// is cut and a line says how much was dropped. A trial flooding its stderr wrote 4 GB in 6 s.
+constexpr off_t kMaxLogBytes = 64 << 20;
+constexpr int kLogCheckMs = 250;  // how often the parent looks at the log's size while the child runs
+class LogCap {
+ public:
+  explicit LogCap(const std::string& path) : path_(path) {}
+  bool active() const { return !path_.empty(); }
+  // Cuts the log back to kMaxLogBytes when it has passed it (the child appends, so it writes on after the
+  // note); async with the child, so at most a check's worth of output lands past the note.
+  void check() {
+    struct stat st {};
+    if (path_.empty() || stat(path_.c_str(), &st) != 0 || st.st_size <= kMaxLogBytes + kNoteRoom) return;
+    dropped_ += st.st_size - kMaxLogBytes;
+    if (truncate(path_.c_str(), kMaxLogBytes) != 0) return;
+    const int fd = open(path_.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
+    if (fd < 0) return;
+    char note[160];
+    const int n = std::snprintf(note, sizeof note,
+                                "\n[growbench: the log passed %lld bytes; %lld bytes after this point were dropped]\n",
+                                static_cast<long long>(kMaxLogBytes), static_cast<long long>(dropped_));
+    [[maybe_unused]] const ssize_t w = write(fd, note, static_cast<std::size_t>(std::max(n, 0)));
+    close(fd);
+  }
+
+ private:
+  static constexpr off_t kNoteRoom = 4096;
+  std::string path_;
+  off_t dropped_ = 0;
+};
+
 // The parent's half: waits for the child `pid` (started at t0, its report pipe's read end `report_fd`,
-// or -1), enforcing the timeout, and reaps it.
+// or -1), enforcing the timeout and the log's cap, and reaps it.
 ChildResult monitor_child(pid_t pid, std::chrono::steady_clock::time_point t0, int report_fd, const ChildLimits& limits,
-                          const std::function<void(const std::string&)>& on_report) {
+                          const std::function<void(const std::string&)>& on_report, const std::string& log_path) {
+  LogCap log(log_path);
   bool reported = false;
   // The report: one write of at most PIPE_BUF bytes arrives whole; EOF means there was none.
   auto read_report = [&] {
@@ -188,9 +221,12 @@ ChildResult monitor_child(pid_t pid, std::chrono::steady_clock::time_point t0, i
       pollfd pfd[2] = {{pidfd, POLLIN, 0}, {report_fd, POLLIN, 0}};
       int timeout_ms = -1;
       if (limits.timeout_s > 0) timeout_ms = std::max(0, static_cast<int>((limits.timeout_s - elapsed()) * 1000.0) + 1);
-      const int rc = poll(pfd, report_fd >= 0 ? 2 : 1, timeout_ms);
+      const bool log_due = log.active() && (timeout_ms < 0 || timeout_ms > kLogCheckMs);
+      const int rc = poll(pfd, report_fd >= 0 ? 2 : 1, log_due ? kLogCheckMs : timeout_ms);
       if (rc < 0 && errno == EINTR) continue;
       if (rc < 0) break;  // cannot wait on it: the blocking wait4 below still reaps it
+      log.check();
+      if (rc == 0 && log_due) continue;
       if (rc == 0) {
         kill_child();
         break;
@@ -225,6 +261,7 @@ ChildResult monitor_child(pid_t pid, std::chrono::steady_clock::time_point t0, i
     }
   }
   r.wall_s = elapsed();
+  log.check();
   // A report written just before the exit may still be in the pipe.
   if (report_fd >= 0 && !reported) {
     fcntl(report_fd, F_SETFL, O_NONBLOCK);
@@ -409,7 +446,8 @@ Launcher::Launcher(Prepare prepare) {
     ChildLimits limits;
     while (read_request(in, description, limits)) {
       try {
-        (void)prepare(description);     // a bad description is an error reply; the child prepares its own
+        // A bad description is an error reply; the child prepares its own.
+        const std::string log_path = prepare(description).log_path;
         limits.die_with_parent = true;  // the launcher is single-threaded
         auto t0 = std::chrono::steady_clock::now();
         auto hand_over = [&](const Spare& c) {
@@ -436,10 +474,13 @@ Launcher::Launcher(Prepare prepare) {
             throw std::runtime_error(fmt::format("cannot start a trial process: {}", std::strerror(err)));
           }
         }
-        const ChildResult cr = monitor_child(job.pid, t0, job.report_fd, limits, [&](const std::string& report) {
-          send_reply(out, Reply::report, report.data(), report.size());
-          if (spare.pid < 0) spare = fork_spare(prepare);
-        });
+        const ChildResult cr = monitor_child(
+            job.pid, t0, job.report_fd, limits,
+            [&](const std::string& report) {
+              send_reply(out, Reply::report, report.data(), report.size());
+              if (spare.pid < 0) spare = fork_spare(prepare);
+            },
+            log_path);
         if (!send_reply(out, Reply::result, &cr, sizeof cr)) break;
       } catch (const std::exception& e) {
         const std::string what = e.what();
