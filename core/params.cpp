@@ -127,6 +127,15 @@ Row choice(std::string name, std::string default_value, std::vector<std::string>
 
 }  // namespace param
 
+void throw_unknown_choice(std::string_view what, std::string_view given, const std::vector<std::string>& choices) {
+  std::string list;
+  for (std::size_t i = 0; i < choices.size(); ++i)
+    list += (i == 0 ? "" : i + 1 == choices.size() ? " or " : ", ") + choices[i];
+  const std::string near = closest_match(given, choices);
+  throw InputError(fmt::format("{} '{}': expected {}{}", what, given, list,
+                               near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near)));
+}
+
 std::string closest_match(std::string_view name, const std::vector<std::string>& candidates) {
   // Optimal string alignment distance: insertions, deletions, substitutions and adjacent transpositions
   // ("stpe" is one edit from "step").

@@ -69,6 +69,9 @@ Row choice(std::string name, std::string default_value, std::vector<std::string>
 
 // The closest candidate to `name` by edit distance, or "" when nothing is close.
 std::string closest_match(std::string_view name, const std::vector<std::string>& candidates);
+// InputError "WHAT 'GIVEN': expected a, b or c (did you mean 'b'?)" for a value outside a list of choices.
+[[noreturn]] void throw_unknown_choice(std::string_view what, std::string_view given,
+                                       const std::vector<std::string>& choices);
 
 // Named defaults for a parameter table: when the table's Choice parameter `preset` takes the value
 // `name`, the listed parameters default to these values instead of their spec defaults (a value the

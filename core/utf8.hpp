@@ -83,6 +83,19 @@ inline std::string utf8_excerpt(std::string_view text, std::size_t max_bytes) {
   return escape_utf8(text.substr(0, end)) + "...";
 }
 
+// Why `text` cannot be a name that files, folders, renders and reports carry (a suite's or scene's name, an
+// entry's label), or "" when it can: at most kMaxNameBytes, and no control character (a line break ended
+// the comment a name was written into).
+inline constexpr std::size_t kMaxNameBytes = 100;
+inline std::string name_problem(std::string_view text) {
+  if (text.size() > kMaxNameBytes)
+    return "expected a name of at most " + std::to_string(kMaxNameBytes) + " bytes, got " + std::to_string(text.size());
+  for (const char c : text)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+      return "expected a name without control characters (a line break, a tab), got '" + escape_utf8(text, true) + "'";
+  return {};
+}
+
 // Whether the whole of `text` is well-formed UTF-8.
 inline bool is_valid_utf8(std::string_view text) {
   for (std::size_t i = 0; i < text.size();) {

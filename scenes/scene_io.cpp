@@ -11,6 +11,7 @@
 
 #include "core/data_path.hpp"
 #include "core/json_util.hpp"
+#include "core/utf8.hpp"
 #include "scenes/geometry.hpp"
 #include "scenes/obj_check.hpp"
 #include "scenes/scene_library.hpp"
@@ -282,6 +283,7 @@ class JsonScene : public JsonPathReader {
     only_keys(j, path, {"name", "obj", "box", "sphere", "cylinder", "transform", "climbable"});
     TriangleMesh m;
     const std::string name = j.contains("name") ? string(j["name"], path + "/name") : "mesh";
+    if (const std::string bad = name_problem(name); !bad.empty()) fail(path + "/name", bad);
     int kinds = 0;
     if (j.contains("obj")) {
       ++kinds;
@@ -410,6 +412,7 @@ class JsonScene : public JsonPathReader {
       }
     }
     s.name = j.contains("name") ? string(j["name"], "/name") : fs::path(file()).stem().string();
+    if (const std::string bad = name_problem(s.name); !bad.empty()) fail("/name", bad);
     if (j.contains("meshes")) {
       const auto& ms = j["meshes"];
       if (!ms.is_array()) fail("/meshes", "expected an array of meshes");

@@ -219,6 +219,29 @@ TEST(CPlugin, ASuiteRecordsAMisbehavingPluginAndGoesOn) {
   EXPECT_EQ(res.context.plugins[0].path, fs::canonical(dir / "line.so").string());
 }
 
+// A trial that failed for want of disk space was journaled as failed, and --resume on a disk with room never
+// ran it again: the suite stops with 2 before journaling it, and the resumed run grows it.
+TEST(CPlugin, ATrialStarvedOfDiskStopsTheSuiteAndRunsAgainOnResume) {
+  const fs::path dir = test::temp_dir("plugin_disk");
+  fs::copy_file(fixture("line"), dir / "line.so");
+  test::write_text(dir / "suite.json", R"({"schema_version": 1, "name": "disk", "repetitions": 1, "warmup": 0,
+    "plugins": ["line.so"], "scenes": ["wall"],
+    "algorithms": [{"name": "line", "label": "first"}, {"name": "line", "label": "full", "params": {"fault": "disk_full"}}]})");
+  const std::string run = fmt::format("suite {} -o {} -q", (dir / "suite.json").string(), (dir / "out").string());
+  const auto full = test::run_growbench(run);
+  EXPECT_EQ(full.status, 2) << full.out;
+  EXPECT_NE(full.out.find("No space left on device (cell full/wall/s1); free space and continue with --resume"),
+            std::string::npos)
+      << full.out;
+  ::setenv("TEST_PLUGIN_DISK_HAS_ROOM", "1", 1);
+  const auto resumed = test::run_growbench(run + " --resume");
+  ::unsetenv("TEST_PLUGIN_DISK_HAS_ROOM");
+  ASSERT_EQ(resumed.status, 0) << resumed.out;
+  const ResultsFile res = read_results((dir / "out" / "results.json").string());
+  ASSERT_EQ(res.trials.size(), 2u);
+  for (const auto& c : res.trials) EXPECT_EQ(c.status, "ok") << c.id;
+}
+
 // The boundary loses nothing: spacecol, compiled from its own source as a plugin and loaded under
 // another name, grows the built-in's plant bit for bit, its every query crossing the C ABI.
 class SpacecolAsPlugin : public ::testing::TestWithParam<std::string> {};

@@ -4,8 +4,8 @@
  *  0 "line": a working plugin. From every seed, a straight stalk that climbs one `step` per growth step
  *    along the seed's direction until `length` nodes or a solid (host->inside) stops it; a leaf at each
  *    tip. Its `fault` parameter makes it crash, hang, exhaust memory or report errors, for the tests of
- *    how a suite records a misbehaving plugin (an exit() it never reports, a message of a megabyte, a flood of stderr).
- *  1 no entry point; 2 another ABI version; 3 a built-in's name; 4 a malformed parameter table. */
+ *    how a suite records a misbehaving plugin (an exit() it never reports, a message of a megabyte, a flood of stderr,
+ * a full disk). 1 no entry point; 2 another ABI version; 3 a built-in's name; 4 a malformed parameter table. */
 #include <math.h>
 #include <stdio.h>
 #include <signal.h>
@@ -18,8 +18,8 @@
 #define TEST_PLUGIN_VARIANT 0
 #endif
 
-static const char* const kFaults[] = {"none",  "crash", "hang",         "oom",  "fail",
-                                      "input", "exit3", "long_message", "flood"};
+static const char* const kFaults[] = {"none",  "crash", "hang",         "oom",   "fail",
+                                      "input", "exit3", "long_message", "flood", "disk_full"};
 
 static const growbench_param kParams[] = {
     {"length", GROWBENCH_PARAM_INT, {20, 0.0, 0, NULL, {0, 0, 0}}, 1, 100000, "", "nodes per stalk", NULL, 0},
@@ -28,7 +28,7 @@ static const growbench_param kParams[] = {
 #else
     {"step", GROWBENCH_PARAM_REAL, {0, 0.02, 0, NULL, {0, 0, 0}}, 0.001, 1.0, "m", "length of one step", NULL, 0},
 #endif
-    {"fault", GROWBENCH_PARAM_CHOICE, {0, 0.0, 0, "none", {0, 0, 0}}, 1, 0, "", "misbehave, for tests", kFaults, 9},
+    {"fault", GROWBENCH_PARAM_CHOICE, {0, 0.0, 0, "none", {0, 0, 0}}, 1, 0, "", "misbehave, for tests", kFaults, 10},
 };
 
 static const char* const kTestParams[] = {"length=8"};
@@ -62,7 +62,7 @@ static int32_t start(growbench_instance* instance, const growbench_scene* scene,
   s->scene = scene;
   s->length = params[0].integer;
   s->step = (float)params[1].real;
-  for (s->fault = 0; s->fault < 9 && strcmp(kFaults[s->fault], params[2].text) != 0; ++s->fault) {
+  for (s->fault = 0; s->fault < 10 && strcmp(kFaults[s->fault], params[2].text) != 0; ++s->fault) {
   }
   if (s->fault == 5) {
     s->host->fail(s->host->context, "fault=input: this scene will not do");
@@ -118,7 +118,11 @@ static int32_t step(growbench_instance* instance) {
     memset(line, 'y', sizeof line);
     for (k = 0; k < 1280; ++k) fwrite(line, 1, sizeof line, stderr);
   }
-  if (s->fault == 6) exit(3); /* the trial's code for out of memory, which it never reported */
+  if (s->fault == 6) exit(3);
+  if (s->fault == 9 && !getenv("TEST_PLUGIN_DISK_HAS_ROOM")) { /* as a write to a full disk fails */
+    s->host->fail(s->host->context, "cannot write: No space left on device");
+    return -GROWBENCH_ERROR;
+  } /* the trial's code for out of memory, which it never reported */
   if (s->fault == 7) {
     char* text = (char*)malloc(1u << 20);
     if (text) {

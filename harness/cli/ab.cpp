@@ -19,12 +19,15 @@ struct AbArgs {
   AbOptions options;
   std::string suite;
   std::vector<std::string> plugins;
+  bool no_confirm = false;
 };
 
 Outcome run_ab_suite(const AbArgs& a) {
   load_plugins(a.plugins);  // each side's trials load them again: their specs list every plugin loaded
   const Suite suite = load_suite(a.suite);
-  const AbResult r = run_ab(suite, a.options);
+  AbOptions o = a.options;
+  o.confirm = !a.no_confirm;
+  const AbResult r = run_ab(suite, o);
   fmt::print("{}", r.table);
   return r.regression ? Outcome::regression : Outcome::ok;
 }
@@ -65,7 +68,7 @@ Command add_ab(CLI::App& app) {
   cmd->add_option("--phases", o.phases, "phases whose wall and CPU time are compared")
       ->default_val(std::vector<std::string>{"growth"})
       ->delimiter(',');
-  cmd->add_flag("!--no-confirm", o.confirm, "do not rerun flagged cells (a flag is then 'unconfirmed')");
+  cmd->add_flag("--no-confirm", a->no_confirm, "do not rerun flagged cells (a flag is then 'unconfirmed')");
   cmd->add_flag("-q,--quiet", o.quiet, "no progress lines");
   return {cmd, [a] { return run_ab_suite(*a); }};
 }

@@ -91,10 +91,10 @@ Outcome list_algorithms(const ListArgs& a) {
   }
   bool first = true;
   for (const AlgorithmEntry* e : all_algorithms()) {
-    const std::string origin = e->plugin ? fmt::format("\n\n{}", plugin_line(*e)) : "";
+    const std::string origin = e->plugin ? fmt::format("\n\n{}", markdown_text(plugin_line(*e))) : "";
     if (a.markdown)
-      fmt::print("{}## {}\n\n{}{}\n\n{}", first ? "" : "\n", e->info().name, e->info().summary, origin,
-                 markdown_of(e->info()));
+      fmt::print("{}## {}\n\n{}{}\n\n{}", first ? "" : "\n", markdown_text(e->info().name),
+                 markdown_text(e->info().summary), origin, markdown_of(e->info()));
     else
       print_text(*e);
     first = false;

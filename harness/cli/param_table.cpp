@@ -19,6 +19,8 @@ bool is_space(char c) {
   return std::isspace(static_cast<unsigned char>(c)) != 0;
 }
 
+}  // namespace
+
 // Doc text as literal Markdown in a table cell. Only what could end the cell or start code, emphasis, a
 // link or HTML is escaped, so the raw README stays readable: `|`, backticks and backslashes always; `*`
 // and `_` unless spaces on both sides (or, for `_`, letters) keep them from emphasising; `]` before
@@ -38,8 +40,6 @@ std::string markdown_text(const std::string& text) {
   }
   return out;
 }
-
-}  // namespace
 
 void print_param_table(const std::vector<ParamSpec>& specs) {
   std::size_t w = 4;

@@ -16,5 +16,7 @@ std::string param_table_markdown(const std::vector<ParamSpec>& specs);
 
 // `text` as inline code, whatever backticks it holds, safe in a table cell.
 std::string markdown_code(const std::string& text);
+// Text as literal Markdown (what could start code, emphasis, a link or HTML escaped), on one line.
+std::string markdown_text(const std::string& text);
 
 }  // namespace growbench::cli

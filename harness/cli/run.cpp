@@ -152,7 +152,7 @@ Command add_run(CLI::App& app) {
                   "seed position X,Y,Z, snapped to the nearest surface (repeatable; replaces the scene's seeds)");
   add_spec_option(run, "--max-steps", spec, "max_steps");
   add_spec_option(run, "--time-limit", spec, "time_limit_s");
-  add_spec_option(run, "-j,--threads", spec, "threads");
+  add_spec_option(run, "-t,--threads", spec, "threads");
   add_spec_option(run, "--voxel-size", spec, "voxel_size");
   add_spec_option(run, "--sides", spec, "sides");
   add_spec_option(run, "--budget-nodes", spec, "budget_nodes");

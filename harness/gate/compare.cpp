@@ -45,7 +45,15 @@ bool CompareResult::fails() const {
 }
 
 std::string CompareResult::table() const {
-  std::string out;
+  // The verdict first, so that it is read before the rows; it closes the output again for a log's tail.
+  std::size_t failing = 0;
+  for (const auto& c : changes) failing += c.fails ? 1 : 0;
+  const std::string verdict =
+      fmt::format("{} cells compared, {} changed quantities, {} failing, {} missing cells: {}\n", cells_compared,
+                  changes.size(), failing, missing_cells.size(), fails() ? "REGRESSION" : "OK");
+  std::string out = verdict;
+  if (!changes.empty() || !missing_cells.empty() || !new_cells.empty() || small_changes > 0 || !timings.empty())
+    out += "\n";
   std::size_t wc = 4, wq = 8, wv = 3;
   for (const auto& c : changes) {
     wc = std::max(wc, c.cell.size());
@@ -87,10 +95,7 @@ std::string CompareResult::table() const {
     for (const auto& [k, n] : tally) counts += fmt::format("{}{} {}", counts.empty() ? "" : ", ", n, k);
     out += "timings: " + counts + "\n\n";
   }
-  std::size_t failing = 0;
-  for (const auto& c : changes) failing += c.fails ? 1 : 0;
-  out += fmt::format("{} cells compared, {} changed quantities, {} failing, {} missing cells: {}\n", cells_compared,
-                     changes.size(), failing, missing_cells.size(), fails() ? "REGRESSION" : "OK");
+  if (out.size() > verdict.size()) out += verdict;
   return out;
 }
 

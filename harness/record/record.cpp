@@ -597,7 +597,10 @@ std::string results_csv(const ResultsFile& results) {
       if (std::find(columns.begin(), columns.end(), k) == columns.end()) columns.push_back(k);
   std::string out;
   auto line = [&](const std::vector<std::string>& cells) {
-    for (std::size_t i = 0; i < cells.size(); ++i) out += (i ? "," : "") + csv_quoted(cells[i]);
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      if (i > 0) out += ',';
+      out += csv_quoted(cells[i]);
+    }
     out += "\n";
   };
   line(columns);

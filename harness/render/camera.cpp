@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "core/params.hpp"
 #include "core/errors.hpp"
 
 namespace growbench {
@@ -14,7 +15,7 @@ namespace growbench {
 CameraMode parse_camera_mode(const std::string& text, const std::string& option) {
   if (text == "auto") return CameraMode::Auto;
   if (text == "scene") return CameraMode::Scene;
-  throw InputError(fmt::format("{} '{}': expected auto or scene", option, text));
+  throw_unknown_choice(option, text, {"auto", "scene"});
 }
 
 const char* to_string(CameraMode m) {

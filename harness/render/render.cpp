@@ -22,6 +22,7 @@
 #include <cairo.h>
 #include <fmt/format.h>
 
+#include "core/params.hpp"
 #include "core/errors.hpp"
 #include "core/json_util.hpp"
 #include "core/utf8.hpp"
@@ -37,7 +38,7 @@ namespace fs = std::filesystem;
 RenderQuality parse_render_quality(const std::string& text, const std::string& option) {
   if (text == "preview") return RenderQuality::Preview;
   if (text == "paper") return RenderQuality::Paper;
-  throw InputError(fmt::format("{} '{}': expected preview or paper", option, text));
+  throw_unknown_choice(option, text, {"preview", "paper"});
 }
 
 const char* to_string(RenderQuality q) {
@@ -47,7 +48,7 @@ const char* to_string(RenderQuality q) {
 Backdrop parse_backdrop(const std::string& text, const std::string& option) {
   if (text == "scene") return Backdrop::Scene;
   if (text == "studio") return Backdrop::Studio;
-  throw InputError(fmt::format("{} '{}': expected scene or studio", option, text));
+  throw_unknown_choice(option, text, {"scene", "studio"});
 }
 
 const char* to_string(Backdrop b) {

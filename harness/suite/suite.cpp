@@ -1,4 +1,3 @@
-#include "core/utf8.hpp"
 #include "harness/record/files.hpp"
 #include "harness/suite/suite.hpp"
 
@@ -8,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -29,6 +29,7 @@
 #include "algorithms/plugins/loader.hpp"
 #include "core/errors.hpp"
 #include "core/json_util.hpp"
+#include "core/utf8.hpp"
 #include "harness/organs/options.hpp"
 #include "harness/output/exporters.hpp"
 #include "harness/record/record.hpp"
@@ -101,6 +102,14 @@ class SuiteReader : public JsonPathReader {
     if (!j[key].is_string())
       fail(fmt::format("{}/{}", path, key), fmt::format("expected {}, got {}", what, j[key].type_name()));
     return j[key].get<std::string>();
+  }
+  // A name (the suite's, a scene's, an entry's label): it becomes folders, file names and captions.
+  std::string name_field(const json& j, const std::string& path, const char* key, const std::string& fallback,
+                         const char* what) const {
+    std::string s = string_field(j, path, key, fallback, what);
+    if (const std::string bad = name_problem(s); !bad.empty() && j.contains(key))
+      fail(fmt::format("{}/{}", path, key), bad);
+    return s;
   }
   // A path in a suite file, relative to the suite file.
   std::string relative_to_suite(const std::string& path) const {
@@ -182,7 +191,7 @@ class SuiteReader : public JsonPathReader {
   }
 
   Common read_settings(const json& j, Suite& s) const {
-    s.name = string_field(j, "", "name", fs::path(file()).stem().string(), "the suite's name");
+    s.name = name_field(j, "", "name", fs::path(file()).stem().string(), "the suite's name");
     s.description = string_field(j, "", "description", "", "a description");
     if (j.contains("repetitions")) s.repetitions = static_cast<int>(number(j["repetitions"], "/repetitions", 1, 1000));
     if (j.contains("warmup")) s.warmup = static_cast<int>(number(j["warmup"], "/warmup", 0, 100));
@@ -234,7 +243,7 @@ class SuiteReader : public JsonPathReader {
           if (!e["params"].is_object()) fail(path + "/params", "expected an object of scene parameters");
           for (const auto& [k, v] : e["params"].items()) se.params.push_back(k + "=" + value_text(v));
         }
-        se.name = string_field(e, path, "name", "", "the scene's display name");
+        se.name = name_field(e, path, "name", "", "the scene's display name");
       }
       try {
         const Scene sc = load_scene(se.spec, se.params);
@@ -271,7 +280,7 @@ class SuiteReader : public JsonPathReader {
       only_keys(e, path, keys);
       if (!e.contains("name") || !e["name"].is_string()) fail(path + "/name", "expected the algorithm's name");
       a.name = e["name"].get<std::string>();
-      a.label = string_field(e, path, "label", "", "the entry's label");
+      a.label = name_field(e, path, "label", "", "the entry's label");
       read_settings_into(e, path, a.spec);
       if (e.contains("fault")) {
         read_spec_field(a.spec, "fault", e["fault"], file(), path + "/fault");
@@ -829,7 +838,9 @@ class SuiteRun {
       pool.emplace(jobs.size(), std::min(width, jobs.size()), [&](std::size_t i) { return start_job(jobs[i]); });
     for (std::size_t jn = 0; jn < jobs.size(); ++jn) {
       if (!o_.quiet) print_progress(jobs, jn, t_start, tty);
-      if (!finish_job(jobs[jn], pool ? pool->take(jn) : start_job(jobs[jn]))) continue;  // a warm-up
+      const bool measured = finish_job(jobs[jn], pool ? pool->take(jn) : start_job(jobs[jn]));
+      if (!o_.quiet) print_outcome(jobs, jn, tty);
+      if (!measured) continue;  // a warm-up
       // Readable snapshots of the whole run every few seconds (always written atomically).
       if (std::chrono::steady_clock::now() - last_snapshot > std::chrono::seconds(10)) {
         write_snapshot();
@@ -1004,7 +1015,19 @@ class SuiteRun {
     if (tty)
       fmt::print(stderr, "\r{:<100}", line.substr(0, 100));
     else
-      fmt::print(stderr, "{}\n", line);
+      fmt::print(stderr, "{}", line);
+  }
+  // Ends the progress line with how the trial ended: "ok, 1.2 s", or its status and the start of its message.
+  void print_outcome(const std::vector<Job>& jobs, std::size_t jn, bool tty) const {
+    std::string outcome = fmt::format("{}, {:.1f} s", last_outcome_.status, last_outcome_.wall_s);
+    if (last_outcome_.message) outcome += ": " + utf8_excerpt(*last_outcome_.message, 60);
+    if (!tty) {
+      fmt::print(stderr, " -> {}\n", outcome);
+      return;
+    }
+    const Job& job = jobs[jn];  // the line again, now with its outcome, kept to 100 columns
+    const std::string line = fmt::format("[{}/{}] {} -> {}", jn + 1, jobs.size(), job.cell->id, outcome);
+    fmt::print(stderr, "\r{:<100}{}", line.substr(0, 100), last_outcome_.status == "ok" ? "" : "\n");
   }
 
   // Runs the cell's trial in its own process: forked by the launcher, or under callgrind as `growbench trial`.
@@ -1135,6 +1158,8 @@ class SuiteRun {
     sample.child_system_s = p.cr.system_s;
     sample.child_max_rss_bytes = p.cr.max_rss_bytes;
     judge(p, dir, sample);
+    last_outcome_ = {sample.status, p.cr.wall_s, sample.message};
+    stop_if_the_disk_is_full(c, sample);
     std::optional<InstructionCounts> instructions;
     if (sample.status == "ok" && o_.instructions) sample.instructions = instructions = read_callgrind_phases(dir);
     if (job.repetition < 0) return false;
@@ -1154,9 +1179,20 @@ class SuiteRun {
     // interrupted suite (even by kill -9) loses at most the trial in flight.
     const std::string line = json_text(to_json(JournalEntry{c.id, sample, cell}), -1);
     if (std::fputs(line.c_str(), journal_.get()) < 0 || std::fflush(journal_.get()) != 0)
-      throw std::runtime_error(fmt::format("{}: cannot append to the journal", journal_path_.string()));
+      throw InputError(fmt::format("{}: cannot append to the journal: {}; the trial runs again with --resume",
+                                   journal_path_.string(), std::strerror(errno)));
     apply_sample(t, sample, cell);
     return true;
+  }
+
+  // A trial that failed for want of disk space says nothing of its input: the suite stops (exit 2) before
+  // journaling it, so that --resume on a disk with room runs it again.
+  void stop_if_the_disk_is_full(const SuiteConfig& c, const SuiteSample& sample) const {
+    if (sample.status == "ok" || !sample.message) return;
+    const std::string full = std::strerror(ENOSPC);
+    if (sample.message->find(full) == std::string::npos) return;
+    throw InputError(fmt::format("{}: {} (cell {}); free space and continue with --resume: that trial runs again",
+                                 out_.string(), full, c.id));
   }
 
   void write_snapshot() {
@@ -1170,6 +1206,11 @@ class SuiteRun {
   fs::path out_, results_path_, journal_path_;
   std::unique_ptr<Launcher> own_launcher_;
   FolderLock lock_;  // released before the launcher ends (members end in reverse order)
+  struct {
+    std::string status;
+    double wall_s = 0.0;
+    std::optional<std::string> message;
+  } last_outcome_;  // of the trial finished last, for the progress line
   Launcher* launcher_ = nullptr;
   ResultsFile results_;
   std::map<std::string, std::size_t> index_;  // cell id -> index in results_.trials

@@ -131,8 +131,9 @@ TEST(Cli, BadInputExitsTwoWithAClearMessage) {
 
 TEST(Cli, RunWritesMeshesSkeletonAndRecord) {
   const auto dir = test::temp_dir("cli_run");
-  const auto r = growbench("run -q -a spacecol -s column --set surface=cling --set point_count=3000 --seed 3 -j 2 -o " +
-                           dir.string());
+  const auto r =
+      growbench("run -q -a spacecol -s column --set surface=cling --set point_count=3000 --seed 3 --threads 2 -o " +
+                dir.string());
   ASSERT_EQ(r.status, 0) << r.out;
   for (const char* f : {"plant.obj", "plant.mtl", "plant.ply", "skeleton.obj", "skeleton.ply", "record.json"})
     EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
@@ -160,7 +161,7 @@ TEST(Cli, CustomLeafObjForHadrich) {
   const std::string leaf = test::write_text(dir / "leaf.obj",
                                             "v 0 0 0\nv 0.3 0 0.5\nv 0 0 1\nv -0.3 0 0.5\nv 0 0.1 0.5\n"
                                             "f 1 2 3\nf 1 3 4\nf 1 5 3\n");
-  const std::string common = "run -q -a hadrich -s wall --set max_particles=400 --max-steps 300 -j 1 -o ";
+  const std::string common = "run -q -a hadrich -s wall --set max_particles=400 --max-steps 300 --threads 1 -o ";
   auto r = growbench(common + (dir / "plain").string());
   ASSERT_EQ(r.status, 0) << r.out;
   r = growbench(common + (dir / "custom").string() + " --leaf-obj " + leaf);

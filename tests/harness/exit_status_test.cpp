@@ -102,7 +102,10 @@ TEST(ExitStatus, HelpIsZeroAndEveryCommandLineErrorIsTwo) {
     EXPECT_EQ(r.status, 2) << c << ": " << r.out;
     EXPECT_FALSE(has(r.out, "internal error")) << c << ": " << r.out;
   }
-  EXPECT_EQ(growbench("--version").status, 0);
+  EXPECT_FALSE(has(growbench("ab --help").out, "{false}"));  // CLI11's rendering of a negated flag
+  const auto version = growbench("--version");
+  EXPECT_EQ(version.status, 0);
+  EXPECT_TRUE(has(version.out, "(commit ")) << version.out;
   auto r = growbench("");
   EXPECT_EQ(r.status, 2) << r.out;
   EXPECT_TRUE(has(r.out, "A subcommand is required")) << r.out;
@@ -175,11 +178,30 @@ TEST(ExitStatus, InputsThatCannotWorkAreTwoNotZeroOrAnAbort) {
       test::write_text(dir / "fault.json",
                        R"({"schema_version": 1, "name": "f", "algorithms": [{"name": "spacecol", "fault": "explode"}],
           "scenes": ["wall"], "seeds": [1]})");
+  auto suite_with = [&](const std::string& name, const std::string& entry) {
+    return test::write_text(dir / name, R"({"schema_version": 1, "name": "n", "algorithms": [)" + entry +
+                                            R"(], "scenes": ["wall"], "seeds": [1]})");
+  };
+  const std::string long_label =
+      suite_with("long.json", R"({"name": "spacecol", "label": ")" + std::string(300, 'x') + R"("})");
+  const std::string broken_label = suite_with("broken.json", R"({"name": "spacecol", "label": "a\nb"})");
+  const std::string scene_name = test::write_text(dir / "named.json", R"({"schema_version": 1, "base": "wall",
+      "name": "x\n#fopen F \"/tmp/pwned\" write"})");
   const std::string fifo = d + "/plugin.so";
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);  // dlopen waited on it forever
   const struct {
     std::string args, expect;
   } cases[] = {
+      // Names become folders, files and captions: a 300-byte label passed and failed only at the first
+      // trial, after files were made; a line break in a name ended the comment it was written into.
+      {"suite " + long_label + " -o " + d + "/long", "at /algorithms/0/label: expected a name of at most 100 bytes"},
+      {"suite " + broken_label + " -o " + d + "/broken", "at /algorithms/0/label: expected a name without control"},
+      {"run -a spacecol -s " + scene_name + " -o " + d + "/named", "at /name: expected a name without control"},
+      // Every choice option suggests the nearest choice, as --algorithm and --scene do.
+      {"run -a spacecol -s wall --render papr -o " + d + "/r",
+       "--render 'papr': expected preview or paper (did you mean 'paper'?)"},
+      {"render " + d + " --camera scen", "--camera 'scen': expected auto or scene (did you mean 'scene'?)"},
+      {"render " + d + " --backdrop studi", "--backdrop 'studi': expected scene or studio (did you mean 'studio'?)"},
       {"list --plugin " + fifo, fifo + ": not a regular file (a FIFO, a device or a socket)"},
       {"run -a lsystem -s wall --set 'premise=F(2e18)J' --set generations=0 -o " + d + "/far",
        "node 1 lies at (-1, 2e+18, 0.13), not within 1e+09 m of the origin"},
@@ -206,6 +228,7 @@ TEST(ExitStatus, InputsThatCannotWorkAreTwoNotZeroOrAnAbort) {
     EXPECT_TRUE(has(r.out, c.expect)) << c.args << ": " << r.out;
   }
   EXPECT_FALSE(fs::exists(dir / "m.json"));
+  EXPECT_FALSE(fs::exists(dir / "long"));  // refused before any file was made
 }
 
 // Two writers on one folder interleaved their files: duplicated (id, repetition) pairs, a good trial

@@ -326,9 +326,9 @@ TEST(Glb, RunWritesTheChosenLayout) {
     std::ifstream in(dir / out / "record.json");
     return Json::parse(in);
   };
-  const Json plain = run("--glb plain -j 1", "plain");
-  const Json one = run("-j 1", "one");
-  const Json two = run("-j 2", "two");
+  const Json plain = run("--glb plain --threads 1", "plain");
+  const Json one = run("--threads 1", "one");
+  const Json two = run("--threads 2", "two");
   EXPECT_EQ(plain["output_bytes"]["glb"].get<std::uintmax_t>(), std::filesystem::file_size(dir / "plain/plant.glb"));
   EXPECT_EQ(plain["output_bytes"]["glb_plain"], plain["output_bytes"]["glb"]);
   EXPECT_EQ(one["output_bytes"]["glb"].get<std::uintmax_t>(), std::filesystem::file_size(dir / "one/plant.glb"));
