@@ -1,11 +1,20 @@
 #include "algorithms/plugins/loader.hpp"
 
 #include <dlfcn.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstddef>
+#include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <deque>
 #include <filesystem>
 #include <set>
@@ -211,6 +220,78 @@ const growbench_plugin* open_plugin(const std::string& path) {
   return t;
 }
 
+// Loading runs the library's constructors and its entry(), code the host cannot vet: one that crashed,
+// aborted or called exit() ended `list` (and `suite`, with exit 0 and no results). It is loaded first in a
+// child, which reports what loading said; a child that ends any other way, or takes longer than
+// kProbeSeconds, is an InputError naming the plugin. Then it is loaded here, as before.
+constexpr int kProbeSeconds = 30;
+void probe_in_child(const std::string& path) {
+  int fds[2];
+  if (pipe2(fds, O_CLOEXEC) != 0) return;  // cannot probe: the load below still checks the rest
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const pid_t pid = fork();
+  if (pid < 0) {
+    close(fds[0]);
+    close(fds[1]);
+    return;
+  }
+  if (pid == 0) {
+    close(fds[0]);
+    // A plugin's exit() here would run the exit handlers of libraries whose threads the fork did not
+    // copy (and wait for them forever): registered last, this handler runs first and ends the child with
+    // the plugin's status.
+    on_exit([](int status, void*) { _exit(status); }, nullptr);
+    std::string said = "ok";
+    try {
+      (void)read_plugin_table(path, *open_plugin(path));
+    } catch (const std::exception& e) {
+      said = e.what();
+    }
+    const char* p = said.data();
+    for (std::size_t left = said.size(); left > 0;) {
+      const ssize_t w = write(fds[1], p, left);
+      if (w <= 0) break;
+      p += w;
+      left -= static_cast<std::size_t>(w);
+    }
+    _exit(0);
+  }
+  close(fds[1]);
+  std::string said;
+  bool late = false;
+  for (const auto t0 = std::chrono::steady_clock::now();;) {
+    const auto left = std::chrono::seconds(kProbeSeconds) - (std::chrono::steady_clock::now() - t0);
+    pollfd pfd{fds[0], POLLIN, 0};
+    const int rc = poll(
+        &pfd, 1,
+        static_cast<int>(std::max<long long>(0, std::chrono::duration_cast<std::chrono::milliseconds>(left).count())));
+    if (rc < 0 && errno == EINTR) continue;
+    if (rc == 0) {
+      late = true;
+      kill(pid, SIGKILL);
+      break;
+    }
+    char buf[4096];
+    const ssize_t n = rc > 0 ? read(fds[0], buf, sizeof buf) : -1;
+    if (n <= 0) break;  // EOF: the child has ended or closed its end
+    said.append(buf, static_cast<std::size_t>(n));
+  }
+  close(fds[0]);
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (said == "ok") return;
+  if (!late && WIFEXITED(status) && WEXITSTATUS(status) == 0 && !said.empty()) throw InputError(said);
+  const std::string how =
+      late ? fmt::format("did not return within {} s", kProbeSeconds)
+      : WIFSIGNALED(status)
+          ? fmt::format("ended the process with signal {} ({})", WTERMSIG(status), strsignal(WTERMSIG(status)))
+          : fmt::format("ended the process with exit status {}", WEXITSTATUS(status));
+  throw InputError(fmt::format("{}: loading it {} (in its constructors or {}()); a plugin must load and return", path,
+                               how, GROWBENCH_PLUGIN_ENTRY_SYMBOL));
+}
+
 void check_name_free(const std::string& path, const std::string& name) {
   for (const auto& e : algorithm_registry())
     if (e.info().name == name)
@@ -229,6 +310,7 @@ const AlgorithmEntry& load_plugin(const std::string& given) {
   const std::string path = abs.empty() ? given : abs.string();
   for (const auto& l : loaded())
     if (l.path == path) return l.entry;
+  probe_in_child(path);
   const growbench_plugin* t = open_plugin(path);
   AlgorithmInfo info = read_plugin_table(path, *t);
   check_name_free(path, info.name);

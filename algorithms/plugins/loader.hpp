@@ -16,6 +16,8 @@ namespace growbench {
 // entry already registered. InputError naming the file when it is missing, is not a shared library,
 // has no growbench_plugin_entry, speaks another ABI version, takes a name already taken, or has a
 // malformed table.
+// The plugin is first loaded in a child: one whose loading crashes, exits or hangs is an InputError
+// here, not the end of the command.
 const AlgorithmEntry& load_plugin(const std::string& path);
 // The checks load_plugin makes of a plugin's table, on their own (for tests and fuzzing): its name,
 // functions, parameter rows (names, types, ranges, finite defaults in range, choices, UTF-8 text, no

@@ -169,6 +169,21 @@ TEST(CPlugin, ItsErrorsKeepTheirKindAndMessage) {
   EXPECT_NE(test::error_of([&] { run_trial_record(spec); }).find("'step'"), std::string::npos);
 }
 
+// A plugin whose entry() crashed or called exit(0) ended `list`, and `suite` exited 0 with no results: it is
+// loaded first in a child, and the command exits 2 naming it.
+TEST(PluginLoader, AnEntryPointThatEndsTheProcessIsAnErrorNotTheEnd) {
+  for (const auto& [variant, how] :
+       std::vector<std::pair<std::string, std::string>>{{"crash_entry", "ended the process with signal 11"},
+                                                        {"exit_entry", "ended the process with exit status 0"}}) {
+    const std::string p = fixture(variant);
+    for (const std::string& command : {"list --plugin " + p, "run -a line -s wall --plugin " + p}) {
+      const auto r = test::run_growbench(command);
+      EXPECT_EQ(r.status, 2) << command << ": " << r.out;
+      EXPECT_NE(r.out.find(p + ": loading it " + how), std::string::npos) << command << ": " << r.out;
+    }
+  }
+}
+
 // A plugin that crashes, hangs or runs out of memory in a suite is recorded as such, and the suite goes on.
 TEST(CPlugin, ASuiteRecordsAMisbehavingPluginAndGoesOn) {
   const fs::path dir = test::temp_dir("plugin_suite");

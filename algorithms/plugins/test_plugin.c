@@ -5,7 +5,8 @@
  *    along the seed's direction until `length` nodes or a solid (host->inside) stops it; a leaf at each
  *    tip. Its `fault` parameter makes it crash, hang, exhaust memory or report errors, for the tests of
  *    how a suite records a misbehaving plugin (an exit() it never reports, a message of a megabyte, a flood of stderr,
- * a full disk). 1 no entry point; 2 another ABI version; 3 a built-in's name; 4 a malformed parameter table. */
+ * a full disk). 1 no entry point; 2 another ABI version; 3 a built-in's name; 4 a malformed parameter table;
+ * 5 an entry() that crashes; 6 an entry() that calls exit(0). */
 #include <math.h>
 #include <stdio.h>
 #include <signal.h>
@@ -239,6 +240,12 @@ GROWBENCH_PLUGIN_EXPORT const growbench_plugin* not_the_entry(void) {
 }
 #else
 GROWBENCH_PLUGIN_EXPORT const growbench_plugin* growbench_plugin_entry(void) {
+#if TEST_PLUGIN_VARIANT == 5
+  signal(SIGSEGV, SIG_DFL);
+  raise(SIGSEGV);
+#elif TEST_PLUGIN_VARIANT == 6
+  exit(0);
+#endif
   return &kPlugin;
 }
 #endif

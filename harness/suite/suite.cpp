@@ -4,6 +4,8 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <sys/statvfs.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -1188,9 +1190,13 @@ class SuiteRun {
   // A trial that failed for want of disk space says nothing of its input: the suite stops (exit 2) before
   // journaling it, so that --resume on a disk with room runs it again.
   void stop_if_the_disk_is_full(const SuiteConfig& c, const SuiteSample& sample) const {
-    if (sample.status == "ok" || !sample.message) return;
+    if (sample.status == "ok") return;
     const std::string full = std::strerror(ENOSPC);
-    if (sample.message->find(full) == std::string::npos) return;
+    // The trial's own error.txt may not have fitted either: then the folder's free space tells.
+    struct statvfs fs_stat {};
+    const bool no_room = statvfs(out_.c_str(), &fs_stat) == 0 &&
+                         static_cast<double>(fs_stat.f_bavail) * static_cast<double>(fs_stat.f_frsize) < 1 << 20;
+    if (!no_room && (!sample.message || sample.message->find(full) == std::string::npos)) return;
     throw InputError(fmt::format("{}: {} (cell {}); free space and continue with --resume: that trial runs again",
                                  out_.string(), full, c.id));
   }
