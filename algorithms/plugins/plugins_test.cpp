@@ -236,7 +236,7 @@ TEST(CPlugin, ASuiteRecordsAMisbehavingPluginAndGoesOn) {
 
 // A trial that failed for want of disk space was journaled as failed, and --resume on a disk with room never
 // ran it again: the suite stops with 2 before journaling it, and the resumed run grows it.
-TEST(CPlugin, ATrialStarvedOfDiskStopsTheSuiteAndRunsAgainOnResume) {
+TEST(CPlugin, ATrialStarvedOfDiskRunsAgainOnResumeWithTheSamePlugin) {
   const fs::path dir = test::temp_dir("plugin_disk");
   fs::copy_file(fixture("line"), dir / "line.so");
   test::write_text(dir / "suite.json", R"({"schema_version": 1, "name": "disk", "repetitions": 1, "warmup": 0,
@@ -249,6 +249,13 @@ TEST(CPlugin, ATrialStarvedOfDiskStopsTheSuiteAndRunsAgainOnResume) {
             std::string::npos)
       << full.out;
   ::setenv("TEST_PLUGIN_DISK_HAS_ROOM", "1", 1);
+  // The plugin rebuilt in between (a byte more, still a loadable library) is refused, named.
+  std::ofstream(dir / "line.so", std::ios::app | std::ios::binary) << '\0';
+  const auto rebuilt = test::run_growbench(run + " --resume");
+  EXPECT_EQ(rebuilt.status, 2) << rebuilt.out;
+  EXPECT_NE(rebuilt.out.find("cannot resume, plugin 'line' has changed since its trials ran (xxh3 "), std::string::npos)
+      << rebuilt.out;
+  fs::copy_file(fixture("line"), dir / "line.so", fs::copy_options::overwrite_existing);
   const auto resumed = test::run_growbench(run + " --resume");
   ::unsetenv("TEST_PLUGIN_DISK_HAS_ROOM");
   ASSERT_EQ(resumed.status, 0) << resumed.out;

@@ -894,6 +894,7 @@ class SuiteRun {
       if (results_.repetitions != suite_.repetitions)
         throw InputError(fmt::format("{}: cannot resume, it ran {} repetitions per cell and this run asks {}",
                                      results_path_.string(), results_.repetitions, suite_.repetitions));
+      check_same_plugins();
     } else {
       results_.mode = o_.instructions ? "instructions" : "timing";
       results_.suite = {suite_.name, suite_.file, suite_.description};
@@ -904,6 +905,22 @@ class SuiteRun {
     results_.context = run_context_record();
     results_.context.suite_file_hash = suite_.hash;
     if (g_threads_at_fork >= 0) results_.context.parent_threads_at_fork = g_threads_at_fork;
+  }
+
+  // A plugin rebuilt between a run and its --resume would mix two programs' trials under one name.
+  void check_same_plugins() const {
+    const auto now = loaded_plugins();
+    for (const PluginOrigin& before : results_.context.plugins) {
+      const auto same = std::find_if(now.begin(), now.end(), [&](const PluginOrigin& p) { return p.name == before.name; });
+      if (same == now.end())
+        throw InputError(fmt::format("{}: cannot resume, its trials ran plugin '{}' ({}), which this run does not load",
+                                     results_path_.string(), before.name, before.path));
+      if (same->hash != before.hash)
+        throw InputError(fmt::format(
+            "{}: cannot resume, plugin '{}' has changed since its trials ran (xxh3 {} then, {} now, {}); "
+            "rerun in another --out",
+            results_path_.string(), before.name, before.hash, same->hash, same->path));
+    }
   }
 
   // Indexes the cells already recorded, and creates entries for every cell of this shard.
