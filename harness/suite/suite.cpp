@@ -911,15 +911,16 @@ class SuiteRun {
   void check_same_plugins() const {
     const auto now = loaded_plugins();
     for (const PluginOrigin& before : results_.context.plugins) {
-      const auto same = std::find_if(now.begin(), now.end(), [&](const PluginOrigin& p) { return p.name == before.name; });
+      const auto same =
+          std::find_if(now.begin(), now.end(), [&](const PluginOrigin& p) { return p.name == before.name; });
       if (same == now.end())
         throw InputError(fmt::format("{}: cannot resume, its trials ran plugin '{}' ({}), which this run does not load",
                                      results_path_.string(), before.name, before.path));
       if (same->hash != before.hash)
-        throw InputError(fmt::format(
-            "{}: cannot resume, plugin '{}' has changed since its trials ran (xxh3 {} then, {} now, {}); "
-            "rerun in another --out",
-            results_path_.string(), before.name, before.hash, same->hash, same->path));
+        throw InputError(
+            fmt::format("{}: cannot resume, plugin '{}' has changed since its trials ran (xxh3 {} then, {} now, {}); "
+                        "rerun in another --out",
+                        results_path_.string(), before.name, before.hash, same->hash, same->path));
     }
   }
 
