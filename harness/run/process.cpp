@@ -409,6 +409,26 @@ Spare fork_spare(const Launcher::Prepare& prepare) {
   return {pid, job[1], rep[0]};
 }
 
+// In the launcher, the subreaper of its jobs: what a job's processes started outside the job's process
+// group (a daemon that called setsid) came to the launcher when its parent ended, and is ended here once
+// the job has been reaped. A process ended in one round may leave children of its own: they come next.
+void end_orphans(pid_t spare) {
+  const std::string list = fmt::format("/proc/self/task/{}/children", getpid());
+  for (int round = 0; round < 64; ++round) {
+    std::vector<pid_t> orphans;
+    if (FILE* f = std::fopen(list.c_str(), "re")) {
+      for (long p = 0; std::fscanf(f, "%ld", &p) == 1;)
+        if (p != spare) orphans.push_back(static_cast<pid_t>(p));
+      std::fclose(f);
+    }
+    if (orphans.empty()) return;
+    for (pid_t p : orphans) kill(p, SIGKILL);
+    for (pid_t p : orphans)
+      while (waitpid(p, nullptr, 0) < 0 && errno == EINTR) {
+      }
+  }
+}
+
 }  // namespace
 
 Launcher::Launcher(Prepare prepare) {
@@ -431,6 +451,7 @@ Launcher::Launcher(Prepare prepare) {
   if (pid_ == 0) {
     prctl(PR_SET_PDEATHSIG, SIGKILL);  // the launcher never outlives its owner
     if (getppid() != owner) _exit(0);
+    prctl(PR_SET_CHILD_SUBREAPER, 1);  // see end_orphans
     // A write to a child that died waiting for its job (or to an owner that died) fails with EPIPE
     // instead of ending the launcher.
     signal(SIGPIPE, SIG_IGN);
@@ -481,6 +502,7 @@ Launcher::Launcher(Prepare prepare) {
               if (spare.pid < 0) spare = fork_spare(prepare);
             },
             log_path);
+        end_orphans(spare.pid);
         if (!send_reply(out, Reply::result, &cr, sizeof cr)) break;
       } catch (const std::exception& e) {
         const std::string what = e.what();

@@ -255,5 +255,34 @@ TEST(Process, WhatAChildLeftInItsGroupEndsWithIt) {
   std::remove(file.c_str());
 }
 
+// A suite's trial that started a daemon of its own (fork, then setsid: outside the trial's process group)
+// left it running after the suite: the launcher, its subreaper, ends it with the trial.
+TEST(Process, ADaemonATrialStartedEndsWithTheTrial) {
+  const std::string file = ::testing::TempDir() + "/growbench_daemon_pid_" + std::to_string(getpid());
+  std::remove(file.c_str());
+  Launcher launcher([file](const std::string&) {
+    return Launcher::Job{[file](int) {
+                           if (fork() == 0) {
+                             setsid();
+                             if (fork() == 0) {  // the daemon: its parent ends at once
+                               if (FILE* f = std::fopen(file.c_str(), "w"))
+                                 std::fprintf(f, "%d\n", getpid()), std::fclose(f);
+                               sleep(60);
+                             }
+                             _exit(0);
+                           }
+                           pid_from(file);
+                           return 0;
+                         },
+                         ""};
+  });
+  const ChildResult r = launcher.run("go", {}, nullptr);
+  EXPECT_EQ(r.exit_code, 0);
+  const pid_t daemon = pid_from(file);
+  ASSERT_GT(daemon, 0);
+  EXPECT_TRUE(ends_within(daemon, std::chrono::seconds(5))) << "pid " << daemon << " outlived its trial";
+  std::remove(file.c_str());
+}
+
 }  // namespace
 }  // namespace growbench
