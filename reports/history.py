@@ -80,10 +80,11 @@ def change_points(values, min_step=0.01):
 
 def safe_name(s):
     """A folder name for a machine or suite name a history file gives, as growbench's safe_name makes
-    them: characters outside [A-Za-z0-9-_.=,] become '_', and a name of dots only ('..') becomes
-    underscores, so a hostile file cannot send a figure outside --out."""
+    them: characters outside [A-Za-z0-9-_.=,] become '_', and so do leading dots ('..' would leave --out,
+    '.x' would be hidden)."""
     s = re.sub(r"[^A-Za-z0-9._=,-]", "_", str(s))
-    return "_" * len(s) if s and s.strip(".") == "" else s
+    dots = len(s) - len(s.lstrip("."))
+    return "_" * dots + s[dots:]
 
 
 def fail(message):
@@ -94,7 +95,7 @@ def fail(message):
 
 def load(dir_):
     groups = {}
-    for path in sorted(glob.glob(os.path.join(dir_, "*", "*", "*.json"))):
+    for path in sorted(glob.glob(os.path.join(dir_, "*", "*", "*.json"), include_hidden=True)):
         try:
             with open(path, encoding="utf-8") as f:
                 doc = json.load(f)

@@ -216,5 +216,16 @@ def write_tex(path, rows_by_cell, labels, scenes, quality, notes=()):
         lines += ["\\paragraph{" + escape(notes[0]) + "}", "{\\footnotesize\\raggedright"]
         lines += [escape(n) + ("\\\\" if i + 1 < len(notes) - 1 else "") for i, n in enumerate(notes[1:])]
         lines += ["\\par}", ""]
-    with open(path, "w") as f:
+    beyond = beyond_latin(lines)
+    if beyond:
+        lines.insert(0, f"% Names here hold characters pdflatex cannot set ({' '.join(beyond)}): compile with lualatex or "
+                        "xelatex and a font that has them.")
+    with open(path, "w", encoding="utf-8") as f:
         f.write("\n".join(lines))
+    return beyond
+
+
+def beyond_latin(lines):
+    """The characters of `lines` past Latin Extended-A, which pdflatex's T1 fonts do not hold (CJK, symbols):
+    a name may be any UTF-8, and a table that names them is still a valid document for lualatex."""
+    return sorted({c for line in lines for c in line if ord(c) > 0x17F})

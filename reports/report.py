@@ -1413,9 +1413,13 @@ def write_report(doc, results_path, out, formats, peers_path=None, pareto_metric
     pooled = pooled_summaries(doc)
     rows = table_rows(cells, pooled)
     notes = table_notes(cells)
-    paper_tables.write_tex(os.path.join(out, "table.tex"),
-                           {(label, scene): row_numbers(group, pooled) for label, scene, group in table_groups(cells)},
-                           ordered(c.row for c in cells), ordered(c.scene for c in cells), QUALITY, notes)
+    beyond = paper_tables.write_tex(
+        os.path.join(out, "table.tex"),
+        {(label, scene): row_numbers(group, pooled) for label, scene, group in table_groups(cells)},
+        ordered(c.row for c in cells), ordered(c.scene for c in cells), QUALITY, notes)
+    if beyond:
+        print(f"report: note: table.tex holds characters pdflatex cannot set ({' '.join(beyond)}); "
+              "compile it with lualatex or xelatex", file=sys.stderr)
     write_markdown(os.path.join(out, "table.md"), rows, CAPTION, notes)
 
     base = os.path.dirname(os.path.abspath(results_path))

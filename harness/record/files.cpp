@@ -197,7 +197,11 @@ std::string safe_name(std::string s) {
   for (auto& c : s)
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.' || c == '=' || c == ','))
       c = '_';
-  if (!s.empty() && s.find_first_not_of('.') == std::string::npos) s.assign(s.size(), '_');
+  // Leading dots too: '..' would step out of the folder, and '.x' would be a hidden folder that globs skip.
+  for (auto& c : s) {
+    if (c != '.') break;
+    c = '_';
+  }
   return s;
 }
 

@@ -82,8 +82,8 @@ inline std::uint64_t write_file_atomic(const std::string& path, std::string_view
 void rename_into_place(const std::string& tmp, const std::string& path);
 
 // `s` with every character outside [A-Za-z0-9-_.=,] replaced by '_': a file or folder name for a label,
-// scene or sweep value. A name of dots only ("..") becomes underscores, so that it names a folder inside
-// its parent, never the parent itself.
+// scene or sweep value. Leading dots become underscores too, so that ".." names a folder inside its parent,
+// never the parent itself, and no name makes a hidden folder.
 std::string safe_name(std::string s);
 
 // Why `id` cannot name a cell's folder under trials/, or "" if it can: a cell id is safe_name parts

@@ -384,7 +384,8 @@ TEST(Record, ACellIdThatLeavesItsFolderIsRefused) {
   EXPECT_EQ(safe_name(".."), "__");
   EXPECT_EQ(safe_name("."), "_");
   EXPECT_EQ(safe_name(""), "");
-  EXPECT_EQ(safe_name("../x"), ".._x");
+  EXPECT_EQ(safe_name("../x"), "___x");
+  EXPECT_EQ(safe_name(".hidden.v2"), "_hidden.v2");
   const auto dir = test::temp_dir("cell_ids");
   nlohmann::json j = to_json(small_results());
   j["trials"][0]["id"] = "../../victim/s1";
