@@ -12,6 +12,7 @@
 #include "harness/cli/command.hpp"
 #include "harness/cli/param_table.hpp"
 #include "harness/organs/options.hpp"
+#include "harness/report/columns.hpp"
 #include "algorithms/organ_shapes.hpp"
 
 namespace growbench::cli {
@@ -34,14 +35,15 @@ std::string plugin_line(const AlgorithmEntry& e) {
 
 void print_text(const AlgorithmEntry& e) {
   const AlgorithmInfo& info = e.info();
-  fmt::print("{}{}\n  {}\n", info.name, e.plugin ? "  [plugin]" : "", info.summary);
-  if (e.plugin) fmt::print("  {}\n", plugin_line(e));
+  fmt::print("{}{}\n{}", info.name, e.plugin ? "  [plugin]" : "", wrap_text(info.summary, "  ", "  "));
+  if (e.plugin) fmt::print("{}", wrap_text(plugin_line(e), "  ", "    "));
   print_param_table(info.params);
   for (const auto& preset : info.presets) {
     std::vector<std::string> kv;
     for (const auto& [k, v] : preset.values) kv.push_back(fmt::format("{}={}", k, format_value(v)));
-    fmt::print("    preset={}: {}\n", preset.name,
-               kv.empty() ? "the defaults above" : fmt::format("{}", fmt::join(kv, " ")));
+    fmt::print("{}", wrap_text(fmt::format("preset={}: {}", preset.name,
+                                           kv.empty() ? "the defaults above" : fmt::format("{}", fmt::join(kv, " "))),
+                               "    ", "      "));
   }
 }
 
@@ -68,11 +70,12 @@ void print_organs(bool markdown) {
     for (std::size_t i = 0; i < names.size(); ++i) fmt::print("- {}: {}\n", markdown_code(names[i]), docs[i]);
     return;
   }
-  fmt::print(
-      "organs  [every algorithm]\n  the organ pass after growth: --organ key=value (a suite entry's \"organs\")\n");
+  fmt::print("organs  [every algorithm]\n{}",
+             wrap_text("the organ pass after growth: --organ key=value (a suite entry's \"organs\")", "  ", "  "));
   print_param_table(organ_param_specs());
   fmt::print("  built-in organ shapes (NAME, or NAME:key=value,... to change a setting):\n");
-  for (std::size_t i = 0; i < names.size(); ++i) fmt::print("    {:<12} {}\n", names[i], docs[i]);
+  for (std::size_t i = 0; i < names.size(); ++i)
+    fmt::print("{}", wrap_text(docs[i], fmt::format("    {:<12} ", names[i]), std::string(17, ' ')));
 }
 
 Outcome list_algorithms(const ListArgs& a) {

@@ -1,5 +1,7 @@
 #include "harness/cli/param_table.hpp"
 
+#include "harness/report/columns.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -41,17 +43,38 @@ std::string markdown_text(const std::string& text) {
   return out;
 }
 
+// One parameter a line: name, type, default, range and unit in columns, then the doc, wrapped within the
+// terminal's width, in its own column when the others leave it room and on the lines below when a long
+// default or range would squeeze it.
 void print_param_table(const std::vector<ParamSpec>& specs) {
-  std::size_t w = 4;
-  for (const auto& s : specs) w = std::max(w, s.name.size());
+  constexpr std::size_t kMaxDefault = 12, kMaxRange = 20, kMaxDocColumn = 60, kDocBelow = 8;
+  std::vector<std::string> defaults, ranges;
+  std::size_t wn = 4, wd = 2, wr = 0;
   for (const auto& s : specs) {
-    std::string range;
+    const std::string d = format_value(s.default_value);
+    defaults.push_back(d.empty() ? "\"\"" : d);
     if (s.type == ParamType::Choice)
-      range = fmt::format("{{{}}}", fmt::join(s.choices, "|"));
+      ranges.push_back(fmt::format("{{{}}}", fmt::join(s.choices, "|")));
     else if (std::isfinite(s.min) || std::isfinite(s.max))
-      range = fmt::format("[{:g}, {:g}]", s.min, s.max);
-    fmt::print("    {:<{}}  {:<6}  default {:<10} {:<18} {:<3}  {}\n", s.name, w, to_string(s.type),
-               format_value(s.default_value).empty() ? "\"\"" : format_value(s.default_value), range, s.unit, s.doc);
+      ranges.push_back(fmt::format("[{:g}, {:g}]", s.min, s.max));
+    else
+      ranges.emplace_back();
+    wn = std::max(wn, display_width(s.name));
+    wd = std::max(wd, std::min(kMaxDefault, display_width(defaults.back())));
+    wr = std::max(wr, std::min(kMaxRange, display_width(ranges.back())));
+  }
+  std::size_t doc_column = 4 + wn + 2 + 6 + 2 + 8 + wd + 2 + wr + 2 + 3 + 2;
+  if (doc_column > kMaxDocColumn) doc_column = kDocBelow;
+  const std::string indent(doc_column, ' ');
+  for (std::size_t i = 0; i < specs.size(); ++i) {
+    const ParamSpec& s = specs[i];
+    std::string head = fmt::format("    {:<{}}  {:<6}  default {:<{}}  {:<{}}  {:<3}", s.name, wn, to_string(s.type),
+                                   defaults[i], wd, ranges[i], wr, s.unit);
+    while (!head.empty() && head.back() == ' ') head.pop_back();
+    if (display_width(head) + 2 <= doc_column)
+      fmt::print("{}", wrap_text(s.doc, fmt::format("{:<{}}", head, doc_column), indent));
+    else
+      fmt::print("{}\n{}", head, wrap_text(s.doc, indent, indent));
   }
 }
 

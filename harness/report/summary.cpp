@@ -6,8 +6,9 @@
 
 #include <fmt/format.h>
 
-#include "harness/stats/stats.hpp"
+#include "harness/report/columns.hpp"
 #include "harness/report/summary.hpp"
+#include "harness/stats/stats.hpp"
 
 namespace growbench {
 namespace {
@@ -51,10 +52,11 @@ std::string machine_note(const RunContext& ctx) {
   std::string out;
   if (ctx.load_average_start && ctx.hardware_threads > 0 &&
       (*ctx.load_average_start)[0] > 0.25 * static_cast<double>(ctx.hardware_threads))
-    out += fmt::format(
-        "Note: the machine was busy when the run began (load average {:.2f} over the last minute, on {} hardware "
-        "threads): its timings may be slower and noisier than a quiet machine's.\n",
-        (*ctx.load_average_start)[0], ctx.hardware_threads);
+    out += wrap_text(fmt::format("Note: the machine was busy when the run began (load average {:.2f} over the last "
+                                 "minute, on {} hardware threads): its timings may be slower and noisier than a quiet "
+                                 "machine's.",
+                                 (*ctx.load_average_start)[0], ctx.hardware_threads),
+                     "", "");
   if (ctx.cpu_mhz || ctx.cpu_governor)
     out += fmt::format("Machine: {}{}{}; load average at the start {}, at the end {}.\n",
                        ctx.cpu_mhz ? fmt::format("{:.0f} MHz", *ctx.cpu_mhz) : "",
@@ -64,8 +66,15 @@ std::string machine_note(const RunContext& ctx) {
   return out;
 }
 
-// One cell's row of its scene's table; warnings about its repetitions go to `warnings`.
-std::string cell_row(const SuiteCell& t, std::vector<std::string>& warnings) {
+// A scene's two tables, each within a terminal's width: how long each cell took and how much memory, then
+// the plant it grew.
+struct SceneTables {
+  TextTable time{{"cell", "status", "verdict", "growth time", "total", "growth RSS"}, {}};
+  TextTable plant{{"cell", "nodes", "length m", "PLY", "cover", "attach", "inside"}, {}};
+};
+
+// One cell's rows of its scene's tables; warnings about its repetitions go to `warnings`.
+void cell_rows(const SuiteCell& t, SceneTables& tables, std::vector<std::string>& warnings) {
   const std::string& sc = t.scene;
   std::string cell = t.id;
   const auto slash = cell.find('/');
@@ -94,12 +103,12 @@ std::string cell_row(const SuiteCell& t, std::vector<std::string>& warnings) {
   const std::string verdict = !r || !r->verdict                        ? "-"
                               : r->verdict->status == "not_applicable" ? "n/a"
                                                                        : r->verdict->status;
-  std::string row =
-      fmt::format("{:<40} {:>6} {:>10} {:>30} {:>10} {:>11} {:>8} {:>9} {:>10} {:>8} {:>8} {:>8}\n", cell.substr(0, 40),
-                  t.status, verdict, growth_text(growth), format_seconds(median(total)), si_bytes(median(rss)),
-                  r ? std::to_string(r->counts.nodes) : "-", r ? fmt::format("{:.2f}", r->total_length_m) : "-",
-                  r && r->output_bytes.ply ? si_bytes(static_cast<double>(*r->output_bytes.ply)) : "-",
-                  metric("coverage"), metric("attached_fraction"), metric("penetration_nodes"));
+  tables.time.rows.push_back(
+      {cell, t.status, verdict, growth_text(growth), format_seconds(median(total)), si_bytes(median(rss))});
+  tables.plant.rows.push_back({cell, r ? std::to_string(r->counts.nodes) : "-",
+                               r ? fmt::format("{:.2f}", r->total_length_m) : "-",
+                               r && r->output_bytes.ply ? si_bytes(static_cast<double>(*r->output_bytes.ply)) : "-",
+                               metric("coverage"), metric("attached_fraction"), metric("penetration_nodes")});
   if (r && r->verdict && !r->verdict->valid())
     warnings.push_back(fmt::format("{} on {}: {} ({}): left out of comparisons", cell, sc, verdict,
                                    fmt::join(r->verdict->reasons, "; ")));
@@ -120,7 +129,6 @@ std::string cell_row(const SuiteCell& t, std::vector<std::string>& warnings) {
     warnings.push_back(fmt::format("{} on {}: repetitions grew different plants", cell, sc));
   if (t.status != "ok")
     warnings.push_back(fmt::format("{} on {}: {} ({})", cell, sc, t.status, t.message.value_or("")));
-  return row;
 }
 
 // Where each trial's time outside its phases went (harness/suite/suite.cpp), medians over every sample.
@@ -137,12 +145,15 @@ std::string overhead_line(const ResultsFile& results) {
         if (*v) over[k].push_back(**v);
   if (over["harness_overhead_s"].empty()) return "";
   auto ms = [&](const char* k) { return fmt::format("{:.2f} ms", 1e3 * median(over[k])); };
-  return fmt::format(
-      "Harness overhead per trial, median of {} samples: {} (medians of its parts: launch {}, child bookkeeping {}, "
-      "parent {}); then the kernel's teardown of the trial process {} (it grows with the trial's memory); outside "
-      "the phases in all {}.\n",
-      over["harness_overhead_s"].size(), ms("harness_overhead_s"), ms("launch_s"), ms("child_bookkeeping_s"),
-      ms("parent_s"), ms("teardown_s"), ms("outside_phases_s"));
+  return wrap_text(
+      fmt::format(
+          "Harness overhead per trial, median of {} samples: {} (medians of its parts: launch {}, child bookkeeping "
+          "{}, "
+          "parent {}); then the kernel's teardown of the trial process {} (it grows with the trial's memory); outside "
+          "the phases in all {}.",
+          over["harness_overhead_s"].size(), ms("harness_overhead_s"), ms("launch_s"), ms("child_bookkeeping_s"),
+          ms("parent_s"), ms("teardown_s"), ms("outside_phases_s")),
+      "", "");
 }
 
 }  // namespace
@@ -150,9 +161,10 @@ std::string overhead_line(const ResultsFile& results) {
 std::string summarize_results(const ResultsFile& results) {
   std::string out;
   const RunContext& ctx = results.context;
-  out +=
-      fmt::format("suite {} | commit {}{} | {} | {} hardware threads | {}\n", results.suite.name, ctx.growbench_commit,
-                  ctx.dirty == "true" ? " (dirty)" : "", ctx.cpu_model, ctx.hardware_threads, ctx.date);
+  out += wrap_text(
+      fmt::format("suite {} | commit {}{} | {} | {} hardware threads | {}", results.suite.name, ctx.growbench_commit,
+                  ctx.dirty == "true" ? " (dirty)" : "", ctx.cpu_model, ctx.hardware_threads, ctx.date),
+      "", "  ");
   std::vector<std::string> scene_order;
   std::map<std::string, std::vector<const SuiteCell*>> by_scene;
   for (const auto& t : results.trials) {
@@ -162,30 +174,33 @@ std::string summarize_results(const ResultsFile& results) {
   out += machine_note(ctx);
   std::vector<std::string> warnings;
   for (const auto& sc : scene_order) {
-    out += fmt::format("\n== scene {}\n", sc);
-    out += fmt::format("{:<40} {:>6} {:>10} {:>30} {:>10} {:>11} {:>8} {:>9} {:>10} {:>8} {:>8} {:>8}\n", "cell",
-                       "status", "verdict", "growth time", "total", "growth RSS", "nodes", "length m", "PLY", "cover",
-                       "attach", "inside");
-    for (const SuiteCell* t : by_scene[sc]) out += cell_row(*t, warnings);
+    SceneTables tables;
+    for (const SuiteCell* t : by_scene[sc]) cell_rows(*t, tables, warnings);
+    out += fmt::format("\n== scene {}\n{}\n{}", sc, tables.time.render(), tables.plant.render());
   }
-  out +=
-      "\nGrowth time: over a cell's repetitions, the median with the distribution-free 95% interval of the median "
+  out += "\n";
+  out += wrap_text(
+      "Growth time: over a cell's repetitions, the median with the distribution-free 95% interval of the median "
       "('CI', from order statistics, 6 repetitions or more) or the range of all of them ('range', fewer); one "
       "trial is shown alone. Growth RSS: the growth phase's own peak resident memory (median). Verdicts other than "
       "valid are left out of comparisons across cells (docs/metrics.md, \"Validity\"); n/a: a metric that does "
-      "not apply.\n";
+      "not apply. Cover, attach, inside: the fraction of the surface covered, of nodes attached to it, and of "
+      "nodes inside a solid (docs/metrics.md).",
+      "", "");
   out += overhead_line(results);
   const auto noisy = static_cast<std::size_t>(std::count_if(warnings.begin(), warnings.end(), [](const std::string& w) {
     return w.find("growth time CV") != std::string::npos;
   }));
-  if (4 * noisy > results.trials.size())
-    out += fmt::format(
-        "\nNote: the growth times of {} of {} cells varied by more than 10% over their repetitions: this run's timings "
-        "are noisy.\n",
-        noisy, results.trials.size());
+  if (4 * noisy > results.trials.size()) {
+    out += '\n';
+    out += wrap_text(fmt::format("Note: the growth times of {} of {} cells varied by more than 10% over their "
+                                 "repetitions: this run's timings are noisy.",
+                                 noisy, results.trials.size()),
+                     "", "");
+  }
   if (!warnings.empty()) {
     out += "\nWarnings:\n";
-    for (const auto& w : warnings) out += "  ! " + w + "\n";
+    for (const auto& w : warnings) out += wrap_text(w, "  ! ", "    ");
   }
   return out;
 }

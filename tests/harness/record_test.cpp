@@ -15,6 +15,8 @@
 #include "core/json_util.hpp"
 #include "harness/record/files.hpp"
 #include "harness/record/record.hpp"
+#include "harness/report/columns.hpp"
+#include "harness/report/summary.hpp"
 #include "test_util.hpp"
 
 namespace growbench {
@@ -430,6 +432,39 @@ TEST(Record, ASpecOutsideItsDeclaredRangesIsRefused) {
   j["threads"] = 5000;
   EXPECT_EQ(test::error_of([&] { (void)from_json<TrialSpec>(j, "spec.json"); }),
             "spec.json: at threads: expected an integer in [0, 1024], got 5000");
+}
+
+// Terminal text: CJK characters count two columns, paragraphs break at spaces within the width.
+TEST(Columns, WrapAndTableKeepToTheirWidth) {
+  EXPECT_EQ(display_width("abc"), 3u);
+  EXPECT_EQ(display_width("\xe6\xa4\x8d\xe7\x89\xa9"), 4u);  // two CJK characters
+  EXPECT_EQ(wrap_text("aa bb cc dd", "> ", "  ", 8), "> aa bb\n  cc dd\n");
+  EXPECT_EQ(wrap_text("averyveryverylongword x", "", "", 8), "averyver\nyverylon\ngword x\n");  // cut at the width
+  TextTable t{{"cell", "n", "time"}, {{"a/s1", "10", "1 ms"}, {"a-very-long-label-that-does-not-fit/s1", "2", "3 ms"}}};
+  EXPECT_EQ(t.render(20),
+            "cell   n  time\n"
+            "a/s1  10  1 ms\n"
+            "a-very-long-label-th\n"
+            "at-does-not-fit/s1\n"
+            "       2  3 ms\n");
+}
+
+// `growbench summary` fits a 100-column terminal, whatever the names and numbers.
+TEST(Columns, TheSummaryFitsAHundredColumns) {
+  ResultsFile r = small_results();
+  r.suite.name = std::string(90, 's') + " with a long name";
+  SuiteCell wide = r.trials[0];
+  wide.label = std::string(70, 'x') + "\xe6\xa4\x8d\xe7\x89\xa9";
+  wide.id = "x/wall/s1/point_count=1000,influence=0.25,kill=0.05";
+  wide.status = "invalid_input";
+  wide.message = std::string(300, 'm');
+  r.trials.push_back(wide);
+  const std::string text = summarize_results(r);
+  std::istringstream lines(text);
+  int n = 0;
+  for (std::string line; std::getline(lines, line); ++n) EXPECT_LE(display_width(line), kTerminalColumns) << line;
+  EXPECT_GT(n, 10);
+  EXPECT_NE(text.find(wide.label), std::string::npos) << "a long name is shown whole: " << text;
 }
 
 }  // namespace
