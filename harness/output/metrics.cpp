@@ -89,6 +89,7 @@ class MetricsPass {
     // Segments: node i (with a parent) and its parent.
     for (std::uint32_t i = 0; i < nodes.size(); ++i)
       if (nodes[i].parent != kNoParent) seg.push_back(i);
+    if (seg.size() >= o.space_order_from) in_space_order();
   }
 
   nlohmann::json run(MetricDetails* details) {
@@ -134,6 +135,35 @@ class MetricsPass {
     const glm::vec3 lo = box.empty() ? glm::vec3(0.0f) : box.min, hi = box.empty() ? glm::vec3(0.0f) : box.max;
     m["bbox_min"] = {lo.x, lo.y, lo.z};
     m["bbox_max"] = {hi.x, hi.y, hi.z};
+  }
+
+  // A large plant has its segments put along a Morton curve of their midpoints, and the pair test
+  // reads each segment's ends from a copy in that order: its nodes are stored in the order they grew, where
+  // neighbours in space lie far apart, and reading them there was most of the self-intersection search on
+  // plants of millions of nodes (below MetricOptions::space_order_from segments the arrays fit in cache and
+  // the copies would cost more than they save). Every figure is a count over all segments and ties are
+  // broken by node index, so no figure depends on the order.
+  void in_space_order() {
+    if (seg.size() < 2) return;
+    Aabb box;
+    for (const std::uint32_t i : seg) box.extend(nodes[i].position);
+    const glm::vec3 scale = 1023.0f / glm::max(box.size(), glm::vec3(1e-30f));
+    auto spread = [](std::uint32_t v) {  // 10 bits to every third of 30
+      v = (v | (v << 16)) & 0x030000FFu;
+      v = (v | (v << 8)) & 0x0300F00Fu;
+      v = (v | (v << 4)) & 0x030C30C3u;
+      return (v | (v << 2)) & 0x09249249u;
+    };
+    std::vector<std::uint64_t> keyed(seg.size());
+    for (std::size_t k = 0; k < seg.size(); ++k) {
+      const glm::vec3 c = glm::clamp((0.5f * (a_of(seg[k]) + nodes[seg[k]].position) - box.min) * scale, 0.0f, 1023.0f);
+      const std::uint32_t code = spread(static_cast<std::uint32_t>(c.x)) |
+                                 (spread(static_cast<std::uint32_t>(c.y)) << 1) |
+                                 (spread(static_cast<std::uint32_t>(c.z)) << 2);
+      keyed[k] = (static_cast<std::uint64_t>(code) << 32) | seg[k];  // ties in node order
+    }
+    std::sort(keyed.begin(), keyed.end());
+    for (std::size_t k = 0; k < seg.size(); ++k) seg[k] = static_cast<std::uint32_t>(keyed[k]);
   }
 
   void index_segments() {
@@ -224,30 +254,21 @@ class MetricsPass {
       return false;
     };
     // Each pair is judged once, from the segment with the larger reach (half length + radius; ties go to
-    // the lower index): a pair can only meet within the sum of the two reaches, at most twice the larger
+    // the lower node index): a pair can only meet within the sum of the two reaches, at most twice the larger
     // one. Searching with the plant's largest radius and half length instead made every thin segment near
     // a thick stem visit hundreds of candidates.
     auto judged_from = [&](std::size_t k, std::size_t l) {
-      return reach[l] < reach[k] || (reach[l] == reach[k] && l > k);
+      return reach[l] < reach[k] || (reach[l] == reach[k] && seg[l] > seg[k]);
     };
     std::vector<std::uint32_t> pairs_of(seg.size(), 0);
     involved = std::vector<std::atomic<std::uint8_t>>(seg.size());  // zero-initialised; set from either side
-    if (tree) {
-      tbb::parallel_for(std::size_t{0}, seg.size(), [&](std::size_t k) {
-        const glm::vec3 a = a_of(seg[k]), b = nodes[seg[k]].position;
-        kd_visit_within(*tree, mid[k], 2.0f * reach[k] * (1.0f + 1e-4f), [&](std::uint32_t l, float) {
-          if (!judged_from(k, l) || neighbours(seg[k], seg[l])) return true;
-          // Always the lower index first, so a pair's verdict does not depend on the side judging it.
-          const float d = k < l ? segment_distance(a, b, a_of(seg[l]), nodes[seg[l]].position)
-                                : segment_distance(a_of(seg[l]), nodes[seg[l]].position, a, b);
-          if (d < nodes[seg[k]].radius + nodes[seg[l]].radius) {
-            involved[k].store(1, std::memory_order_relaxed);
-            involved[l].store(1, std::memory_order_relaxed);
-            ++pairs_of[k];
-          }
-          return true;
-        });
-      });
+    auto from_nodes = [&](std::size_t k) { return Ends{a_of(seg[k]), nodes[seg[k]].position, nodes[seg[k]].radius}; };
+    if (seg.size() < o.space_order_from) {
+      count_crossings(from_nodes, judged_from, neighbours, pairs_of);
+    } else {  // see in_space_order
+      std::vector<Ends> ends(seg.size());
+      tbb::parallel_for(std::size_t{0}, seg.size(), [&](std::size_t k) { ends[k] = from_nodes(k); });
+      count_crossings([&](std::size_t k) -> const Ends& { return ends[k]; }, judged_from, neighbours, pairs_of);
     }
     std::size_t pairs = 0, inv = 0;
     for (std::size_t k = 0; k < seg.size(); ++k) {
@@ -256,6 +277,38 @@ class MetricsPass {
     }
     m["self_intersections"] = pairs;
     m["self_intersection_fraction"] = ratio(inv, seg.size());
+  }
+
+  struct Ends {
+    glm::vec3 a, b;
+    float radius;
+  };
+
+  // Every pair of segments that cross, judged from one side: counted in pairs_of, both marked in involved.
+  template <class EndsOf, class JudgedFrom, class Neighbours>
+  void count_crossings(const EndsOf& ends, const JudgedFrom& judged_from, const Neighbours& neighbours,
+                       std::vector<std::uint32_t>& pairs_of) {
+    if (!tree) return;
+    tbb::parallel_for(std::size_t{0}, seg.size(), [&](std::size_t k) {
+      const Ends ek = ends(k);
+      kd_visit_within(*tree, mid[k], 2.0f * reach[k] * (1.0f + 1e-4f), [&](std::uint32_t l, float d2) {
+        // Cheapest first, as in a dense plant most candidates fail: two segments whose midpoints are farther
+        // apart than the sum of their reaches cannot meet; the tree check reads nodes far apart in memory,
+        // so it comes last, for the pairs that do meet.
+        const float reach_sum = (reach[k] + reach[l]) * (1.0f + 1e-4f);
+        if (!judged_from(k, l) || d2 > reach_sum * reach_sum) return true;
+        const Ends& el = ends(l);
+        // Always the lower node index first, so a pair's verdict does not depend on the side judging it.
+        const float d =
+            seg[k] < seg[l] ? segment_distance(ek.a, ek.b, el.a, el.b) : segment_distance(el.a, el.b, ek.a, ek.b);
+        if (d < ek.radius + el.radius && !neighbours(seg[k], seg[l])) {
+          involved[k].store(1, std::memory_order_relaxed);
+          involved[l].store(1, std::memory_order_relaxed);
+          ++pairs_of[k];
+        }
+        return true;
+      });
+    });
   }
 
   void leaf_metrics() {

@@ -180,6 +180,12 @@ TEST(Metrics, SelfIntersectionAndLeafOverlapMatchAllPairs) {
               1e-12);
   EXPECT_NEAR(m["leaf_overlap"].get<double>(), static_cast<double>(overlapping) / static_cast<double>(p.organs.size()),
               1e-12);
+  // The same figures when the search reads the segments in space order, as it does for large plants.
+  MetricOptions spatial;
+  spatial.space_order_from = 0;
+  const auto ms = compute_metrics(p, q, spatial);
+  EXPECT_EQ(ms["self_intersections"], pairs);
+  EXPECT_EQ(ms["self_intersection_fraction"], m["self_intersection_fraction"]);
 }
 
 TEST(Metrics, LeafOverlapAndLightExposure) {
