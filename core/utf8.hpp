@@ -87,12 +87,18 @@ inline std::string utf8_excerpt(std::string_view text, std::size_t max_bytes) {
 // entry's label), or "" when it can: at most kMaxNameBytes, and no control character (a line break ended
 // the comment a name was written into).
 inline constexpr std::size_t kMaxNameBytes = 100;
+// Whether `text` holds an ASCII control character (a line break, a tab, an escape): what ends a line or a
+// comment that a name or path is written into.
+inline bool has_control_char(std::string_view text) {
+  for (const char c : text)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) return true;
+  return false;
+}
 inline std::string name_problem(std::string_view text) {
   if (text.size() > kMaxNameBytes)
     return "expected a name of at most " + std::to_string(kMaxNameBytes) + " bytes, got " + std::to_string(text.size());
-  for (const char c : text)
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
-      return "expected a name without control characters (a line break, a tab), got '" + escape_utf8(text, true) + "'";
+  if (has_control_char(text))
+    return "expected a name without control characters (a line break, a tab), got '" + escape_utf8(text, true) + "'";
   return {};
 }
 

@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "core/utf8.hpp"
 #include "harness/cli/command.hpp"
 
 namespace growbench::cli {
@@ -49,9 +50,8 @@ CLI::Validator integer_in(long long lo, unsigned long long hi) {
 CLI::Validator path_named(const std::string& what) {
   return {[=](std::string& text) -> std::string {
             if (text.empty()) return fmt::format("expected {}, got an empty name", what);
-            for (const char c : text)
-              if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
-                return fmt::format("expected {} without control characters (a line break or a tab)", what);
+            if (has_control_char(text))
+              return fmt::format("expected {} without control characters (a line break or a tab)", what);
             return {};
           },
           "PATH"};

@@ -24,25 +24,16 @@ struct MergeArgs {
 };
 
 Outcome merge_shards(const MergeArgs& a) {
-  std::vector<ResultsFile> shards;
-  for (const auto& f : a.inputs) {
-    const nlohmann::json j = read_json_file(f);
-    // A file without its shard would be taken for shard 0 of 1: which part of the suite it holds is unknown.
-    if (!j.is_object() || !j.contains("shard"))
-      throw InputError(
-          fmt::format("{}: no 'shard' key, so which shard of its suite it holds is unknown; expected "
-                      "the results of `growbench suite --shard I/N`",
-                      f));
-    shards.push_back(results_from_json(j, f));
-  }
-  const ResultsFile merged = merge_results(shards, a.inputs, a.mixed);
+  std::vector<nlohmann::json> shards;
+  for (const auto& f : a.inputs) shards.push_back(read_json_file(f));
+  const nlohmann::json merged = merge_results(shards, a.inputs, a.mixed);
   make_directories(std::filesystem::path(a.out).parent_path().string());
-  write_file_atomic(a.out, json_text(to_json(merged), 1));
-  if (merged.context.mixed_machines.value_or(false))
+  write_file_atomic(a.out, json_text(merged, 1));
+  if (merged["context"].value("mixed_machines", false))
     fmt::print(
         stderr,
         "growbench: warning: the shards ran on different machines or builds; their timings are not comparable\n");
-  fmt::print("merged {} shards, {} cells, into {}\n", shards.size(), merged.trials.size(), a.out);
+  fmt::print("merged {} shards, {} cells, into {}\n", shards.size(), merged["trials"].size(), a.out);
   return Outcome::ok;
 }
 

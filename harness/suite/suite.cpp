@@ -704,7 +704,15 @@ ResultsFile merge_results(const std::vector<ResultsFile>& shards, const std::vec
 
 json merge_results(const std::vector<json>& shards, const std::vector<std::string>& names, bool mixed_machines) {
   std::vector<ResultsFile> typed;
-  for (std::size_t k = 0; k < shards.size(); ++k) typed.push_back(from_json<ResultsFile>(shards[k], names.at(k)));
+  for (std::size_t k = 0; k < shards.size(); ++k) {
+    // A file without its shard would be read as shard 0 of 1: which part of the suite it holds is unknown.
+    if (!shards[k].is_object() || !shards[k].contains("shard"))
+      throw InputError(
+          fmt::format("{}: no 'shard' key, so which shard of its suite it holds is unknown; expected "
+                      "the results of `growbench suite --shard I/N`",
+                      names.at(k)));
+    typed.push_back(from_json<ResultsFile>(shards[k], names.at(k)));
+  }
   return to_json(merge_results(typed, names, mixed_machines));
 }
 

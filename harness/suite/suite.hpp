@@ -97,7 +97,8 @@ std::string run_suite(const Suite& suite, const SuiteRunOptions& options);
 // cannot be compared with each other, so that takes `mixed_machines`, and the merged context then says so.
 ResultsFile merge_results(const std::vector<ResultsFile>& shards, const std::vector<std::string>& names,
                           bool mixed_machines = false);
-// The same on results read as JSON (each read with from_json, errors naming names[k]).
+// The same on results read as JSON (each read with from_json, errors naming names[k]); a file without a
+// "shard" key is refused.
 nlohmann::json merge_results(const std::vector<nlohmann::json>& shards, const std::vector<std::string>& names,
                              bool mixed_machines = false);
 
