@@ -159,7 +159,7 @@ def check_tex(path):
             f.write("\\documentclass{article}\\usepackage{booktabs}"
                     "\\begin{document}\\input{table}\\end{document}\n")
         r = subprocess.run([tex, "-interaction=nonstopmode", "-halt-on-error", "-no-shell-escape", "doc.tex"],
-                           cwd=d, capture_output=True, text=True, timeout=120)
+                           cwd=d, capture_output=True, text=True, timeout=300)  # lualatex builds its font cache once
         check(r.returncode == 0, f"{path}: {tex} fails on it: {r.stdout[-1500:]}")
 
 
