@@ -213,7 +213,7 @@ std::string cell_id_problem(const std::string& id) {
     if (part.empty() || safe_name(part) != part)
       return fmt::format(
           "cell id \"{}\" is not a path of plain names inside the folder (expected LABEL/SCENE/sSEED, "
-          "each of [A-Za-z0-9-_.=,], none empty, '.' or '..')",
+          "each of [A-Za-z0-9-_.=,], none empty or starting with '.')",
           escape_utf8(id, true));
     if (end == id.size()) return "";
     start = end + 1;

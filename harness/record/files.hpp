@@ -87,7 +87,7 @@ void rename_into_place(const std::string& tmp, const std::string& path);
 std::string safe_name(std::string s);
 
 // Why `id` cannot name a cell's folder under trials/, or "" if it can: a cell id is safe_name parts
-// joined by '/' (LABEL/SCENE/sSEED[/SWEEP]), none empty or made of dots, so that no results file, journal
+// joined by '/' (LABEL/SCENE/sSEED[/SWEEP]), none empty or starting with a dot, so that no results file, journal
 // or baseline can point a writer outside its folder.
 std::string cell_id_problem(const std::string& id);
 

@@ -711,7 +711,7 @@ json merge_results(const std::vector<json>& shards, const std::vector<std::strin
           fmt::format("{}: no 'shard' key, so which shard of its suite it holds is unknown; expected "
                       "the results of `growbench suite --shard I/N`",
                       names.at(k)));
-    typed.push_back(from_json<ResultsFile>(shards[k], names.at(k)));
+    typed.push_back(results_from_json(shards[k], names.at(k)));
   }
   return to_json(merge_results(typed, names, mixed_machines));
 }
@@ -1218,10 +1218,13 @@ class SuiteRun {
   void stop_if_the_disk_is_full(const SuiteConfig& c, const SuiteSample& sample) const {
     if (sample.status == "ok") return;
     const std::string full = std::strerror(ENOSPC);
-    // The trial's own error.txt may not have fitted either: then the folder's free space tells.
+    // The trial's own error.txt may not have fitted either: then the folder's free space tells. A file
+    // system that reports no blocks at all (some virtual and network ones) tells nothing; root may use the
+    // blocks reserved for it.
     struct statvfs fs_stat {};
-    const bool no_room = statvfs(out_.c_str(), &fs_stat) == 0 &&
-                         static_cast<double>(fs_stat.f_bavail) * static_cast<double>(fs_stat.f_frsize) < 1 << 20;
+    const bool known = statvfs(out_.c_str(), &fs_stat) == 0 && fs_stat.f_blocks > 0;
+    const auto free_blocks = geteuid() == 0 ? fs_stat.f_bfree : fs_stat.f_bavail;
+    const bool no_room = known && static_cast<double>(free_blocks) * static_cast<double>(fs_stat.f_frsize) < 1 << 20;
     if (!no_room && (!sample.message || sample.message->find(full) == std::string::npos)) return;
     throw InputError(fmt::format("{}: {} (cell {}); free space and continue with --resume: that trial runs again",
                                  out_.string(), full, c.id));

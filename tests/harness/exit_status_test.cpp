@@ -172,6 +172,15 @@ TEST(ExitStatus, InputsThatCannotWorkAreTwoNotZeroOrAnAbort) {
   });
   const std::string twice0 = variant("twice0.json", [](json& j) { j["shard"] = {{"index", 0}, {"count", 2}}; });
   const std::string twice1 = variant("twice1.json", [](json& j) { j["shard"] = {{"index", 1}, {"count", 2}}; });
+  // A shard is a results file: merge checks what every reader of one checks.
+  const std::string shard_no_samples = variant("shard_no_samples.json", [](json& j) {
+    j["shard"] = {{"index", 0}, {"count", 1}};
+    j["trials"][0]["samples"] = json::array();
+  });
+  const std::string shard_escape = variant("shard_escape.json", [](json& j) {
+    j["shard"] = {{"index", 0}, {"count", 1}};
+    j["trials"][0]["id"] = "../../victim/s1";
+  });
   const std::string clash = test::write_text(dir / "clash.lsys", "premise: A(1,2)\nA(x,x) = F(x) A(x,x)\n");
   const std::string flat = test::write_text(dir / "flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
   const std::string fault =
@@ -220,6 +229,8 @@ TEST(ExitStatus, InputsThatCannotWorkAreTwoNotZeroOrAnAbort) {
        "shard 0/2 has 2 cells, but a suite of 2 cells in 2 shards gives it 1"},
       {"merge " + twice0 + " " + twice1 + " -o " + d + "/m.json",
        "cell 'spacecol/wall/s1' is in the merged results twice"},
+      {"merge " + shard_no_samples + " -o " + d + "/m.json", "at /trials/0/samples: cell 'spacecol/wall/s1' is ok"},
+      {"merge " + shard_escape + " -o " + d + "/m.json", "at /trials/0/id: cell id \"../../victim/s1\""},
   };
   for (const auto& c : cases) {
     const auto r = growbench(c.args);
