@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include "harness/report/columns.hpp"
 #include "scenes/scene.hpp"
 
 namespace growbench::test {
@@ -46,6 +48,29 @@ inline std::string error_of(const std::function<void()>& f) {
     return e.what();
   }
   return "(no error)";
+}
+
+// `text` as one paragraph: its words joined by single spaces, so that a wrapped line reads as unwrapped.
+inline std::string one_paragraph(const std::string& text) {
+  std::istringstream in(text);
+  std::string flat;
+  for (std::string w; in >> w;) flat += (flat.empty() ? "" : " ") + w;
+  return flat;
+}
+
+// `text` without any whitespace: a word cut across lines (a long path) reads whole again.
+inline std::string without_spaces(const std::string& text) {
+  std::string s;
+  for (char c : text)
+    if (!std::isspace(static_cast<unsigned char>(c))) s += c;
+  return s;
+}
+
+// Every line of `text` fits a terminal of kTerminalColumns.
+inline void expect_lines_fit(const std::string& text, const std::string& what) {
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);)
+    EXPECT_LE(display_width(line), kTerminalColumns) << what << ": " << line;
 }
 
 struct CommandResult {

@@ -71,7 +71,15 @@ void print_param_table(const std::vector<ParamSpec>& specs) {
     std::string head = fmt::format("    {:<{}}  {:<6}  default {:<{}}  {:<{}}  {:<3}", s.name, wn, to_string(s.type),
                                    defaults[i], wd, ranges[i], wr, s.unit);
     while (!head.empty() && head.back() == ' ') head.pop_back();
-    if (display_width(head) + 2 <= doc_column)
+    if (display_width(head) > kTerminalColumns) {  // a long list of choices: on the lines below, wrapped
+      std::string front = fmt::format("    {:<{}}  {:<6}  default {}", s.name, wn, to_string(s.type), defaults[i]);
+      fmt::print("{}{}", display_width(front) > kTerminalColumns ? wrap_text(front, "", indent) : front + '\n',
+                 wrap_text(fmt::format("{}  {}", ranges[i], s.unit), indent, indent));
+      head.clear();
+    }
+    if (head.empty())
+      fmt::print("{}", wrap_text(s.doc, indent, indent));
+    else if (display_width(head) + 2 <= doc_column)
       fmt::print("{}", wrap_text(s.doc, fmt::format("{:<{}}", head, doc_column), indent));
     else
       fmt::print("{}\n{}", head, wrap_text(s.doc, indent, indent));

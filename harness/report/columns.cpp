@@ -16,6 +16,33 @@ std::size_t display_width(std::string_view text) {
   return field - (padded.size() - text.size());
 }
 
+namespace {
+
+// Spaces, tabs, line breaks and other control characters all separate words: a note that holds a line
+// break or a tab would otherwise carry it into the middle of a wrapped line.
+bool is_gap(char c) {
+  const auto u = static_cast<unsigned char>(c);
+  return u <= 0x20 || u == 0x7f;
+}
+
+// Where to cut `word` so that its first part takes at most `room` columns: after the last '/', '|' or ','
+// that fits, so that a cut path still reads as its folders and a list as its items, else at the last whole
+// character that fits (at least one).
+std::size_t cut_point(std::string_view word, std::size_t room) {
+  std::size_t cut = 0, used = 0, after_mark = 0;
+  while (cut < word.size()) {
+    const std::size_t n = std::max<std::size_t>(1, utf8_char_length(word, cut));
+    const std::size_t w = display_width(word.substr(cut, n));
+    if (cut > 0 && used + w > room) break;
+    cut += n;
+    used += w;
+    if ((word[cut - 1] == '/' || word[cut - 1] == '|' || word[cut - 1] == ',') && cut < word.size()) after_mark = cut;
+  }
+  return cut < word.size() && after_mark > 0 ? after_mark : cut;
+}
+
+}  // namespace
+
 std::string wrap_text(std::string_view text, std::string_view first, std::string_view rest, std::size_t width) {
   std::string out(first);
   std::size_t used = display_width(first);
@@ -27,46 +54,36 @@ std::string wrap_text(std::string_view text, std::string_view first, std::string
     used = rest_w;
     empty_line = true;
   };
-  auto put = [&](std::string_view piece, std::size_t w) {
+  auto put = [&](std::string_view piece) {
     if (!empty_line) {
       out += ' ';
       ++used;
     }
     out += piece;
-    used += w;
+    used += display_width(piece);
     empty_line = false;
   };
   for (std::size_t i = 0; i < text.size();) {
-    const std::size_t start = text.find_first_not_of(' ', i);
-    if (start == std::string_view::npos) break;
-    const std::size_t end = std::min(text.find(' ', start), text.size());
-    std::string_view word = text.substr(start, end - start);
+    while (i < text.size() && is_gap(text[i])) ++i;
+    std::size_t end = i;
+    while (end < text.size() && !is_gap(text[end])) ++end;
+    std::string_view word = text.substr(i, end - i);
     i = end;
+    if (word.empty()) break;
     const std::size_t w = display_width(word);
-    if (used + (empty_line ? 0 : 1) + w <= width) {
-      put(word, w);
-      continue;
-    }
-    if (w <= room) {
-      new_line();
-      put(word, w);
-      continue;
-    }
-    // A word longer than any line (a path, a cell id) is cut at the width, a whole character at a time.
-    if (!empty_line) new_line();
-    while (!word.empty()) {
-      std::size_t cut = 0, cut_w = 0;
-      while (cut < word.size()) {
-        const std::size_t n = std::max<std::size_t>(1, utf8_char_length(word, cut));
-        const std::size_t cw = display_width(word.substr(cut, n));
-        if (cut > 0 && used + cut_w + cw > width) break;
-        cut += n;
-        cut_w += cw;
+    if (used + (empty_line ? 0 : 1) + w > width) {
+      // A word that fits a line goes to the next; a longer one (a path, a cell id) starts where it is, if
+      // the line has room, and is cut so that no line passes the width.
+      if (w <= room ? (!empty_line || used > rest_w) : used + 2 > width) new_line();
+      while (!word.empty() && used + (empty_line ? 0 : 1) + display_width(word) > width) {
+        const std::size_t taken = used + (empty_line ? 0 : 1);
+        const std::size_t cut = cut_point(word, width > taken ? width - taken : 1);
+        put(word.substr(0, cut));
+        word.remove_prefix(cut);
+        if (!word.empty()) new_line();
       }
-      put(word.substr(0, cut), cut_w);
-      word.remove_prefix(cut);
-      if (!word.empty()) new_line();
     }
+    if (!word.empty()) put(word);
   }
   return out + '\n';
 }

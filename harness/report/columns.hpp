@@ -1,5 +1,5 @@
 // Text for a terminal: a line is at most kTerminalColumns wide, counted as a terminal shows it (a CJK
-// character takes two columns), so that tables and notes read in an 100-column window and in a CI log.
+// character takes two columns), so that tables and notes read in a 100-column window and in a CI log.
 #pragma once
 
 #include <cstddef>
@@ -14,8 +14,10 @@ inline constexpr std::size_t kTerminalColumns = 100;
 // The columns `text` takes on a terminal, as fmt's padding counts them (so that padded text lines up).
 std::size_t display_width(std::string_view text);
 
-// `text` broken at spaces into lines of at most `width` columns, the first starting with `first`, the
-// others with `rest`; a word longer than a line has a line of its own. Each line ends with '\n'.
+// `text` broken at spaces (and tabs, line breaks and other control characters) into lines of at most
+// `width` columns, the first starting with `first`, the others with `rest`. A word longer than a line is
+// cut: after a '/', '|' or ',' where it can be, so that a path reads as its folders and a list as its
+// items. Each line ends with '\n'.
 std::string wrap_text(std::string_view text, std::string_view first, std::string_view rest,
                       std::size_t width = kTerminalColumns);
 

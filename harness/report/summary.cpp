@@ -176,7 +176,9 @@ std::string summarize_results(const ResultsFile& results) {
   for (const auto& sc : scene_order) {
     SceneTables tables;
     for (const SuiteCell* t : by_scene[sc]) cell_rows(*t, tables, warnings);
-    out += fmt::format("\n== scene {}\n{}\n{}", sc, tables.time.render(), tables.plant.render());
+    out += '\n';
+    out += wrap_text(fmt::format("== scene {}", sc), "", "   ");
+    out += fmt::format("{}\n{}", tables.time.render(), tables.plant.render());
   }
   out += "\n";
   out += wrap_text(

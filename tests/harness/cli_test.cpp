@@ -31,10 +31,8 @@ TEST(Cli, HelpAndLists) {
   EXPECT_EQ(r.status, 0);
   for (const char* s : {"wall", "facade", "column", "corner", "pergola", "boulder", "trunk", "envelope", "mesh:PATH"})
     EXPECT_NE(r.out.find(s), std::string::npos) << s;
-  std::istringstream in(r.out);  // the lines as one paragraph: a list may wrap
-  std::string flat;
-  for (std::string w; in >> w;) flat += w + ' ';
-  EXPECT_NE(flat.find("(cow, spot, stanford-bunny, suzanne, teapot, uv-cube)"), std::string::npos) << r.out;
+  EXPECT_NE(test::one_paragraph(r.out).find("(cow, spot, stanford-bunny, suzanne, teapot, uv-cube)"), std::string::npos)
+      << r.out;
   r = growbench("run -a ivy -s mesh:bunny -o " + test::temp_dir("cli_badmesh").string());
   EXPECT_EQ(r.status, 2) << r.out;
   EXPECT_NE(r.out.find("unknown mesh 'bunny' (did you mean 'stanford-bunny'?)"), std::string::npos) << r.out;
@@ -79,9 +77,7 @@ TEST(Cli, ListAndScenesFitAHundredColumns) {
   for (const char* cmd : {"list", "list organs", "scenes"}) {
     const auto r = growbench(cmd);
     ASSERT_EQ(r.status, 0) << cmd;
-    std::istringstream lines(r.out);
-    for (std::string line; std::getline(lines, line);)
-      EXPECT_LE(display_width(line), kTerminalColumns) << cmd << ": " << line;
+    test::expect_lines_fit(r.out, cmd);
   }
 }
 

@@ -395,7 +395,7 @@ TEST(Record, ACellIdThatLeavesItsFolderIsRefused) {
   EXPECT_EQ(test::error_of([&] { read_results(path); }),
             path +
                 ": at /trials/0/id: cell id \"../../victim/s1\" is not a path of plain names inside the folder "
-                "(expected LABEL/SCENE/sSEED, each of [A-Za-z0-9-_.=,], none empty, '.' or '..')");
+                "(expected LABEL/SCENE/sSEED, each of [A-Za-z0-9-_.=,], none empty or starting with '.')");
 }
 
 // A symlink planted where a file's temporary copy goes does not redirect the write: the link is replaced,
@@ -440,6 +440,13 @@ TEST(Columns, WrapAndTableKeepToTheirWidth) {
   EXPECT_EQ(display_width("\xe6\xa4\x8d\xe7\x89\xa9"), 4u);  // two CJK characters
   EXPECT_EQ(wrap_text("aa bb cc dd", "> ", "  ", 8), "> aa bb\n  cc dd\n");
   EXPECT_EQ(wrap_text("averyveryverylongword x", "", "", 8), "averyver\nyverylon\ngword x\n");  // cut at the width
+  // A path is cut after a folder; line breaks, tabs and other control characters separate words.
+  EXPECT_EQ(wrap_text("see /tmp/abc/defgh/x.so now", "", "", 12), "see /tmp/\nabc/defgh/\nx.so now\n");
+  EXPECT_EQ(wrap_text("{none|crash|hang|oom}", "", "  ", 12), "{none|crash|\n  hang|oom}\n");
+  EXPECT_EQ(wrap_text("a\nb\tc\x1b\x7f d\r\n", "", "", 80), "a b c d\n");
+  EXPECT_EQ(wrap_text("", "> ", "  ", 8), "> \n");
+  // A first part wider than the rest sends a word that fits the other lines to the next line.
+  EXPECT_EQ(wrap_text("abcdef", "long head: ", "  ", 10), "long head: \n  abcdef\n");
   TextTable t{{"cell", "n", "time"}, {{"a/s1", "10", "1 ms"}, {"a-very-long-label-that-does-not-fit/s1", "2", "3 ms"}}};
   EXPECT_EQ(t.render(20),
             "cell   n  time\n"
@@ -454,17 +461,20 @@ TEST(Columns, TheSummaryFitsAHundredColumns) {
   ResultsFile r = small_results();
   r.suite.name = std::string(90, 's') + " with a long name";
   SuiteCell wide = r.trials[0];
+  wide.scene = std::string(120, 'w');
   wide.label = std::string(70, 'x') + "\xe6\xa4\x8d\xe7\x89\xa9";
-  wide.id = "x/wall/s1/point_count=1000,influence=0.25,kill=0.05";
+  wide.id = "x/wall/s1/k=1";
   wide.status = "invalid_input";
   wide.message = std::string(300, 'm');
   r.trials.push_back(wide);
   const std::string text = summarize_results(r);
-  std::istringstream lines(text);
-  int n = 0;
-  for (std::string line; std::getline(lines, line); ++n) EXPECT_LE(display_width(line), kTerminalColumns) << line;
-  EXPECT_GT(n, 10);
-  EXPECT_NE(text.find(wide.label), std::string::npos) << "a long name is shown whole: " << text;
+  test::expect_lines_fit(text, "summary");
+  EXPECT_GT(std::count(text.begin(), text.end(), '\n'), 10);
+  // A name that fits a line is never cut: its row's name has a line of its own.
+  EXPECT_NE(text.find("\n" + wide.label + "/s1/k=1\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("== scene " + std::string(91, 'w') + "\n   " + std::string(29, 'w') + "\ncell"),
+            std::string::npos)
+      << text;
 }
 
 }  // namespace

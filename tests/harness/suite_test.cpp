@@ -453,8 +453,9 @@ TEST(Suite, TheReadmesFiguresAreTheStandardSuites) {
   const std::string root = GROWBENCH_SOURCE_DIR;
   const SuitePlan p = plan_of(load_suite(root + "/bench/suites/standard.json"));
   std::ifstream in(root + "/README.md");
-  std::string readme, word;
-  while (in >> word) readme += word + " ";  // lines wrap anywhere: compare with single spaces
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string readme = test::one_paragraph(text.str());  // lines wrap anywhere: compare with single spaces
   for (const std::string& said :
        {fmt::format("({} cells: {} algorithm entries x {} scenes x {} seeds,", p.cells, p.entries, p.scenes, p.seeds),
         fmt::format("**one repetition** of each cell ({} trials, after one warm-up)", p.cells),
