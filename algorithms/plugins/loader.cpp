@@ -18,6 +18,7 @@
 #include <deque>
 #include <filesystem>
 #include <set>
+#include <thread>
 
 #include <fmt/format.h>
 
@@ -239,8 +240,8 @@ void probe_in_child(const std::string& path) {
   if (pid == 0) {
     close(fds[0]);
     // A plugin's exit() here would run the exit handlers of libraries whose threads the fork did not
-    // copy (and wait for them forever): registered last, this handler runs first and ends the child with
-    // the plugin's status.
+    // copy (and wait for them forever): handlers run in reverse order, so this one, registered after the
+    // host's libraries' and before the plugin's, ends the child with the plugin's status before theirs.
     on_exit([](int status, void*) { _exit(status); }, nullptr);
     std::string said = "ok";
     try {
@@ -278,8 +279,18 @@ void probe_in_child(const std::string& path) {
     said.append(buf, static_cast<std::size_t>(n));
   }
   close(fds[0]);
+  // A child that closed its end without ending (a constructor that closes every descriptor and then waits)
+  // is given kProbeSeconds more to end, then killed.
   int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  for (const auto t0 = std::chrono::steady_clock::now();;) {
+    const pid_t w = waitpid(pid, &status, late ? 0 : WNOHANG);
+    if (w == pid || (w < 0 && errno != EINTR)) break;
+    if (w == 0 && std::chrono::steady_clock::now() - t0 > std::chrono::seconds(kProbeSeconds)) {
+      late = true;
+      kill(pid, SIGKILL);
+    } else if (w == 0) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
   }
   if (said == "ok") return;
   if (!late && WIFEXITED(status) && WEXITSTATUS(status) == 0 && !said.empty()) throw InputError(said);

@@ -6,12 +6,15 @@
  *    tip. Its `fault` parameter makes it crash, hang, exhaust memory or report errors, for the tests of
  *    how a suite records a misbehaving plugin (an exit() it never reports, a message of a megabyte, a flood of stderr,
  * a full disk). 1 no entry point; 2 another ABI version; 3 a built-in's name; 4 a malformed parameter table;
- * 5 an entry() that crashes; 6 an entry() that calls exit(0). */
+ * 5 an entry() that crashes; 6 an entry() that calls exit(0); 7 an entry() that closes every descriptor and
+ * waits forever. */
+#define _POSIX_C_SOURCE 200809L /* close() and pause() under C99 without extensions */
 #include <math.h>
 #include <stdio.h>
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "growbench/plugin.h"
 
@@ -245,6 +248,9 @@ GROWBENCH_PLUGIN_EXPORT const growbench_plugin* growbench_plugin_entry(void) {
   raise(SIGSEGV);
 #elif TEST_PLUGIN_VARIANT == 6
   exit(0);
+#elif TEST_PLUGIN_VARIANT == 7
+  for (int fd = 0; fd < 1024; ++fd) close(fd);
+  for (;;) pause();
 #endif
   return &kPlugin;
 }

@@ -421,11 +421,17 @@ void end_orphans(pid_t spare) {
         if (p != spare) orphans.push_back(static_cast<pid_t>(p));
       std::fclose(f);
     }
-    if (orphans.empty()) return;
+    if (orphans.empty()) break;
     for (pid_t p : orphans) kill(p, SIGKILL);
     for (pid_t p : orphans)
       while (waitpid(p, nullptr, 0) < 0 && errno == EINTR) {
       }
+  }
+  // Orphans that ended on their own, or that the list could not show (no /proc), are zombies until reaped.
+  siginfo_t si{};
+  while (waitid(P_ALL, 0, &si, WEXITED | WNOHANG | WNOWAIT) == 0 && si.si_pid != 0 && si.si_pid != spare) {
+    waitpid(si.si_pid, nullptr, 0);
+    si = {};
   }
 }
 
