@@ -83,10 +83,6 @@ inline std::string utf8_excerpt(std::string_view text, std::size_t max_bytes) {
   return escape_utf8(text.substr(0, end)) + "...";
 }
 
-// Why `text` cannot be a name that files, folders, renders and reports carry (a suite's or scene's name, an
-// entry's label), or "" when it can: at most kMaxNameBytes, and no control character (a line break ended
-// the comment a name was written into).
-inline constexpr std::size_t kMaxNameBytes = 100;
 // Whether `text` holds an ASCII control character (a line break, a tab, an escape): what ends a line or a
 // comment that a name or path is written into.
 inline bool has_control_char(std::string_view text) {
@@ -94,6 +90,11 @@ inline bool has_control_char(std::string_view text) {
     if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) return true;
   return false;
 }
+
+// Why `text` cannot be a name that files, folders, renders and reports carry (a suite's or scene's name, an
+// entry's label), or "" when it can: at most kMaxNameBytes, and no control character (a line break ended
+// the comment a name was written into).
+inline constexpr std::size_t kMaxNameBytes = 100;
 inline std::string name_problem(std::string_view text) {
   if (text.size() > kMaxNameBytes)
     return "expected a name of at most " + std::to_string(kMaxNameBytes) + " bytes, got " + std::to_string(text.size());

@@ -681,8 +681,7 @@ std::string decal_problem(const Scene& scene, const Plant& plant) {
   for (std::size_t i = 0; i < plant.decals.size(); ++i) {
     const SurfaceDecal& d = plant.decals[i];
     // The name goes into a POV-Ray string as it is.
-    if (std::any_of(d.image.begin(), d.image.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20; }))
-      return fmt::format("decal {}: its image name has a control character", i);
+    if (has_control_char(d.image)) return fmt::format("decal {}: its image name has a control character", i);
     if (d.mesh == kPlanarDecal) {
       if (!(glm::length(glm::cross(d.u_axis, d.v_axis)) > 0.0f))
         return fmt::format("decal {} ({}): its u_axis and v_axis span no plane", i, d.image);
@@ -1097,9 +1096,7 @@ std::string decal_render_problem(const Scene& scene, const Plant& plant, const f
     const fs::path rel(image);
     const bool plain = !image.empty() && rel.is_relative() &&
                        std::none_of(rel.begin(), rel.end(), [](const fs::path& p) { return p == ".."; }) &&
-                       std::none_of(image.begin(), image.end(), [](char c) {
-                         return c == '"' || c == '\\' || static_cast<unsigned char>(c) < 0x20 || c == 0x7f;
-                       });
+                       image.find_first_of("\"\\") == std::string::npos && !has_control_char(image);
     if (!plain)
       return fmt::format(
           "decal {}: its image '{}' is not a plain file name inside the render's directory (expected a "
