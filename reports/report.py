@@ -1419,7 +1419,7 @@ def write_report(doc, results_path, out, formats, peers_path=None, pareto_metric
         ordered(c.row for c in cells), ordered(c.scene for c in cells), QUALITY, notes)
     if beyond:
         print(f"report: note: table.tex holds characters pdflatex cannot set ({' '.join(beyond)}); "
-              "compile it with lualatex or xelatex", file=sys.stderr)
+              "compile it with lualatex or xelatex and a font that has them", file=sys.stderr)
     write_markdown(os.path.join(out, "table.md"), rows, CAPTION, notes)
 
     base = os.path.dirname(os.path.abspath(results_path))

@@ -5,7 +5,7 @@ rendered, summarized, reported, compared, sharded and merged (also through bench
 a stand-in sbatch that runs what it is given), and added to a history that is plotted. Every command must
 succeed, write nothing outside its output folder, and carry each name as inert text: no element, attribute
 or script the name brought into a page, no formula cell in the CSV, no directive line in render.pov, a
-table.tex that pdflatex compiles and a table.md whose rows keep their columns. Names with a control
+table.tex that LaTeX sets with every character and a table.md whose rows keep their columns. Names with a control
 character are refused (exit 2, naming the key) before anything is written.
 
 usage: hostile_names_test.py GROWBENCH WORKDIR
@@ -144,8 +144,9 @@ def check_markdown(path):
 
 
 def check_tex(path):
-    """table.tex compiles; pdflatex has no glyphs past Latin (the CJK name), so the file must say to use
-    lualatex, with which it must compile."""
+    """table.tex compiles with every character set. pdflatex has no glyphs past Latin (the CJK name), so the
+    file must say to use lualatex, which sets it with DejaVu Sans and Droid Sans Fallback for CJK. A glyph
+    no font has is only a line in the log ("Missing character"), so the log is read too."""
     with open(path, encoding="utf-8") as f:
         first = f.readline()
     check("lualatex" in first and "植" in first, f"{path}: the first line does not name lualatex for 植: {first!r}")
@@ -153,14 +154,22 @@ def check_tex(path):
     if not shutil.which(tex):
         check(False, f"{tex} is missing: scripts/install-deps installs it")
         return
+    fonts = ("\\usepackage{fontspec}"
+             "\\directlua{luaotfload.add_fallback(\"cjk\", {\"Droid Sans Fallback:mode=node;\"})}"
+             "\\setmainfont{DejaVu Sans}[RawFeature={fallback=cjk}]") if tex == "lualatex" else ""
     with tempfile.TemporaryDirectory() as d:
         shutil.copy(path, os.path.join(d, "table.tex"))
         with open(os.path.join(d, "doc.tex"), "w") as f:
-            f.write("\\documentclass{article}\\usepackage{booktabs}"
+            f.write("\\documentclass{article}\\usepackage{booktabs}" + fonts +
                     "\\begin{document}\\input{table}\\end{document}\n")
         r = subprocess.run([tex, "-interaction=nonstopmode", "-halt-on-error", "-no-shell-escape", "doc.tex"],
                            cwd=d, capture_output=True, text=True, timeout=300)  # lualatex builds its font cache once
         check(r.returncode == 0, f"{path}: {tex} fails on it: {r.stdout[-1500:]}")
+        with open(os.path.join(d, "doc.log"), encoding="utf-8", errors="replace") as f:
+            log = f.read()
+        lost = sorted({line.strip() for line in log.splitlines()
+                       if "Missing character" in line or "Error in luaotfload" in line})
+        check(not lost, f"{path}: {tex} set it without every character: {lost[:5]}")
 
 
 def check_pov(out):
