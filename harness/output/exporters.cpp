@@ -32,6 +32,9 @@
 namespace growbench {
 namespace {
 
+// The glTF attribute that carries OutputMesh::birth_steps: per vertex, and per organ instance.
+constexpr const char* kBirthStep = "_BIRTH_STEP";
+
 static_assert(std::endian::native == std::endian::little, "the PLY writer assumes a little-endian host");
 
 // Formatted text streamed through an AtomicFile: records are formatted into a small buffer that is handed
@@ -352,8 +355,8 @@ std::uint64_t write_glb_container(const std::string& path, const std::string& js
 }
 
 // The vertex attributes every primitive shares: POSITION and NORMAL, COLOR_0 when the mesh has colours
-// (clamped to [0, 1], as glTF's colours are), and each other attribute as _NAME (application-specific
-// attributes start with '_').
+// (clamped to [0, 1], as glTF's colours are), _BIRTH_STEP (OutputMesh::birth_steps, as floats: exact to
+// 2^24 steps), and each other attribute as _NAME (application-specific attributes start with '_').
 std::map<std::string, int> shared_attributes(GltfBuilder& b, const OutputMesh& m) {
   const std::size_t nv = m.positions.size();
   Aabb box;
@@ -375,8 +378,14 @@ std::map<std::string, int> shared_attributes(GltfBuilder& b, const OutputMesh& m
     for (auto& c : clamped) c = glm::clamp(c, glm::vec3(0.0f), glm::vec3(1.0f));
     attrs["COLOR_0"] = b.vertex_floats(&clamped[0].x, nv, 3);
   }
+  if (m.birth_steps.size() == nv && b.count_only) {
+    attrs[kBirthStep] = b.vertex_floats(nullptr, nv, 1);
+  } else if (m.birth_steps.size() == nv) {
+    const std::vector<float> steps(m.birth_steps.begin(), m.birth_steps.end());
+    attrs[kBirthStep] = b.vertex_floats(steps.data(), nv, 1);
+  }
   for (const auto& a : m.attributes) {
-    std::string name = "_" + attribute_word(a.name);
+    std::string name = std::string(1, '_').append(attribute_word(a.name));
     while (attrs.count(name)) name += "_";
     attrs[name] = b.vertex_floats(a.values.data(), nv, a.components);
   }
@@ -402,11 +411,11 @@ void build_plain_glb(GltfBuilder& b, const OutputMesh& m) {
     return;
   }
   // One allocation for the whole binary chunk (positions, normals, indices, each padded to 4 bytes).
-  std::size_t vertex_floats = m.colors.empty() ? 6 : 9;
+  std::size_t vertex_floats = (m.colors.empty() ? 6 : 9) + (m.birth_steps.empty() ? 0 : 1);
   for (const auto& a : m.attributes) vertex_floats += static_cast<std::size_t>(a.components);
   if (!b.count_only)
     b.buffer.data.reserve(vertex_floats * m.positions.size() * sizeof(float) + m.triangles.size() * sizeof(glm::uvec3) +
-                          m.lines.size() * sizeof(glm::uvec2) + 4 * (2 * m.groups.size() + 2 + m.attributes.size()));
+                          m.lines.size() * sizeof(glm::uvec2) + 4 * (2 * m.groups.size() + 3 + m.attributes.size()));
   const std::map<std::string, int> attributes = shared_attributes(b, m);
   std::map<std::string, std::vector<double>> colours;
   for (const auto& c : material_colors()) colours[c.material] = {c.r, c.g, c.b, 1.0};
@@ -663,6 +672,21 @@ int vertex_accessor(CompactGlb& g, const std::vector<std::array<T, N>>& values, 
   return g.accessor(view, component, values.size(), type, normalized);
 }
 
+// Growth steps as a SCALAR accessor: per vertex, unsigned 16-bit in 4-byte records (meshopt wants records
+// of a multiple of 4 bytes, and a vertex view says its stride) when every step fits; else, and per
+// instance (whose views are tightly packed), float, exact to 2^24 steps.
+int birth_step_accessor(CompactGlb& g, const std::vector<std::uint32_t>& steps, bool vertex) {
+  const std::uint32_t last = steps.empty() ? 0 : *std::max_element(steps.begin(), steps.end());
+  if (vertex && last <= UINT16_MAX) {
+    std::vector<std::array<std::uint16_t, 2>> narrow(steps.size(), {0, 0});
+    for (std::size_t i = 0; i < steps.size(); ++i) narrow[i][0] = static_cast<std::uint16_t>(steps[i]);
+    return g.accessor(g.attribute_view(narrow.data(), narrow.size(), 4, vertex), kUnsignedShort, narrow.size(),
+                      "SCALAR");
+  }
+  const std::vector<float> wide(steps.begin(), steps.end());
+  return g.accessor(g.attribute_view(wide.data(), wide.size(), 4, vertex), kFloat, wide.size(), "SCALAR");
+}
+
 // The vertex attributes of a piece, quantized; `box_min` and `step` dequantize its positions.
 Json piece_attributes(CompactGlb& g, const OutputMesh& m, const Piece& p, const glm::vec3& box_min, float step) {
   const std::size_t n = p.vertices.size();
@@ -703,6 +727,11 @@ Json piece_attributes(CompactGlb& g, const OutputMesh& m, const Piece& p, const 
             static_cast<std::uint16_t>(std::lround(std::clamp(m.colors[p.vertices[i]][k], 0.0f, 1.0f) * 65535.0f));
     attrs["COLOR_0"] = vertex_accessor(g, col, kUnsignedShort, "VEC3", true);
   }
+  if (m.birth_steps.size() == m.positions.size()) {
+    std::vector<std::uint32_t> steps(n);
+    for (std::size_t i = 0; i < n; ++i) steps[i] = m.birth_steps[p.vertices[i]];
+    attrs[kBirthStep] = birth_step_accessor(g, steps, true);
+  }
   for (const auto& a : m.attributes) {
     static constexpr const char* kTypes[] = {"SCALAR", "VEC2", "VEC3", "VEC4"};
     const auto c = static_cast<std::size_t>(std::clamp(a.components, 1, 4));
@@ -710,7 +739,7 @@ Json piece_attributes(CompactGlb& g, const OutputMesh& m, const Piece& p, const 
     for (std::size_t i = 0; i < n; ++i)
       for (std::size_t k = 0; k < c; ++k)
         values[i * c + k] = a.values[p.vertices[i] * static_cast<std::size_t>(a.components) + k];
-    std::string name = "_" + attribute_word(a.name);
+    std::string name = std::string(1, '_').append(attribute_word(a.name));
     while (attrs.contains(name)) name += "_";
     attrs[name] = g.accessor(g.attribute_view(values.data(), n, 4 * c, true), kFloat, n, kTypes[c - 1]);
   }
@@ -747,8 +776,8 @@ bool in_organ_group(const std::string& group, OrganKind kind) {
 
 // One organ shape as a mesh (float positions and normals: a few vertices) drawn at every organ of it by
 // EXT_mesh_gpu_instancing; returns the node.
-int write_instances(CompactGlb& g, const OrganShape& shape, const std::vector<const Organ*>& organs, int material,
-                    const std::string& name) {
+int write_instances(CompactGlb& g, const OrganShape& shape, const std::vector<const Organ*>& organs,
+                    const std::vector<std::uint32_t>& steps, int material, const std::string& name) {
   const std::size_t nv = shape.mesh.vertices.size();
   Json attrs;
   attrs["POSITION"] = g.accessor(g.attribute_view(shape.mesh.vertices.data(), nv, 12, true), kFloat, nv, "VEC3");
@@ -790,6 +819,7 @@ int write_instances(CompactGlb& g, const OrganShape& shape, const std::vector<co
   inst["ROTATION"] =
       g.accessor(g.attribute_view(rotation.data(), n, 8, false, f ? &r : nullptr), kShort, n, "VEC4", true);
   inst["SCALE"] = g.accessor(g.attribute_view(scale.data(), n, 12, false, f ? &s : nullptr), kFloat, n, "VEC3");
+  if (!steps.empty()) inst[kBirthStep] = birth_step_accessor(g, steps, false);
   g.use("EXT_mesh_gpu_instancing", false);
   return g.add("nodes",
                {{"name", name}, {"mesh", mesh}, {"extensions", {{"EXT_mesh_gpu_instancing", {{"attributes", inst}}}}}});
@@ -828,6 +858,7 @@ std::uint64_t write_glb(const std::string& path, const OutputMesh& m, GlbLayout 
   if (layout == GlbLayout::Plain || (m.triangles.empty() && m.lines.empty())) return write_glb(path, m);
   CompactGlb g(layout == GlbLayout::Compact);
   const bool instancing = m.colors.empty() && m.attributes.empty();
+  const std::uint32_t last_step = last_birth_step(plant);
   std::vector<std::uint32_t> local(m.positions.size(), kNoVertex);
   std::vector<int> children;                            // of the root
   std::map<std::string, std::vector<int>> group_nodes;  // plant group -> its nodes
@@ -837,8 +868,13 @@ std::uint64_t write_glb(const std::string& path, const OutputMesh& m, GlbLayout 
     std::vector<std::vector<const Organ*>> by_shape;
     if (instancing) by_shape = organs_by_shape(group, plant, shapes);
     if (!by_shape.empty()) {
-      for (std::size_t s = 0; s < by_shape.size(); ++s)
-        if (!by_shape[s].empty()) into.push_back(write_instances(g, shapes.at(s), by_shape[s], material, group.name));
+      for (std::size_t s = 0; s < by_shape.size(); ++s) {
+        if (by_shape[s].empty()) continue;
+        std::vector<std::uint32_t> steps;
+        if (!m.birth_steps.empty())
+          for (const Organ* o : by_shape[s]) steps.push_back(organ_birth_step(plant, *o, last_step));
+        into.push_back(write_instances(g, shapes.at(s), by_shape[s], steps, material, group.name));
+      }
       continue;
     }
     const auto pieces = [&](const std::uint32_t* idx, std::size_t count, std::size_t arity) {

@@ -11,7 +11,9 @@
 //  - other vertex attributes (OutputMesh::attributes): PLY float properties (NAME, or NAME_0, NAME_1, ...
 //    for several components) and glTF attributes _NAME (application-specific ones start with '_'); names
 //    keep letters, digits and '_', anything else becomes '_'. OBJ has no place for them;
-//  - line segments (branch geometry skeleton): OBJ `l`, PLY `edge` elements (vertex1, vertex2), glTF LINES.
+//  - line segments (branch geometry skeleton): OBJ `l`, PLY `edge` elements (vertex1, vertex2), glTF LINES;
+//  - birth steps (OutputMesh::birth_steps): glTF only, _BIRTH_STEP on every vertex and every organ instance
+//    (EXT_mesh_gpu_instancing): the growth step its part appeared at, which a viewer plays growth from.
 // A mesh without them is written byte for byte as before they existed.
 #pragma once
 

@@ -137,6 +137,7 @@ struct TubePath {
   std::vector<float> rad;
   std::vector<std::uint16_t> divisions;  // when the plant has node tubes
   std::vector<RingSource> src;           // when `sources`
+  std::vector<std::uint32_t> steps;      // each ring's birth step: its segment's end node's
   bool sources = false;
 };
 
@@ -147,20 +148,26 @@ void tube_path(TubePath& t, const Plant& plant, const std::vector<std::int32_t>&
   if (!x.tubes && !t.sources) {  // most plants: points and radii alone, in vectors that do not escape
     std::vector<glm::vec3> pts;
     std::vector<float> rad;
+    std::vector<std::uint32_t> steps;
     for (std::size_t j = 0; j < chain.size(); ++j) {
       const auto& node = plant.nodes[static_cast<std::size_t>(chain[j])];
       const glm::vec3 p = node.position;
       if (!pts.empty() && glm::length(p - pts.back()) < 1e-7f) continue;  // drop zero-length segments
       float r = node.radius;
+      // A chain's first ring is its first segment's: it appears with that segment's end.
+      std::uint32_t step = node.birth_step;
       if (j == 0 && chain.size() > 1) {
         const auto& next = plant.nodes[static_cast<std::size_t>(chain[1])];
         if (next.shoot != node.shoot) r = std::min(r, next.radius);
+        step = next.birth_step;
       }
       pts.push_back(p);
       rad.push_back(std::max(r, o.min_radius > 0.0f ? o.min_radius : 1e-4f));
+      steps.push_back(step);
     }
     t.pts = std::move(pts);
     t.rad = std::move(rad);
+    t.steps = std::move(steps);
     return;
   }
   for (std::size_t j = 0; j < chain.size(); ++j) {
@@ -172,12 +179,14 @@ void tube_path(TubePath& t, const Plant& plant, const std::vector<std::int32_t>&
     // and its own values: those of its first segment's end.
     float r = node.radius;
     std::int32_t own = id;
+    std::uint32_t step = node.birth_step;
     if (j == 0 && chain.size() > 1) {
       const auto& next = plant.nodes[static_cast<std::size_t>(chain[1])];
       if (next.shoot != node.shoot) {
         r = std::min(r, next.radius);
         own = chain[1];
       }
+      step = next.birth_step;
     }
     r = std::max(r, o.min_radius > 0.0f ? o.min_radius : 1e-4f);
     if (x.tubes && !t.pts.empty()) {
@@ -191,12 +200,14 @@ void tube_path(TubePath& t, const Plant& plant, const std::vector<std::int32_t>&
         t.pts.push_back(p0 + (p - p0) * f);
         t.rad.push_back(r0 + (r - r0) * f);
         t.divisions.push_back(d);
+        t.steps.push_back(node.birth_step);
         if (t.sources) t.src.push_back({from, id, f});
       }
       t.divisions.push_back(d);
     }
     t.pts.push_back(p);
     t.rad.push_back(r);
+    t.steps.push_back(step);
     if (t.sources) t.src.push_back({own, own, 0.0f});
   }
 }
@@ -230,6 +241,7 @@ void add_tube(OutputMesh& m, const Plant& plant, const std::vector<std::int32_t>
     const auto base = static_cast<std::uint32_t>(m.positions.size());
     add_strip(m, pts, rad, start, end, d, normal);
     const auto S = static_cast<std::uint32_t>(d);
+    for (std::size_t j = start; j <= end; ++j) m.birth_steps.insert(m.birth_steps.end(), S, path.steps[j]);
     if (vertex_data)
       for (std::size_t j = start; j <= end; ++j) add_vertex_data(m, x, src[j], S);
     if (triangle_groups)
@@ -250,6 +262,7 @@ void add_tube(OutputMesh& m, const Plant& plant, const std::vector<std::int32_t>
       const auto centre = static_cast<std::uint32_t>(m.positions.size());
       m.positions.push_back(pts[j]);
       m.normals.push_back(start ? -t : t);
+      m.birth_steps.push_back(path.steps[j]);
       if (vertex_data) add_vertex_data(m, x, src[j], 1);
       const std::uint32_t ring = start ? first_ring : last_ring;
       const auto S = static_cast<std::uint32_t>(start ? first_sides : last_sides);
@@ -272,6 +285,7 @@ void add_skeleton_lines(OutputMesh& m, const Plant& plant, const TubeExtras& x,
   for (std::size_t i = 0; i < plant.nodes.size(); ++i) {
     m.positions.push_back(plant.nodes[i].position);
     m.normals.emplace_back(0.0f, 1.0f, 0.0f);
+    m.birth_steps.push_back(plant.nodes[i].birth_step);
     const auto id = static_cast<std::int32_t>(i);
     if (x.vertex_data()) add_vertex_data(m, x, {id, id, 0.0f}, 1);
   }
@@ -373,8 +387,9 @@ void complete_vertex_data(OutputMesh& m) {
   for (auto& a : m.attributes) a.values.resize(m.positions.size() * static_cast<std::size_t>(a.components), 0.0f);
 }
 
-void add_organ(OutputMesh& m, const Organ& organ, const OrganShape& shape, const glm::vec3* color) {
+void add_organ(OutputMesh& m, const Organ& organ, const OrganShape& shape, const glm::vec3* color, std::uint32_t step) {
   const auto base = static_cast<std::uint32_t>(m.positions.size());
+  m.birth_steps.resize(base + shape.mesh.vertices.size(), step);
   const glm::mat3 r = glm::mat3_cast(organ.orientation);
   for (std::size_t k = 0; k < shape.mesh.vertices.size(); ++k) {
     // organ_point's arithmetic in its order (the same floats), with the rotation made once per organ.
@@ -386,6 +401,17 @@ void add_organ(OutputMesh& m, const Organ& organ, const OrganShape& shape, const
 }
 
 }  // namespace
+
+std::uint32_t last_birth_step(const Plant& plant) {
+  std::uint32_t last = 0;
+  for (const auto& n : plant.nodes) last = std::max(last, n.birth_step);
+  return last;
+}
+
+std::uint32_t organ_birth_step(const Plant& plant, const Organ& organ, std::uint32_t last_step) {
+  const auto n = static_cast<std::size_t>(organ.node);
+  return organ.node >= 0 && n < plant.nodes.size() ? plant.nodes[n].birth_step : last_step;
+}
 
 MesherOptions with_leaf_mesh(MesherOptions o) {
   if (!o.leaf_obj.empty() && !o.leaf) o.leaf = std::make_shared<const OrganShape>(load_organ_obj(o.leaf_obj));
@@ -408,11 +434,13 @@ OutputMesh mesh_plant(const Plant& plant, const MesherOptions& o) {
   // Vertex colours only when some organ has a colour of its own; then every vertex has one, its organ's
   // or its group's material colour.
   const bool colored = shapes.any_color(plant);
+  const std::uint32_t last_step = last_birth_step(plant);
   auto organ_mesh = [&](const Organ& organ) {
-    if (!colored) return add_organ(m, organ, shapes.of(organ), nullptr);
+    const std::uint32_t step = organ_birth_step(plant, organ, last_step);
+    if (!colored) return add_organ(m, organ, shapes.of(organ), nullptr, step);
     pad_colors(m);
     const glm::vec3 c = shapes.linear_color(organ);
-    add_organ(m, organ, shapes.of(organ), &c);
+    add_organ(m, organ, shapes.of(organ), &c, step);
   };
   auto group = [&](const char* name, const char* material, auto&& body) {
     const auto first = static_cast<std::uint32_t>(m.triangles.size());
@@ -439,9 +467,10 @@ OutputMesh mesh_plant(const Plant& plant, const MesherOptions& o) {
         n += glm::vec3((a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y));
       }
       n = glm::length(n) > 0.0f ? glm::normalize(n) : glm::vec3(0, 1, 0);
-      for (const auto& v : poly.vertices) {
+      for (const auto& v : poly.vertices) {  // polygons stand for no node: they appear with the plant
         m.positions.push_back(v);
         m.normals.push_back(n);
+        m.birth_steps.push_back(last_step);
       }
       for (std::uint32_t i = 1; i + 1 < poly.vertices.size(); ++i)
         m.triangles.emplace_back(base, base + i, base + i + 1);

@@ -63,6 +63,11 @@ struct OutputMesh {
   // vertex it adds; mesh_plant gives the vertices left without one their group's material_color.
   std::vector<glm::vec3> colors;
   std::vector<VertexAttribute> attributes;  // each empty or complete, as colors
+  // The growth step at which each vertex's part of the plant appeared (PlantNode::birth_step of the node
+  // a tube ring or skeleton vertex stands for, of an organ's node), one per position, so that a viewer can
+  // show the plant as it grew. Not an `attributes` entry: it never reaches OBJ or PLY, and the glTF writer
+  // keeps organs instanced with it (a per-instance value).
+  std::vector<std::uint32_t> birth_steps;
 };
 
 // Marks the vertices so far that have no colour as uncoloured (see OutputMesh::colors).
@@ -87,6 +92,12 @@ OrganShapes organ_shapes(const Plant& plant, const MesherOptions& options = {});
 glm::vec3 material_srgb(std::string_view material);
 
 OutputMesh mesh_plant(const Plant& plant, const MesherOptions& options = {});
+
+// The growth step of the plant's newest node: when what stands for no node (an L-system polygon, an organ
+// on no node) is taken to appear.
+std::uint32_t last_birth_step(const Plant& plant);
+// The growth step at which `organ` appeared: its node's, else `last_step`.
+std::uint32_t organ_birth_step(const Plant& plant, const Organ& organ, std::uint32_t last_step);
 
 // Chains of nodes along which tubes run: each starts at a root or a branching point and follows the
 // main child (the one that continues the parent's shoot, else the first). Shared with the skeleton

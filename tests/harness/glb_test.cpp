@@ -85,7 +85,8 @@ std::string view_bytes(const Glb& g, int view) {
   const Json& v = g.doc["bufferViews"][static_cast<std::size_t>(view)];
   if (!v.contains("extensions")) {
     EXPECT_EQ(v["buffer"], 0);
-    return g.bin.substr(v["byteOffset"].get<std::size_t>(), v["byteLength"].get<std::size_t>());
+    return g.bin.substr(v.value("byteOffset", std::size_t{0}),
+                        v["byteLength"].get<std::size_t>());  // glTF's default offset is 0
   }
   const Json& e = v["extensions"]["EXT_meshopt_compression"];
   const auto count = e["count"].get<std::size_t>(), stride = e["byteStride"].get<std::size_t>();
@@ -142,7 +143,8 @@ glm::vec3 vec3_at(const std::vector<float>& v, std::size_t i) {
 // every instanced organ's vertices, both in world space.
 struct Decoded {
   std::vector<glm::vec3> corners, corner_normals, organ_vertices;
-  std::vector<float> corner_tolerance;  // half the piece's quantization step
+  std::vector<float> corner_tolerance;           // half the piece's quantization step
+  std::vector<float> corner_steps, organ_steps;  // _BIRTH_STEP, when the file has it
   std::size_t pieces = 0;
 };
 
@@ -158,11 +160,14 @@ Decoded decode(const Glb& g) {
       const Json& inst = node["extensions"]["EXT_mesh_gpu_instancing"]["attributes"];
       const auto t = accessor_values(g, inst["TRANSLATION"]), r = accessor_values(g, inst["ROTATION"]),
                  s = accessor_values(g, inst["SCALE"]);
+      const auto steps = inst.contains("_BIRTH_STEP") ? accessor_values(g, inst["_BIRTH_STEP"]) : std::vector<float>{};
       for (std::size_t i = 0; i < t.size() / 3; ++i) {
         const glm::mat3 rot =
             glm::mat3_cast(glm::normalize(glm::quat(r[4 * i + 3], r[4 * i], r[4 * i + 1], r[4 * i + 2])));
-        for (std::size_t k = 0; k < pos.size() / 3; ++k)
+        for (std::size_t k = 0; k < pos.size() / 3; ++k) {
           d.organ_vertices.push_back(vec3_at(t, i) + rot * (vec3_at(pos, k) * vec3_at(s, i)));
+          if (!steps.empty()) d.organ_steps.push_back(steps[i]);
+        }
       }
       continue;
     }
@@ -171,7 +176,11 @@ Decoded decode(const Glb& g) {
     const float step = node["scale"][0];
     EXPECT_EQ(node["scale"][1], node["scale"][0]);  // uniform: normals need no correction
     EXPECT_EQ(g.doc["accessors"][prim["indices"].get<std::size_t>()]["componentType"], 5123);  // uint16
+    const auto steps = prim["attributes"].contains("_BIRTH_STEP")
+                           ? accessor_values(g, prim["attributes"]["_BIRTH_STEP"])
+                           : std::vector<float>{};
     for (const float i : idx) {
+      if (!steps.empty()) d.corner_steps.push_back(steps[static_cast<std::size_t>(i)]);
       EXPECT_LT(i, 65535.0f);  // the primitive restart value is not an index
       const auto k = static_cast<std::size_t>(i);
       d.corners.push_back(origin + step * vec3_at(pos, k));
@@ -189,7 +198,7 @@ Decoded decode(const Glb& g) {
 void expect_same_plant(const Glb& g, const OutputMesh& m, const Plant& plant, bool compact) {
   const Decoded d = decode(g);
   std::vector<glm::vec3> corners, normals, organ_vertices;
-  std::vector<float> organ_tolerance;
+  std::vector<float> organ_tolerance, corner_steps, organ_steps;
   for (const auto& group : m.groups) {
     const bool organs = group.name == "leaves" || group.name == "flowers";
     for (std::uint32_t t = group.first_triangle; t < group.first_triangle + group.triangle_count; ++t)
@@ -197,6 +206,7 @@ void expect_same_plant(const Glb& g, const OutputMesh& m, const Plant& plant, bo
         if (organs) continue;
         corners.push_back(m.positions[m.triangles[t][k]]);
         normals.push_back(m.normals[m.triangles[t][k]]);
+        corner_steps.push_back(static_cast<float>(m.birth_steps[m.triangles[t][k]]));
       }
   }
   // Instances come shape by shape within each organ group; here every organ of a group has one shape.
@@ -209,6 +219,7 @@ void expect_same_plant(const Glb& g, const OutputMesh& m, const Plant& plant, bo
       const glm::vec3 a = glm::abs(o.position);
       for (const auto& v : shapes.of(o).mesh.vertices) {
         organ_vertices.push_back(organ_point(o, v));
+        organ_steps.push_back(static_cast<float>(plant.nodes[static_cast<std::size_t>(o.node)].birth_step));
         organ_tolerance.push_back(compact ? 5e-6f + 6e-5f * std::max({a.x, a.y, a.z}) + 1e-3f * o.size : 5e-6f);
       }
     }
@@ -216,10 +227,14 @@ void expect_same_plant(const Glb& g, const OutputMesh& m, const Plant& plant, bo
   // meshoptimizer's index codec may start a triangle at another corner (the same triangle, the same
   // winding), so each triangle must match in one of its three rotations.
   ASSERT_EQ(d.corners.size(), corners.size());
+  // Each vertex and organ carries the step at which it appeared, exactly.
+  ASSERT_EQ(d.corner_steps.size(), corners.size());
+  ASSERT_EQ(d.organ_steps, organ_steps);
   auto corner_matches = [&](std::size_t decoded, std::size_t expected) {
     const glm::vec3 e = glm::abs(d.corners[decoded] - corners[expected]);
     return std::max({e.x, e.y, e.z}) <= d.corner_tolerance[decoded] * 1.01f + 1e-6f &&
-           glm::length(d.corner_normals[decoded] - normals[expected]) <= (compact ? 0.03f : 0.01f);
+           glm::length(d.corner_normals[decoded] - normals[expected]) <= (compact ? 0.03f : 0.01f) &&
+           d.corner_steps[decoded] == corner_steps[expected];
   };
   for (std::size_t t = 0; t < corners.size(); t += 3) {
     int rotation = -1;
@@ -252,6 +267,32 @@ TEST(Glb, PlainBytesAreTheFileSizeWithoutWritingIt) {
   m.groups.back().plant_group = "g1";
   EXPECT_EQ(plain_glb_bytes(m), write_glb((dir / "b.glb").string(), m));
   EXPECT_EQ(plain_glb_bytes(OutputMesh{}), write_glb((dir / "empty.glb").string(), OutputMesh{}));
+}
+
+// A viewer plays a plant back from its file: each vertex carries the step at which its part appeared. A
+// tube's rings appear with the segment they end (a chain's first ring with its first segment), so at step k
+// exactly the segments whose end node existed are whole; an organ appears with its node.
+TEST(Glb, EachVertexCarriesTheStepItsPartAppeared) {
+  Plant p;
+  p.nodes = {{{0, 0, 0}, 0.01f, kNoParent, 0, 0, 0}, {{0, 1, 0}, 0.01f, 0, 0, 0, 3}, {{0, 2, 0}, 0.01f, 1, 0, 0, 7}};
+  p.organs.push_back({{0, 2, 0}, glm::quat(1, 0, 0, 0), 0.1f, OrganKind::Leaf, 2});
+  p.polygons.push_back({{{1, 0, 0}, {1, 1, 0}, {2, 1, 0}}});
+  MesherOptions o;
+  o.sides = 4;
+  const OutputMesh m = mesh_plant(p, o);
+  ASSERT_EQ(m.birth_steps.size(), m.positions.size());
+  const std::size_t leaf = OrganShapes(p).of(p.organs[0]).mesh.vertices.size();
+  std::vector<std::uint32_t> expect = {3, 3, 3, 3, 3, 3, 3, 3, 7, 7, 7, 7, 3, 7};  // three rings, two caps
+  expect.insert(expect.end(), leaf, 7);
+  expect.insert(expect.end(), {7, 7, 7});  // a polygon stands for no node: it appears with the plant
+  EXPECT_EQ(m.birth_steps, expect);
+  // Every layout writes them; the plain file as floats.
+  const auto dir = test::temp_dir("glb_steps");
+  write_glb((dir / "plain.glb").string(), m);
+  const Glb plain = read_glb(dir / "plain.glb");
+  const auto steps = accessor_values(plain, plain.doc["meshes"][0]["primitives"][0]["attributes"]["_BIRTH_STEP"]);
+  EXPECT_EQ(steps, std::vector<float>(expect.begin(), expect.end()));
+  EXPECT_EQ(plain_glb_bytes(m), std::filesystem::file_size(dir / "plain.glb"));
 }
 
 // glTF wants buffers of at least one byte; a plant with no geometry has no buffer data in any layout.
