@@ -349,4 +349,44 @@ glm::mat4 trs(const glm::vec3& translate, const glm::vec3& rotate_deg, const glm
   return glm::scale(m, scale);
 }
 
+ShadedMesh crease_shaded(const TriangleMesh& m) {
+  const std::size_t nv = m.vertices.size(), nt = m.triangles.size();
+  std::vector<glm::vec3> face(nt);  // area-weighted normals
+  std::vector<std::vector<std::uint32_t>> around(nv);
+  for (std::size_t t = 0; t < nt; ++t) {
+    const glm::uvec3 tri = m.triangles[t];
+    face[t] = glm::cross(m.vertices[tri.y] - m.vertices[tri.x], m.vertices[tri.z] - m.vertices[tri.x]);
+    for (int k = 0; k < 3; ++k) around[tri[k]].push_back(static_cast<std::uint32_t>(t));
+  }
+  const float cos_crease = std::cos(glm::radians(kCreaseDeg));
+  ShadedMesh out;
+  out.triangles.resize(nt);
+  // Per original vertex, the split copies made so far: (new index); a corner reuses a copy whose normal
+  // matches its own.
+  std::vector<std::vector<std::uint32_t>> copies(nv);
+  for (std::size_t t = 0; t < nt; ++t) {
+    const float lt = glm::length(face[t]);
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t v = m.triangles[t][k];
+      glm::vec3 n(0.0f);
+      for (const std::uint32_t f : around[v]) {
+        const float lf = glm::length(face[f]);
+        if (lf > 0.0f && lt > 0.0f && glm::dot(face[f] / lf, face[t] / lt) >= cos_crease) n += face[f];
+      }
+      n = glm::length(n) > 0.0f ? glm::normalize(n) : glm::vec3(0.0f, 1.0f, 0.0f);
+      std::uint32_t id = UINT32_MAX;
+      for (const std::uint32_t c : copies[v])
+        if (glm::dot(out.normals[c], n) > 0.9999f) id = c;
+      if (id == UINT32_MAX) {
+        id = static_cast<std::uint32_t>(out.vertices.size());
+        out.vertices.push_back(m.vertices[v]);
+        out.normals.push_back(n);
+        copies[v].push_back(id);
+      }
+      out.triangles[t][k] = id;
+    }
+  }
+  return out;
+}
+
 }  // namespace growbench::geom

@@ -35,6 +35,19 @@ bool triangles_overlap(const glm::vec3 (&a)[3], const glm::vec3 (&b)[3]);
 // no face uses).
 std::vector<glm::vec3> vertex_normal_sums(const TriangleMesh& mesh);
 
+// A mesh ready for smooth shading that keeps its creases (a render's and scene.glb's scene meshes): each
+// triangle corner's normal is the area-weighted mean of the faces around its vertex that meet the corner's
+// own face at less than kCreaseDeg, and a vertex whose corners get different normals is split. The
+// triangles keep their order, so texture coordinates indexed by triangle still apply.
+// Tessellated curves (a column's sides, the bunny) turn by much less than kCreaseDeg from face to face; a
+// box's faces meet at 90 degrees and keep their edges.
+constexpr float kCreaseDeg = 40.0f;
+struct ShadedMesh {
+  std::vector<glm::vec3> vertices, normals;
+  std::vector<glm::uvec3> triangles;
+};
+ShadedMesh crease_shaded(const TriangleMesh& mesh);
+
 // Closed, outward-facing primitive meshes.
 TriangleMesh make_box(const std::string& name, const glm::vec3& min, const glm::vec3& max);
 TriangleMesh make_cylinder(const std::string& name, const glm::vec3& base, const glm::vec3& top, float radius_base,

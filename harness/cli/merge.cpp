@@ -23,9 +23,22 @@ struct MergeArgs {
   bool mixed = false;
 };
 
+// A shard's files are named relative to its results file; the merged file names them relative to itself.
+void rebase_scene_files(nlohmann::json& shard, const std::string& from, const std::string& to) {
+  if (!shard.contains("scenes") || !shard["scenes"].is_object()) return;
+  namespace fs = std::filesystem;
+  const fs::path src = fs::weakly_canonical(fs::absolute(from)).parent_path();
+  const fs::path dst = fs::weakly_canonical(fs::absolute(to)).parent_path();
+  for (auto& [hash, file] : shard["scenes"].items())
+    if (file.is_string()) file = (src / file.get<std::string>()).lexically_normal().lexically_relative(dst).string();
+}
+
 Outcome merge_shards(const MergeArgs& a) {
   std::vector<nlohmann::json> shards;
-  for (const auto& f : a.inputs) shards.push_back(read_json_file(f));
+  for (const auto& f : a.inputs) {
+    shards.push_back(read_json_file(f));
+    rebase_scene_files(shards.back(), f, a.out);
+  }
   const nlohmann::json merged = merge_results(shards, a.inputs, a.mixed);
   make_directories(std::filesystem::path(a.out).parent_path().string());
   write_file_atomic(a.out, json_text(merged, 1));

@@ -17,11 +17,13 @@
 #include <fmt/format.h>
 
 #include "core/params.hpp"
+#include "harness/output/exporters.hpp"
 #include "harness/record/files.hpp"
 #include "harness/cli/command.hpp"
 #include "harness/record/record.hpp"
 #include "harness/render/render_results.hpp"
 #include "harness/run/trial.hpp"
+#include "scenes/scene_library.hpp"
 
 namespace growbench::cli {
 
@@ -66,8 +68,8 @@ void print_record(const TrialRecord& rec, const TrialSpec& spec, const std::stri
   std::string own;  // the algorithm's own files (the vines' texture), as the record lists them
   for (const auto& [name, bytes] : r.output_bytes.algorithm_files) own += ", " + name;
   fmt::print(
-      "  wrote {}/plant.obj, plant.ply, plant.glb, plant.gbplant, skeleton.obj, skeleton.ply{}, record.json (geometry "
-      "hash {})\n",
+      "  wrote {}/plant.obj, plant.ply, plant.glb, plant.gbplant, skeleton.obj, skeleton.ply{}, record.json, scene.glb "
+      "(geometry hash {})\n",
       out_dir, own, r.geometry_hash);
   if (rec.frames)
     fmt::print("  kept {} frames in {}/frames (capture took {:.3f} s, not counted in growth)\n", rec.frames->count,
@@ -127,6 +129,8 @@ Outcome run_one(RunArgs& a) {
   };
   const FolderLock lock = FolderLock::take(a.out_dir, "run");
   const TrialRecord rec = run_trial_record(spec, progress);
+  // What the plant grew on, beside it, for viewers (not an output of the algorithm: not timed, not counted).
+  write_scene_glb((std::filesystem::path(a.out_dir) / "scene.glb").string(), load_scene(spec.scene, spec.scene_params));
   if (!a.quiet && isatty(STDERR_FILENO)) fmt::print(stderr, "\r{:60}\r", "");
   print_record(rec, spec, a.out_dir);
   return render ? render_run(a.out_dir, *render) : Outcome::ok;

@@ -24,10 +24,12 @@
 #include <tbb/task_arena.h>
 #include <meshoptimizer.h>
 #include <nlohmann/json.hpp>
+#include <glm/gtc/quaternion.hpp>
 #include <tiny_gltf.h>
 
 #include "core/errors.hpp"
 #include "harness/record/files.hpp"
+#include "scenes/geometry.hpp"
 
 namespace growbench {
 namespace {
@@ -492,6 +494,127 @@ std::string plain_glb_json(GltfBuilder& b) {
 std::uint64_t write_glb(const std::string& path, const OutputMesh& m) {
   GltfBuilder b;
   build_plain_glb(b, m);
+  const std::string json = plain_glb_json(b);
+  return write_glb_container(path, json, b.buffer.data);
+}
+
+namespace {
+
+// A rotation as glTF writes it (x, y, z, w).
+std::vector<double> gltf_rotation(const glm::quat& q) {
+  return {q.x, q.y, q.z, q.w};
+}
+
+// The rotation that turns a glTF light's or camera's forward axis (-Z) onto `forward`, with `up` up.
+glm::quat facing(const glm::vec3& forward) {
+  const glm::vec3 f = glm::normalize(forward);
+  const glm::vec3 up = std::abs(f.y) > 0.999f ? glm::vec3(0.0f, 0.0f, -1.0f) : glm::vec3(0.0f, 1.0f, 0.0f);
+  return glm::quatLookAtRH(f, up);
+}
+
+// The scene's materials, the colours its renders give them (sRGB there, linear here as glTF's are).
+int scene_material(tinygltf::Model& model, const char* name, glm::vec3 srgb) {
+  tinygltf::Material mat;
+  mat.name = name;
+  const auto linear = [](float c) { return c <= 0.04045f ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); };
+  mat.pbrMetallicRoughness.baseColorFactor = {linear(srgb.r), linear(srgb.g), linear(srgb.b), 1.0};
+  mat.pbrMetallicRoughness.metallicFactor = 0.0;
+  mat.pbrMetallicRoughness.roughnessFactor = 0.9;
+  model.materials.push_back(mat);
+  return static_cast<int>(model.materials.size() - 1);
+}
+
+// One node and mesh per scene mesh, shaded smooth within its creases as the renders shade it.
+void add_scene_meshes(GltfBuilder& b, const Scene& scene) {
+  const int ground = scene_material(b.model, "ground", {0.59f, 0.58f, 0.55f});
+  const int surface = scene_material(b.model, "surface", {0.80f, 0.78f, 0.74f});
+  for (const TriangleMesh& mesh : scene.meshes) {
+    if (mesh.triangles.empty()) continue;
+    const geom::ShadedMesh sm = geom::crease_shaded(mesh);
+    Aabb box;
+    for (const auto& v : sm.vertices) box.extend(v);
+    tinygltf::Primitive prim;
+    const std::size_t nv = sm.vertices.size();
+    prim.attributes["POSITION"] =
+        b.accessor(b.view(sm.vertices.data(), nv * sizeof(glm::vec3), TINYGLTF_TARGET_ARRAY_BUFFER),
+                   TINYGLTF_COMPONENT_TYPE_FLOAT, nv, TINYGLTF_TYPE_VEC3);
+    b.model.accessors.back().minValues = {box.min.x, box.min.y, box.min.z};
+    b.model.accessors.back().maxValues = {box.max.x, box.max.y, box.max.z};
+    prim.attributes["NORMAL"] =
+        b.accessor(b.view(sm.normals.data(), nv * sizeof(glm::vec3), TINYGLTF_TARGET_ARRAY_BUFFER),
+                   TINYGLTF_COMPONENT_TYPE_FLOAT, nv, TINYGLTF_TYPE_VEC3);
+    prim.indices = b.indices(sm.triangles.data(), sm.triangles.size() * 3);
+    prim.material = mesh.climbable ? surface : ground;
+    prim.mode = TINYGLTF_MODE_TRIANGLES;
+    tinygltf::Mesh gm;
+    gm.name = mesh.name;
+    gm.primitives.push_back(prim);
+    b.model.meshes.push_back(gm);
+    tinygltf::Node node;
+    node.name = mesh.name;
+    node.mesh = static_cast<int>(b.model.meshes.size() - 1);
+    node.extras = tinygltf::Value(tinygltf::Value::Object{{"climbable", tinygltf::Value(mesh.climbable)}});
+    b.model.nodes.push_back(node);
+  }
+}
+
+// The scene's light (KHR_lights_punctual): the sun a directional light shining along -direction, a point
+// light at its place; and its camera, looking from its position at its look-at point.
+void add_scene_light_and_camera(GltfBuilder& b, const Scene& scene) {
+  tinygltf::Light light;
+  tinygltf::Node light_node;
+  light.color = {1.0, 0.98, 0.94};
+  if (scene.light.kind == Light::Kind::Sun) {
+    light.name = light_node.name = "sun";
+    light.type = "directional";
+    light.intensity = 3.0;
+    light_node.rotation = gltf_rotation(facing(-scene.light.direction));
+  } else {
+    light.name = light_node.name = "light";
+    light.type = "point";
+    // Candela giving about the sun's illuminance at the scene's middle.
+    light.intensity = 3.0 * std::max(1e-6, double(glm::dot(scene.light.position - scene.bounds().center(),
+                                                           scene.light.position - scene.bounds().center())));
+    light_node.translation = {scene.light.position.x, scene.light.position.y, scene.light.position.z};
+  }
+  b.model.lights.push_back(light);
+  light_node.extensions["KHR_lights_punctual"] =
+      tinygltf::Value(tinygltf::Value::Object{{"light", tinygltf::Value(0)}});
+  b.model.nodes.push_back(light_node);
+
+  const Camera& c = scene.camera;
+  tinygltf::Camera cam;
+  cam.name = "camera";
+  cam.type = "perspective";
+  cam.perspective.yfov = glm::radians(double(c.fov_deg));  // growbench's fov is vertical (harness/render/camera.hpp)
+  const double size = std::max(
+      1.0, double(glm::length(scene.bounds().max - scene.bounds().min)) + double(glm::length(c.position - c.look_at)));
+  cam.perspective.znear = 1e-3 * size;
+  cam.perspective.zfar = 100.0 * size;
+  b.model.cameras.push_back(cam);
+  tinygltf::Node cam_node;
+  cam_node.name = "camera";
+  cam_node.camera = 0;
+  cam_node.translation = {c.position.x, c.position.y, c.position.z};
+  if (glm::length(c.look_at - c.position) > 0.0f) cam_node.rotation = gltf_rotation(facing(c.look_at - c.position));
+  b.model.nodes.push_back(cam_node);
+}
+
+}  // namespace
+
+std::uint64_t write_scene_glb(const std::string& path, const Scene& scene) {
+  GltfBuilder b;
+  b.model.asset.version = "2.0";
+  b.model.asset.generator = "growbench";
+  b.model.asset.extras = tinygltf::Value(tinygltf::Value::Object{
+      {"scene", tinygltf::Value(scene.name)}, {"content_hash", tinygltf::Value(scene.content_hash())}});
+  add_scene_meshes(b, scene);
+  add_scene_light_and_camera(b, scene);
+  tinygltf::Scene root;
+  root.name = scene.name;
+  for (std::size_t i = 0; i < b.model.nodes.size(); ++i) root.nodes.push_back(static_cast<int>(i));
+  b.model.scenes.push_back(root);
+  b.model.defaultScene = 0;
   const std::string json = plain_glb_json(b);
   return write_glb_container(path, json, b.buffer.data);
 }

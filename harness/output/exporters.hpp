@@ -24,6 +24,7 @@
 #include "algorithms/plant.hpp"
 #include "harness/output/mesher.hpp"
 #include "harness/record/trial_spec.hpp"
+#include "scenes/scene.hpp"
 
 namespace growbench {
 
@@ -85,4 +86,10 @@ std::uint64_t plain_glb_bytes(const OutputMesh& mesh);
 // with the rest.
 std::uint64_t write_glb(const std::string& path, const OutputMesh& mesh, GlbLayout layout, const Plant& plant,
                         const OrganShapes& shapes);
+// What a plant grew on, for viewers (the report's 3D view): each scene mesh a node and mesh named as it
+// (extras.climbable; materials "ground" and "surface"), smooth-shaded within its creases as renders shade
+// it, in the plain layout; the scene's light (KHR_lights_punctual: "sun", directional, or "light", a
+// point); its camera ("camera", perspective, the vertical fov); asset.extras the scene's name and
+// content_hash.
+std::uint64_t write_scene_glb(const std::string& path, const Scene& scene);
 }  // namespace growbench

@@ -695,6 +695,7 @@ struct ResultsFile {
   std::optional<std::vector<ShardRecord>> shards;  // merged files
   std::optional<RenderSummary> renders;
   std::optional<ResultsSummary> summary;
+  std::optional<std::map<std::string, std::string>> scenes;  // scene content hash -> its scene.glb
 
   static constexpr std::string_view kSchemaName = "results";
   static constexpr auto fields() {
@@ -710,7 +711,11 @@ struct ResultsFile {
                       field("trials", &R::trials).with(kRequiredField),
                       field("shards", &R::shards),
                       field("renders", &R::renders),
-                      field("summary", &R::summary)};
+                      field("summary", &R::summary),
+                      field("scenes", &R::scenes)
+                          .describe("Each scene the trials grew on (by its content hash, the trials' scene_hash): its "
+                                    "meshes, light and camera as a .glb, relative to this file (the report's 3D "
+                                    "views show each plant on it).")};
   }
 };
 

@@ -87,60 +87,6 @@ void vec(Out out, const glm::vec3& v) {
 // Radii below this are drawn at it: a zero radius is a degenerate POV-Ray primitive.
 constexpr float kMinRadius = 1e-4f;
 
-// Scene meshes are drawn with smooth shading except across creases: two faces at a vertex share a normal
-// when they meet at less than this angle. Tessellated curves (a column's sides, the bunny) turn by much less
-// from face to face; a box's faces meet at 90 degrees and keep their edges.
-constexpr float kCreaseDeg = 40.0f;
-
-// A mesh ready for smooth shading with creases kept: each triangle corner's normal is the area-weighted
-// mean of the faces around its vertex within kCreaseDeg of the corner's own face, and a vertex whose
-// corners get different normals is split (the triangles keep their order, so texture coordinates indexed by
-// triangle still apply).
-struct ShadedMesh {
-  std::vector<glm::vec3> vertices, normals;
-  std::vector<glm::uvec3> triangles;
-};
-
-ShadedMesh crease_shaded(const TriangleMesh& m) {
-  const std::size_t nv = m.vertices.size(), nt = m.triangles.size();
-  std::vector<glm::vec3> face(nt);  // area-weighted normals
-  std::vector<std::vector<std::uint32_t>> around(nv);
-  for (std::size_t t = 0; t < nt; ++t) {
-    const glm::uvec3 tri = m.triangles[t];
-    face[t] = glm::cross(m.vertices[tri.y] - m.vertices[tri.x], m.vertices[tri.z] - m.vertices[tri.x]);
-    for (int k = 0; k < 3; ++k) around[tri[k]].push_back(static_cast<std::uint32_t>(t));
-  }
-  const float cos_crease = std::cos(glm::radians(kCreaseDeg));
-  ShadedMesh out;
-  out.triangles.resize(nt);
-  // Per original vertex, the split copies made so far: (new index); a corner reuses a copy whose normal
-  // matches its own.
-  std::vector<std::vector<std::uint32_t>> copies(nv);
-  for (std::size_t t = 0; t < nt; ++t) {
-    const float lt = glm::length(face[t]);
-    for (int k = 0; k < 3; ++k) {
-      const std::uint32_t v = m.triangles[t][k];
-      glm::vec3 n(0.0f);
-      for (const std::uint32_t f : around[v]) {
-        const float lf = glm::length(face[f]);
-        if (lf > 0.0f && lt > 0.0f && glm::dot(face[f] / lf, face[t] / lt) >= cos_crease) n += face[f];
-      }
-      n = glm::length(n) > 0.0f ? glm::normalize(n) : glm::vec3(0.0f, 1.0f, 0.0f);
-      std::uint32_t id = UINT32_MAX;
-      for (const std::uint32_t c : copies[v])
-        if (glm::dot(out.normals[c], n) > 0.9999f) id = c;
-      if (id == UINT32_MAX) {
-        id = static_cast<std::uint32_t>(out.vertices.size());
-        out.vertices.push_back(m.vertices[v]);
-        out.normals.push_back(n);
-        copies[v].push_back(id);
-      }
-      out.triangles[t][k] = id;
-    }
-  }
-  return out;
-}
-
 // Texture coordinates for write_mesh2: corner k of triangle t has uvs[triangles[t][k]] (TriangleMesh's).
 struct MeshUvs {
   const std::vector<glm::vec2>& uvs;
@@ -449,7 +395,7 @@ void write_scene_meshes(Out out, const Scene& scene, const std::vector<SurfaceDe
                      uv_decals.size() + planar.size() == 1 ? "" : "s");
     fmt::format_to(out, "\n");
     const MeshUvs uv{m.uvs, m.uv_triangles};
-    const ShadedMesh shaded = crease_shaded(m);
+    const geom::ShadedMesh shaded = geom::crease_shaded(m);
     write_mesh2(out, shaded.vertices, shaded.normals, shaded.triangles, 0,
                 static_cast<std::uint32_t>(shaded.triangles.size()), uv_decals.empty() ? nullptr : &uv);
     // Layered textures: the first is the bottom layer, each later one lies on top of those before it.

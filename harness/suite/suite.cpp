@@ -697,7 +697,13 @@ ResultsFile merge_results(const std::vector<ResultsFile>& shards, const std::vec
     merged.trials.push_back(cell);
   }
   if (!differ.empty()) merged.context.mixed_machines = true;
-  merged.renders.reset();    // per-shard render summaries do not describe the merged grid
+  merged.renders.reset();  // per-shard render summaries do not describe the merged grid
+  merged.scenes.reset();   // every shard's scene files (one hash, one scene, whichever shard wrote it)
+  for (const ResultsFile& s : shards) {
+    if (!s.scenes) continue;
+    if (!merged.scenes) merged.scenes.emplace();
+    for (const auto& [hash, file] : *s.scenes) merged.scenes->try_emplace(hash, file);
+  }
   update_summaries(merged);  // the seeds of one entry and scene may have run in different shards
   return merged;
 }
@@ -825,6 +831,7 @@ class SuiteRun {
     open_results();
     add_cells();
     check_inputs();
+    write_scene_files();
     if (o_.resume && fs::exists(journal_path_)) {
       if (const std::string torn = repair_journal(journal_path_.string()); !torn.empty())
         fmt::print(stderr,
@@ -864,6 +871,24 @@ class SuiteRun {
   }
 
  private:
+  // Each distinct scene's meshes, light and camera once, as OUT/scenes/NAME-HASH.glb, for the report's 3D
+  // views; results.json's "scenes" maps each content hash (the trials' scene_hash) to its file.
+  void write_scene_files() {
+    std::map<std::string, std::string> files;
+    std::set<std::pair<std::string, std::vector<std::string>>> seen;
+    for (const auto& c : suite_.configs) {
+      if (!seen.insert({c.spec.scene, c.spec.scene_params}).second) continue;
+      const Scene scene = load_scene(c.spec.scene, c.spec.scene_params);
+      const std::string hash = scene.content_hash();
+      if (files.count(hash)) continue;
+      const std::string name = fmt::format("scenes/{}-{}.glb", safe_name(scene.name), hash);
+      make_directories((out_ / "scenes").string());
+      write_scene_glb((out_ / name).string(), scene);
+      files[hash] = name;
+    }
+    results_.scenes = std::move(files);
+  }
+
   struct Job {
     const SuiteConfig* cell;
     int repetition;  // -1: warm-up

@@ -19,6 +19,7 @@
 #include "core/json_util.hpp"
 #include "harness/output/exporters.hpp"
 #include "harness/record/record.hpp"
+#include "scenes/scene_library.hpp"
 #include "test_util.hpp"
 
 namespace growbench {
@@ -390,6 +391,59 @@ TEST(Glb, RunWritesTheChosenLayout) {
   const auto r = test::run_growbench(plant + "--glb draco -o " + (dir / "bad").string());
   EXPECT_EQ(r.status, 2) << r.out;
   EXPECT_NE(r.out.find("--glb: draco not in {plain,instanced,compact}"), std::string::npos) << r.out;
+}
+
+// scene.glb: every scene mesh a node of its name with its vertices where the scene has them, the sun shining
+// along -direction, the camera at its position looking at its look-at point, with the vertical fov.
+TEST(Glb, SceneFileHoldsTheMeshesTheSunAndTheCamera) {
+  const auto dir = test::temp_dir("glb_scene");
+  Scene scene = load_scene("wall");
+  scene.light.direction = {1.0f, 2.0f, -0.5f};
+  scene.camera = {{0.5f, 1.2f, 4.0f}, {0.1f, 0.9f, 0.0f}, 38.0f};
+  const auto bytes = write_scene_glb((dir / "scene.glb").string(), scene);
+  EXPECT_EQ(bytes, std::filesystem::file_size(dir / "scene.glb"));
+  const Glb g = read_glb(dir / "scene.glb");
+  EXPECT_EQ(g.doc["asset"]["extras"]["content_hash"], scene.content_hash());
+  EXPECT_EQ(g.doc["asset"]["extras"]["scene"], scene.name);
+  const auto quat = [](const Json& r) {
+    return glm::quat(r[3].get<float>(), r[0].get<float>(), r[1].get<float>(), r[2].get<float>());
+  };
+  std::size_t meshes = 0;
+  for (const Json& node : g.doc["nodes"]) {
+    if (node.contains("mesh")) {
+      const TriangleMesh& m = scene.meshes.at(meshes++);
+      EXPECT_EQ(node["name"], m.name);
+      EXPECT_EQ(node["extras"]["climbable"], m.climbable);
+      const Json& prim = g.doc["meshes"][node["mesh"].get<std::size_t>()]["primitives"][0];
+      const std::string material = g.doc["materials"][prim["material"].get<std::size_t>()]["name"];
+      EXPECT_EQ(material, m.climbable ? "surface" : "ground");
+      const std::vector<float> pos = accessor_values(g, prim["attributes"]["POSITION"]);
+      const std::vector<float> idx = accessor_values(g, prim["indices"]);
+      ASSERT_EQ(idx.size(), 3 * m.triangles.size());
+      for (std::size_t t = 0; t < m.triangles.size(); ++t)
+        for (int k = 0; k < 3; ++k)
+          EXPECT_EQ(vec3_at(pos, static_cast<std::size_t>(idx[3 * t + static_cast<std::size_t>(k)])),
+                    m.vertices[m.triangles[t][k]]);
+    } else if (node.contains("camera")) {
+      EXPECT_EQ(node["name"], "camera");
+      EXPECT_EQ(glm::vec3(node["translation"][0].get<float>(), node["translation"][1].get<float>(),
+                          node["translation"][2].get<float>()),
+                scene.camera.position);
+      const glm::vec3 forward = quat(node["rotation"]) * glm::vec3(0.0f, 0.0f, -1.0f);
+      EXPECT_LT(glm::length(forward - glm::normalize(scene.camera.look_at - scene.camera.position)), 1e-5f);
+      const Json& cam = g.doc["cameras"][node["camera"].get<std::size_t>()];
+      EXPECT_NEAR(cam["perspective"]["yfov"].get<double>(), 38.0 * M_PI / 180.0, 1e-6);
+    } else {
+      EXPECT_EQ(node["name"], "sun");
+      const Json& light = g.doc["extensions"]["KHR_lights_punctual"]["lights"]
+                               [node["extensions"]["KHR_lights_punctual"]["light"].get<std::size_t>()];
+      EXPECT_EQ(light["type"], "directional");
+      const glm::vec3 shines = quat(node["rotation"]) * glm::vec3(0.0f, 0.0f, -1.0f);
+      EXPECT_LT(glm::length(shines + glm::normalize(scene.light.direction)), 1e-5f);
+    }
+  }
+  EXPECT_EQ(meshes, scene.meshes.size());
+  EXPECT_EQ(g.doc["nodes"].size(), scene.meshes.size() + 2);
 }
 
 TEST(Glb, LayoutNames) {

@@ -554,6 +554,19 @@ TEST(Suite, ShardsMergeIntoTheUnshardedRun) {
       EXPECT_EQ(x[f], y[f]) << k << " " << f;
   }
   EXPECT_EQ(b["shards"].size(), 3u);
+  // Each scene's file once per run, under its content hash (the trials' scene_hash); the merged file names
+  // the shards' files relative to itself.
+  ASSERT_EQ(a["scenes"].size(), 2u);
+  for (const auto& t : a["trials"]) EXPECT_TRUE(a["scenes"].contains(t["scene_hash"].get<std::string>())) << t["id"];
+  for (const auto& [hash, file] : a["scenes"].items())
+    EXPECT_TRUE(std::filesystem::is_regular_file(dir / "full" / file.get<std::string>())) << file;
+  ASSERT_EQ(b["scenes"].size(), 2u);
+  for (const auto& [hash, file] : b["scenes"].items()) {
+    const std::string f = file.get<std::string>();
+    EXPECT_EQ(f.rfind("sh_", 0), 0u) << f;
+    EXPECT_TRUE(std::filesystem::is_regular_file(dir / f)) << f;
+    EXPECT_TRUE(a["scenes"].contains(hash)) << hash;
+  }
   const auto cmp =
       growbench("compare " + (dir / "full" / "results.json").string() + " " + (dir / "merged.json").string());
   EXPECT_EQ(cmp.status, 0) << cmp.out;
