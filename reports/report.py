@@ -7,7 +7,9 @@ algorithms' code. Run with Debian's /usr/bin/python3, which sees python3-matplot
     /usr/bin/python3 reports/report.py out/demo/results.json --out out/demo/report
 
 Writes into OUT: fig-*.png and fig-*.pdf, table.tex (booktabs), table.md, renders/ (copies of the
-comparison grids), and index.html, which needs nothing from the network.
+comparison grids), trials/ (a page per trial: its render, a 3D view of its plant on its scene with growth
+playback (reports/viewer.py), its numbers and files), and index.html. Nothing needs the network: the pages
+work opened from file://.
 
 The file is checked against harness/record/results.schema.json first (python3-jsonschema), the
 schema whose version the C++ writes: a renamed or mistyped field is an error naming the file and the
@@ -43,7 +45,9 @@ import re
 import shutil
 import sys
 
+import explore
 import paper_tables
+import viewer
 
 # The t quantiles t_{0.975, df} for df = 1..30 (beyond: 1.96).
 T975 = [12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160, 2.145, 2.131,
@@ -63,6 +67,8 @@ QUALITY = [("coverage", "surface coverage", "fraction"),
 METRICS_DOC = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "docs", "metrics.md")
 # The results file's schema, declared beside the C++ record that writes it.
 SCHEMA_NAME = "harness/record/results.schema.json"
+# A trial page loads a plant.glb up to this size (MB) at once, a larger one when asked.
+VIEWER_AUTOLOAD_MB = 40
 SCHEMA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", *SCHEMA_NAME.split("/"))
 
 
@@ -1072,9 +1078,10 @@ def trial_dir_of(c, base):
     return d if os.path.isdir(d) else None
 
 
-def write_trial_pages(cells, base, out):
-    """One page per trial under OUT/trials/: its render, verdict, numbers and files (links into the results
-    directory). Returns {trial id: the page's path relative to OUT}."""
+def write_trial_pages(cells, base, out, views=None):
+    """One page per trial under OUT/trials/: its render, its 3D view (VIEWS: the viewer's HTML per trial id, from
+    viewer.write_assets), verdict, numbers and files (links into the results directory). Returns {trial id: the
+    page's path relative to OUT}."""
     e = html.escape
     pages = {}
     os.makedirs(os.path.join(out, "trials"), exist_ok=True)
@@ -1098,11 +1105,18 @@ def write_trial_pages(cells, base, out):
             parts.append(f"<figure><img src='{e(rel(png))}' alt='render of {e(c.id())}'><figcaption>POV-Ray "
                          f"{e(str(render.get('quality', '')))}, camera {e(str(render.get('camera', '?')))}"
                          f"{'; ' + e(shares) if shares else ''}.</figcaption></figure>")
+        if views and c.id() in views:
+            parts.append(views[c.id()])
         rows = [("growth time", growth_time_text(c.growth_summary, c.growth)), ("nodes", f"{c.nodes}")]
         rows += [(k, "n/a" if v is None else f"{v:.4g}" if isinstance(v, float) else str(v))
                  for k, v in sorted(c.metrics.items()) if not isinstance(v, (list, dict))]
         parts.append("<table class='context'>" + "".join(f"<tr><th>{e(k)}</th><td>{e(v)}</td></tr>" for k, v in rows) +
                      "</table>")
+        curve = explore.growth_curve_svg(c.t.get("curve"))
+        if curve:
+            parts.append(f"<h2>Growth</h2><figure>{curve}<figcaption>Nodes over the growth steps (the record's growth "
+                         "curve): what the 3D view's playback shows, step by step."
+                         "</figcaption></figure>")
         if d and os.path.isdir(d):
             files = sorted(f for f in os.listdir(d) if os.path.isfile(os.path.join(d, f)))
             parts.append("<h2>Files</h2><ul>" + "".join(
@@ -1135,6 +1149,8 @@ img { max-width: 100%; border: 1px solid #ddd; }
 .wide { overflow-x: auto; } table.results { font-size: 0.8em; } table.results td { white-space: nowrap; }
 .grid-image { position: relative; display: inline-block; max-width: 100%; } .grid-image img { display: block; }
 .grid-image a.cell { position: absolute; } .grid-image a.cell:hover { outline: 3px solid #2a6fdb; }
+#gb-trials tr.left-out-row td { color: #777; } #gb-plot a.gb-point circle:hover { stroke: #000; stroke-width: 2; }
+#gb-trials th { white-space: nowrap; user-select: none; }
 """
 
 # Marks any image that did not load, and records the count on <body> (a headless browser test reads it).
@@ -1187,7 +1203,8 @@ def machine_state_rows(ctx):
     return rows
 
 
-def write_html(path, doc, results_path, rows, figs, grids, failed, caption, metrics_doc=None, peers=(), cells=()):
+def write_html(path, doc, results_path, rows, figs, grids, failed, caption, metrics_doc=None, peers=(), cells=(),
+               explore_section=""):
     e = html.escape
     how = (f" <a href='{e(metrics_doc)}'>How each quality metric is defined, and its error bound</a>."
            if metrics_doc else "")
@@ -1248,6 +1265,7 @@ def write_html(path, doc, results_path, rows, figs, grids, failed, caption, metr
     parts.append("</table></div>")
     parts.append(f"<p class='note'>{e(caption)} Also as <a href='table.tex'>LaTeX (booktabs)</a> and "
                  f"<a href='table.md'>Markdown</a>.{how}</p>")
+    parts.append(explore_section)
 
     # Every plant judged other than valid, with its reasons: kept and shown, never silently dropped.
     parts.append("<h2 id='left-out'>Plants left out of comparisons</h2>")
@@ -1395,8 +1413,9 @@ def write_peers_only(path, out, formats):
 
 # ---------------------------------------------------------------- main
 
-def write_report(doc, results_path, out, formats, peers_path=None, pareto_metric=None):
-    """Figures, tables and index.html in `out` from a results document already read and checked (load_results)."""
+def write_report(doc, results_path, out, formats, peers_path=None, pareto_metric=None, viewer_mb=VIEWER_AUTOLOAD_MB):
+    """Figures, tables and index.html in `out` from a results document already read and checked (load_results).
+    VIEWER_MB: the size in MB above which a trial page's 3D view waits for a click; None: no 3D views."""
     cells = [Cell(t) for t in doc["trials"]]
     if not cells:
         raise ReportError(f"{results_path}: no trials to report")
@@ -1423,13 +1442,16 @@ def write_report(doc, results_path, out, formats, peers_path=None, pareto_metric
     write_markdown(os.path.join(out, "table.md"), rows, CAPTION, notes)
 
     base = os.path.dirname(os.path.abspath(results_path))
-    pages = write_trial_pages(cells, base, out)
+    views = None
+    if viewer_mb is not None:
+        views = viewer.write_assets(doc, cells, base, out, own_path, slug, trial_dir_of, viewer_mb)
+    pages = write_trial_pages(cells, base, out, views)
     grids = copy_grids(doc, base, out, pages)
     failed = [c for c in cells if not c.ok]
     peers_path = peers_path or os.path.join(base, "peers.json")
     peers = peers_html(load_peers(peers_path), peers_path, out, formats) if os.path.exists(peers_path) else []
     write_html(os.path.join(out, "index.html"), doc, results_path, rows, figs, grids, failed, CAPTION,
-               write_metrics_doc(out), peers, cells)
+               write_metrics_doc(out), peers, cells, explore.explore_html(cells, pages, QUALITY))
     print(f"report: wrote {len(figs)} figures ({', '.join(formats)}), table.tex, table.md and index.html "
           f"in {out}", file=sys.stderr)
     return figs
@@ -1444,6 +1466,11 @@ def main(argv=None):
                                     "results); default: a peers.json beside the results file, if there is one")
     ap.add_argument("--pareto-metric", help=f"the quality metric of the quality-against-cost (Pareto) figures, one "
                                              f"per scene of a suite with sweeps (default {PARETO_METRIC})")
+    ap.add_argument("--viewer-autoload-mb", type=float, default=VIEWER_AUTOLOAD_MB,
+                    help=f"a trial page loads its 3D view at once when plant.glb is at most this many MB, else on a "
+                         f"click (default {VIEWER_AUTOLOAD_MB:g})")
+    ap.add_argument("--no-viewer", action="store_true",
+                    help="no 3D views: each one copies its plant.glb into the report, as base64 (4/3 of its size)")
     args = ap.parse_args(argv)
     if args.results is None and args.peers is None:
         ap.error("give a results file, --peers, or both")
@@ -1454,7 +1481,7 @@ def main(argv=None):
             return 0
         doc = load_results(args.results)
         write_report(doc, args.results, args.out, [f for f in args.formats.split(",") if f], args.peers,
-                     args.pareto_metric)
+                     args.pareto_metric, None if args.no_viewer else args.viewer_autoload_mb)
     except ReportError as e:
         print(f"report: error: {e}", file=sys.stderr)
         return 2

@@ -1,10 +1,12 @@
 // growbench report: figures, tables and index.html from a results file alone.
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <fmt/format.h>
 
 #include "harness/record/files.hpp"
 #include "harness/cli/command.hpp"
@@ -17,6 +19,8 @@ namespace {
 
 struct ReportArgs {
   std::string results, out, pareto_metric;
+  std::optional<double> viewer_autoload_mb;
+  bool no_viewer = false;
 };
 
 Outcome report(ReportArgs& a) {
@@ -27,6 +31,9 @@ Outcome report(ReportArgs& a) {
   const FolderLock lock = FolderLock::take(a.out, "report");
   std::vector<std::string> extra;
   if (!a.pareto_metric.empty()) extra = {"--pareto-metric", a.pareto_metric};
+  if (a.viewer_autoload_mb)
+    extra.insert(extra.end(), {"--viewer-autoload-mb", fmt::format("{}", *a.viewer_autoload_mb)});
+  if (a.no_viewer) extra.push_back("--no-viewer");
   return script_status(run_report(a.results, a.out, extra), "reports/report.py");
 }
 
@@ -42,6 +49,12 @@ Command add_report(CLI::App& app) {
   cmd->add_option("--pareto-metric", a->pareto_metric,
                   "the quality metric of the quality-against-cost figures (one per scene of a suite with sweeps; "
                   "default coverage): any metric of the results file, e.g. attached_fraction, leaf_light_exposure");
+  cmd->add_option("--viewer-autoload-mb", a->viewer_autoload_mb,
+                  "a trial page shows its 3D view at once when plant.glb is at most this many MB, else on a click "
+                  "(default: reports/report.py's)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_flag("--no-viewer", a->no_viewer,
+                "trial pages without a 3D view (each view puts its plant.glb into the report, as base64)");
   return {cmd, [a] { return report(*a); }};
 }
 

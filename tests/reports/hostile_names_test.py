@@ -75,10 +75,12 @@ class Page(html.parser.HTMLParser):
 
     def __init__(self):
         super().__init__(convert_charrefs=True)
-        self.problems, self.text, self.in_script = [], [], False
+        self.problems, self.text, self.in_script, self.in_data = [], [], False, False
 
     def handle_starttag(self, tag, attrs):
         self.in_script = tag == "script"
+        # A data block (the report's trial table, the history's series) is never run: it must hold JSON.
+        self.in_data = tag == "script" and ("type", "application/json") in attrs
         if tag == "pwn-tag":
             self.problems.append(f"a <{tag}> element")
         for k, v in attrs:
@@ -89,6 +91,12 @@ class Page(html.parser.HTMLParser):
         self.in_script = False
 
     def handle_data(self, data):
+        if self.in_script and self.in_data:
+            try:
+                json.loads(data)
+            except ValueError as e:
+                self.problems.append(f"a JSON data block that does not parse ({e}): {data[:80]!r}")
+            return
         if self.in_script and "pwn" in data:
             self.problems.append(f"script text {data[:80]!r}")
         self.text.append(data)
