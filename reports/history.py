@@ -21,6 +21,9 @@ import os
 import re
 import statistics
 import sys
+import time
+
+import history_view
 
 METRICS = [
     ("growth_wall_s", "growth wall time"),
@@ -93,6 +96,9 @@ def fail(message):
     sys.exit(2)
 
 
+FILE_KEY = " file"  # where load() found a document (no history file has a key that starts with a space)
+
+
 def load(dir_):
     groups = {}
     for path in sorted(glob.glob(os.path.join(dir_, "*", "*", "*.json"), include_hidden=True)):
@@ -105,6 +111,7 @@ def load(dir_):
             fail(f"{path}: not a history file (kind {doc.get('kind') if isinstance(doc, dict) else None!r})")
         if not isinstance(doc.get("runs"), list):
             fail(f"{path}: at runs: expected an array of runs")
+        doc[FILE_KEY] = path
         groups.setdefault((doc.get("machine", ""), doc.get("suite", "")), []).append(doc)
     for docs in groups.values():
         docs.sort(key=lambda d: (d.get("commit_time") or 0, d["runs"][0].get("date", "") if d["runs"] else ""))
@@ -141,6 +148,24 @@ def behaviour_changes(docs):
                 if h:
                     last[cell] = h
     return changes
+
+
+def commit_dates(docs):
+    """Each commit's date: its commit time (UTC) when the history file has one, else its first run's date."""
+    out = []
+    for d in docs:
+        t = d.get("commit_time")
+        if isinstance(t, (int, float)) and not isinstance(t, bool) and 0 <= t < 2 ** 40:
+            out.append(time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime(t)))
+        else:
+            out.append(str(d["runs"][0].get("date", "")) if d["runs"] and isinstance(d["runs"][0], dict) else "")
+    return out
+
+
+def metric_words(metrics):
+    words = dict(METRICS)
+    return {m: words.get(m, f"instructions, {m.split('.', 1)[1]} phase" if m.startswith("instructions.") else m)
+            for m in metrics}
 
 
 def main():
@@ -214,16 +239,23 @@ def main():
         if group["behaviour_changes"]:
             body.append("<p>Behaviour changed (geometry hash): " + ", ".join(
                 f"{html.escape(b['cell'])} at {html.escape(b['commit'])}" for b in group["behaviour_changes"]) + "</p>")
+        files = [os.path.relpath(d[FILE_KEY], a.out) for d in docs]
+        body.append(history_view.group_html(sub, commits, commit_dates(docs), files, data, group["change_points"],
+                                            metric_words(metrics)))
+        body.append("<details><summary>The same as static figures (PNG, with PDFs beside them)</summary>")
         for m, png in figures:
             body.append(f"<figure><img src='{html.escape(png)}' alt='{html.escape(m)}'><figcaption>{html.escape(m)}</figcaption></figure>")
+        body.append("</details>")
     with open(os.path.join(a.out, "change_points.json"), "w") as f:
         json.dump(report, f, indent=1)
     with open(os.path.join(a.out, "index.html"), "w") as f:
         f.write("<!doctype html><meta charset='utf-8'><title>growbench history</title>"
                 "<style>body{font-family:sans-serif;max-width:70em;margin:auto}table{border-collapse:collapse}"
-                "td,th{border:1px solid #ccc;padding:2px 6px}img{max-width:100%}</style>"
+                "td,th{border:1px solid #ccc;padding:2px 6px}img{max-width:100%}.note{color:#555}"
+                f"{history_view.STYLE}</style>"
                 f"<h1>growbench history</h1><p>Change points: a step of at least {100 * a.min_step:g}% that the noise "
-                "does not explain (binary segmentation, see reports/history.py).</p>" + "".join(body))
+                "does not explain (binary segmentation, see reports/history.py).</p>" + "".join(body) +
+                f"<script>{history_view.SCRIPT}</script>")
     n = sum(len(g["change_points"]) for g in report["groups"])
     print(f"history: {len(groups)} machine/suite groups, {n} change points; wrote {a.out}/index.html")
 

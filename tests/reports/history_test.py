@@ -74,6 +74,11 @@ if len(sys.argv) == 3:
     check(not any(c[0] == "b/wall/s1" for c in found), f"nothing changed in cell b: {found}")
     check(os.path.exists(os.path.join(work, "plot", "test_cpu_r_-2t", "t", "growth_wall_s.png")), "the figure")
     check(os.path.exists(os.path.join(work, "plot", "index.html")), "index.html")
+    # The page's interactive plot, driven in headless chromium (tools/viewer/test-history.mjs).
+    viewer = os.path.join(os.path.dirname(__file__), "..", "..", "tools", "viewer")
+    out = subprocess.run(["node", os.path.join(viewer, "test-history.mjs"), os.path.join(work, "plot", "index.html"),
+                          "a/wall/s1", "c3", "1.2"], capture_output=True, text=True)
+    check(out.returncode == 0, f"the interactive history plot: {out.stdout}{out.stderr}")
 
     # Hostile history files (written by hand, not by history add): a machine and suite that would lead out
     # of --out, commits and a cell carrying HTML and TeX. Nothing is written outside --out, nothing is
@@ -93,7 +98,7 @@ if len(sys.argv) == 3:
     check(os.listdir(os.path.join(work, "hostile_out")) == ["plot"], "nothing beside --out")
     check(not os.path.exists(escape_to), "nothing at the absolute suite name")
     page = open(os.path.join(plot, "index.html"), encoding="utf-8").read()
-    check("<script>" not in page and "<img src=x" not in page and "<b>" not in page,
+    check("<script>alert" not in page and "<img src=x" not in page and "<b>" not in page,
           "no element injected into index.html")
     check("at &lt;img src=x onerror=alert(2)&gt;" in page, "the commit is shown, escaped")
     written = [os.path.relpath(os.path.join(d, f), plot) for d, _, fs in os.walk(plot) for f in fs]
