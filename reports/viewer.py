@@ -4,13 +4,14 @@ A page opened from file:// can load neither an ES module nor a file through fetc
 the page's "null" origin), so everything arrives as classic scripts:
     REPORT/viewer/growbench-viewer.js   three.js and the viewer in one script (tools/viewer, built by
                                         scripts/install-deps), once per report, with its THIRD-PARTY.txt
-    REPORT/scenes/NAME-HASH.glb.js      each scene's scene.glb once, as base64 (the results' "scenes" map)
-    REPORT/trials/SLUG/plant.glb.js     the trial's plant.glb, as base64
+    REPORT/scenes/NAME-HASH.glb.js      each scene's scene.glb once, gzipped, as base64 (the results' "scenes" map)
+    REPORT/trials/SLUG/plant.glb.js     the trial's plant.glb, gzipped, as base64
 The viewer (tools/viewer/src/viewer.js) turns each <div class='gb-viewer'> into a canvas; growth playback reads
 the _BIRTH_STEP each vertex and organ instance of plant.glb carries.
 """
 
 import base64
+import gzip
 import html
 import json
 import os
@@ -23,9 +24,11 @@ NOTICE = "THIRD-PARTY.txt"
 
 
 def write_data_script(src, dst, key):
-    """SRC's bytes as base64 in a classic script that files them under KEY in self.GB_DATA; its size."""
+    """SRC's bytes, gzipped, as base64 in a classic script that files them under KEY in self.GB_DATA; its size.
+    A meshopt-compressed GLB still shrinks by about 40% under gzip, which browsers undo natively
+    (DecompressionStream): the base64 costs 4/3, the gzip gives more than that back."""
     with open(src, "rb") as f:
-        data = base64.b64encode(f.read())
+        data = base64.b64encode(gzip.compress(f.read(), compresslevel=6, mtime=0))
     os.makedirs(os.path.dirname(dst), exist_ok=True)
     with open(dst, "wb") as f:
         # json.dumps makes any key a valid JavaScript string literal.

@@ -43,7 +43,13 @@ try {
       r.abort();
     });
     const t0 = performance.now();
-    await page.goto(fileUrl(file), { waitUntil: 'load' });
+    try {
+      await page.goto(fileUrl(file), { waitUntil: 'load' });
+    } catch (e) {
+      fail(name, `cannot open the page: ${e.message}`);
+      await page.close();
+      continue;
+    }
     await page.waitForFunction(() => ['loaded', 'error'].includes(document.body.dataset.viewer), { timeout: 180000 });
     const loadedMs = performance.now() - t0;
     const state = await page.evaluate(() => document.body.dataset.viewer);

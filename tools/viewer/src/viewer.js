@@ -4,8 +4,8 @@
 // Bundled by build.mjs (esbuild) into ONE classic script, dist/growbench-viewer.js, because Chromium refuses
 // ES module imports over file:// (a module script is fetched in CORS mode, and a file:// page's origin is
 // "null"). For the same reason the viewer never fetches a .glb: each data file is a classic script,
-// FILE.glb.js, holding the GLB as base64: `(self.GB_DATA = self.GB_DATA || {})["KEY"] = "...";`. The viewer
-// adds a <script> for it, then decodes and parses it with GLTFLoader.parse.
+// FILE.glb.js, holding the GLB (gzipped or not) as base64: `(self.GB_DATA = self.GB_DATA || {})["KEY"] = "...";`.
+// The viewer adds a <script> for it, then decodes, unzips and parses it with GLTFLoader.parse.
 //
 // A page holds one element per viewer and loads this script after it:
 //   <div class="gb-viewer" data-plant="ID/plant.glb.js" data-plant-key="plant:ID"
@@ -57,11 +57,17 @@ function loadData(src, key) {
       if (typeof text !== 'string') return reject(new Error(`${src} did not define GB_DATA["${key}"]`));
       delete self.GB_DATA[key];
       s.remove();
-      resolve(decodeBase64(text).buffer);
+      resolve(gunzipped(decodeBase64(text)));
     };
     s.onerror = () => reject(new Error(`cannot load ${src}`));
     document.head.appendChild(s);
   });
+}
+// The bytes themselves, or, when they are gzipped (the report gzips each .glb: 1f 8b, where a GLB starts
+// "glTF"), what they unzip to.
+function gunzipped(bytes) {
+  if (bytes[0] !== 0x1f || bytes[1] !== 0x8b) return Promise.resolve(bytes.buffer);
+  return new Response(new Blob([bytes]).stream().pipeThrough(new DecompressionStream('gzip'))).arrayBuffer();
 }
 function decodeBase64(text) {
   if (Uint8Array.fromBase64) return Uint8Array.fromBase64(text);
@@ -292,7 +298,7 @@ class Viewer {
         : `every node appeared at step ${lastStep}: no growth to play`;
     }
     // Camera: from the scene camera's side, framing the plant.
-    const box = new Box3().setFromObject(plant.scene);
+    const box = this.plantBox = new Box3().setFromObject(plant.scene);
     this.plantSphere = box.getBoundingSphere(new Sphere());
     const all = new Box3().setFromObject(scene);
     const fov = sceneCamera ? sceneCamera.fov : 45;
@@ -310,10 +316,27 @@ class Viewer {
     this.frame();
     this.setStep(this.step);
   }
+  // From the view direction, far enough that the bounding sphere fits, then nearer until the plant's box
+  // spans most of the frame: a flat or thin plant would otherwise be small in the middle.
   frame() {
     const s = this.plantSphere, fov = this.camera.fov * Math.PI / 180;
     const fit = Math.min(fov, 2 * Math.atan(Math.tan(fov / 2) * this.camera.aspect));
-    const dist = 1.15 * s.radius / Math.sin(fit / 2);
+    let dist = 1.15 * s.radius / Math.sin(fit / 2);
+    const corners = [], b = this.plantBox, p = new Vector3();
+    for (let i = 0; i < 8; i++) corners.push(new Vector3(i & 1 ? b.max.x : b.min.x, i & 2 ? b.max.y : b.min.y, i & 4 ? b.max.z : b.min.z));
+    for (let k = 0; k < 4; k++) {
+      this.camera.position.copy(s.center).addScaledVector(this.viewDir, dist);
+      this.camera.lookAt(s.center);
+      this.camera.updateMatrixWorld(true);
+      let span = 0;
+      for (const c of corners) {
+        p.copy(c).project(this.camera);
+        if (p.z > 1) { span = 2; break; }  // a corner behind the camera: keep the distance that fits the sphere
+        span = Math.max(span, Math.abs(p.x), Math.abs(p.y));
+      }
+      if (!(span > 0) || span > 1.5) break;
+      dist *= 0.5 + 0.5 * span / 0.85;  // halfway towards a span of 85% of the frame
+    }
     this.camera.position.copy(s.center).addScaledVector(this.viewDir, dist);
     this.controls.target.copy(s.center);
     this.controls.update();
