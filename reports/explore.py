@@ -26,15 +26,17 @@ def number(v):
 
 
 def trial_row(c, page):
-    peaks = [p for p in c.growth_rss if isinstance(p, (int, float))]
+    peaks = [p for p in c.growth_rss if number(p) is not None]
     params = c.t.get("params") if isinstance(c.t.get("params"), dict) else {}
     return {"id": c.id(), "page": page, "entry": c.row, "label": c.label, "scene": c.scene,
             "seed": c.seed, "status": c.status,
-            "sweep": c.t.get("sweep") if isinstance(c.t.get("sweep"), dict) else {},
+            "sweep": {k: v for k, v in (c.t.get("sweep") or {}).items() if isinstance(v, (str, bool)) or number(v) is not None}
+                     if isinstance(c.t.get("sweep"), dict) else {},
             "params": {k: v for k, v in params.items() if isinstance(v, (str, bool)) or number(v) is not None},
             "verdict": c.verdict or ("valid" if c.ok else "-"), "valid": bool(c.valid),
             "reasons": "; ".join(c.reasons), "trials": len(c.growth),
-            "growth_s": number(statistics.median(c.growth)) if c.growth else None, "nodes": c.nodes or None, "glb": number(c.bytes.get("glb")),
+            "growth_s": number(statistics.median(c.growth)) if c.growth and all(number(g) is not None for g in c.growth)
+                        else None, "nodes": c.nodes or None, "glb": number(c.bytes.get("glb")),
             "growth_peak_mb": statistics.median(peaks) / 2 ** 20 if peaks else None,
             "metrics": {k: number(v) for k, v in sorted(c.metrics.items()) if not isinstance(v, (list, dict))}}
 

@@ -22,6 +22,7 @@ import re
 import statistics
 import sys
 import time
+import urllib.parse
 
 import history_view
 
@@ -194,6 +195,7 @@ def main():
         os.makedirs(os.path.join(a.out, sub), exist_ok=True)
         data = series(docs)
         metrics = sorted({m for _, m in data})
+        marks = []  # (cell, metric, commit index) of each change point: commit names need not be unique
         figures = []
         for m in metrics:
             cells = sorted(c for c, mm in data if mm == m)
@@ -212,6 +214,7 @@ def main():
                     ax.plot([i1], [rel[k]], marker="D", ms=9, mfc="none", mec=line.get_color(), mew=2)
                     group["change_points"].append({"cell": cell, "metric": m, "before": commits[i0],
                                                    "after": commits[i1], "ratio": ratio})
+                    marks.append((cell, m, i1))
             ax.set_yscale("log")
             plain = matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}")
             ax.yaxis.set_major_formatter(plain)
@@ -239,8 +242,10 @@ def main():
         if group["behaviour_changes"]:
             body.append("<p>Behaviour changed (geometry hash): " + ", ".join(
                 f"{html.escape(b['cell'])} at {html.escape(b['commit'])}" for b in group["behaviour_changes"]) + "</p>")
-        files = [os.path.relpath(d[FILE_KEY], a.out) for d in docs]
-        body.append(history_view.group_html(sub, commits, commit_dates(docs), files, data, group["change_points"],
+        # Links: each part of the path quoted, so that '#', '?' or '%' in a folder name stays a file name.
+        files = ["./" + "/".join(urllib.parse.quote(part) for part in os.path.relpath(d[FILE_KEY], a.out).split(os.sep))
+                 for d in docs]
+        body.append(history_view.group_html(sub, commits, commit_dates(docs), files, data, marks,
                                             metric_words(metrics)))
         body.append("<details><summary>The same as static figures (PNG, with PDFs beside them)</summary>")
         for m, png in figures:

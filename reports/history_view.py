@@ -15,14 +15,15 @@ def finite(v):
 
 
 def group_html(key, commits, dates, files, data, change_points, metric_names):
-    """One group's section. FILES: each commit's history file, relative to the page. DATA: {(cell, metric): [value or None per commit]}; CHANGE_POINTS: dicts with cell,
-    metric and after (the commit of the new level); METRIC_NAMES: {metric: words}."""
+    """One group's section. FILES: each commit's history file as a link from the page. DATA: {(cell, metric):
+    [value or None per commit]}; CHANGE_POINTS: (cell, metric, index of the commit of the new level);
+    METRIC_NAMES: {metric: words}."""
     metrics = sorted({m for _, m in data})
     payload = {
         "commits": commits, "dates": dates, "files": files,
         "metrics": [[m, metric_names.get(m, m)] for m in metrics],
         "series": {m: {c: [finite(v) for v in data[(c, mm)]] for c, mm in sorted(data) if mm == m} for m in metrics},
-        "changes": [[c["cell"], c["metric"], commits.index(c["after"])] for c in change_points],
+        "changes": [list(c) for c in change_points],
     }
     # No "<" inside the script element, which "</script>" or "<!--" in a name could end or derail.
     text = json.dumps(payload, allow_nan=False, separators=(",", ":")).replace("<", "\\u003c")

@@ -1074,8 +1074,9 @@ def trial_dir_of(c, base):
     png = own_path(base, render.get("png"))
     if png:
         return os.path.dirname(png)
-    d = os.path.join(base, "trials", *c.id().split("/"))
-    return d if os.path.isdir(d) else None
+    # A trial id from the file names a folder under trials/, and only there (own_path: no "..", no link out).
+    d = own_path(base, os.path.join("trials", *c.id().split("/")))
+    return d if d and os.path.isdir(d) else None
 
 
 def write_trial_pages(cells, base, out, views=None):

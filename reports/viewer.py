@@ -75,7 +75,11 @@ def write_assets(doc, cells, base, out, own_path, slug, trial_dir_of, autoload_m
     for c in cells:
         d = trial_dir_of(c, base)
         glb = os.path.join(d, "plant.glb") if d else None
-        if not glb or not os.path.isfile(glb):
+        if not d:
+            views[c.id()] = ("<p class='note'>No 3D view: the trial's folder is not beside the results file (a merged "
+                             "file names its shards' trials in their own folders).</p>")
+            continue
+        if not os.path.isfile(glb):
             views[c.id()] = "<p class='note'>No 3D view: the trial left no plant.glb.</p>"
             continue
         rel = f"{slug(c.id())}/plant.glb.js"

@@ -1,6 +1,7 @@
 // The .glb layouts (harness/output/exporters.hpp): the plain layout's size computed without writing it, and
 // the instanced and compact layouts decoded back here (meshoptimizer's own decoder for the compressed views)
 // and compared with the plain mesh: pieces within half a quantization step, organs where add_organ puts them.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -294,6 +295,20 @@ TEST(Glb, EachVertexCarriesTheStepItsPartAppeared) {
   const auto steps = accessor_values(plain, plain.doc["meshes"][0]["primitives"][0]["attributes"]["_BIRTH_STEP"]);
   EXPECT_EQ(steps, std::vector<float>(expect.begin(), expect.end()));
   EXPECT_EQ(plain_glb_bytes(m), std::filesystem::file_size(dir / "plain.glb"));
+  // A user attribute of that name, in any case, keeps its own: viewers read names lower-cased.
+  OutputMesh named = m;
+  named.attributes.push_back({"Birth_Step", 1, std::vector<float>(m.positions.size(), 5.0f)});
+  write_glb((dir / "named.glb").string(), named);
+  write_glb((dir / "named_compact.glb").string(), named, GlbLayout::Compact, p, OrganShapes(p));
+  for (const char* file : {"named.glb", "named_compact.glb"}) {
+    const Glb g = read_glb(dir / file);
+    const Json& attrs = g.doc["meshes"][0]["primitives"][0]["attributes"];
+    EXPECT_TRUE(attrs.contains("_BIRTH_STEP")) << file << attrs.dump();
+    EXPECT_TRUE(attrs.contains("_Birth_Step_")) << file << attrs.dump();
+    for (const float v : accessor_values(g, attrs["_Birth_Step_"])) EXPECT_EQ(v, 5.0f) << file;
+    const std::vector<float> kept = accessor_values(g, attrs["_BIRTH_STEP"]);
+    EXPECT_NE(std::find(kept.begin(), kept.end(), 3.0f), kept.end()) << file;
+  }
 }
 
 // glTF wants buffers of at least one byte; a plant with no geometry has no buffer data in any layout.

@@ -50,7 +50,14 @@ try {
       await page.close();
       continue;
     }
-    await page.waitForFunction(() => ['loaded', 'error'].includes(document.body.dataset.viewer), { timeout: 180000 });
+    const settled = () => page.waitForFunction(() => ['loaded', 'error', 'deferred'].includes(document.body.dataset.viewer),
+                                               { timeout: 180000 });
+    await settled();
+    if (await page.evaluate(() => document.body.dataset.viewer) === 'deferred') {
+      console.log(`  deferred: ${await page.$eval('.gb-viewer .gb-load', b => b.textContent)}; clicking it`);
+      await page.click('.gb-viewer .gb-load');
+      await settled();
+    }
     const loadedMs = performance.now() - t0;
     const state = await page.evaluate(() => document.body.dataset.viewer);
     const frame = () => page.evaluate(() => new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r))));
@@ -120,6 +127,10 @@ try {
         await frame();
         const s = await stats();
         seen.push(s);
+        // Faithful: what is drawn is exactly what was born by this step, checked item by item.
+        const f = await page.evaluate(() => GBViewer.viewers[0].frameCheck());
+        if (f.drawnLater || f.hiddenEarlier || !f.items)
+          fail(name, `step ${f.step}: ${f.drawnLater} drawn items born later, ${f.hiddenEarlier} hidden items born by then, of ${f.items}`);
         console.log(`  slider at ${at * 100}%: step ${s.step}, ${s.frame.triangles} triangles, plant indices ${s.indices}, instances ${s.instances}`);
         if (shots) await (await page.$('.gb-viewer')).screenshot({ path: `${shots}/${name}-step-${s.step}.png` });
       }

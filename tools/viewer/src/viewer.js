@@ -44,7 +44,9 @@ let bodyState = {};  // viewer index -> state, summarised on <body data-viewer>
 function setBodyState(i, state) {
   bodyState[i] = state;
   const all = Object.values(bodyState);
-  document.body.dataset.viewer = all.includes('error') ? 'error' : all.every(s => s === 'loaded') ? 'loaded' : 'loading';
+  // 'deferred': a plant over the autoload size, waiting for its button.
+  document.body.dataset.viewer = all.includes('error') ? 'error' : all.includes('loading') ? 'loading'
+    : all.includes('deferred') ? 'deferred' : 'loaded';
 }
 
 // The bytes of a data script: add <script src>, then take its base64 out of GB_DATA.
@@ -205,7 +207,7 @@ class Viewer {
       const b = append(el, 'button', 'gb-load', `Load the 3D view${mb}`);
       this.status.textContent = 'Not loaded yet.';
       b.addEventListener('click', () => { b.remove(); this.load(); });
-      setBodyState(this.index, 'loaded');  // nothing asked for, nothing failed
+      setBodyState(this.index, 'deferred');
     } else {
       this.load();
     }
@@ -298,7 +300,11 @@ class Viewer {
         : `every node appeared at step ${lastStep}: no growth to play`;
     }
     // Camera: from the scene camera's side, framing the plant.
-    const box = this.plantBox = new Box3().setFromObject(plant.scene);
+    // A plant with no geometry is framed by its scene, or failing that by a metre around the origin.
+    let box = new Box3().setFromObject(plant.scene);
+    if (box.isEmpty()) box = new Box3().setFromObject(scene);
+    if (box.isEmpty()) box = new Box3(new Vector3(-0.5, 0, -0.5), new Vector3(0.5, 1, 0.5));
+    this.plantBox = box;
     this.plantSphere = box.getBoundingSphere(new Sphere());
     const all = new Box3().setFromObject(scene);
     const fov = sceneCamera ? sceneCamera.fov : 45;
@@ -384,6 +390,31 @@ class Viewer {
     this.renderer.render(this.scene, this.camera);
     const i = this.renderer.info.render;
     this.lastFrame = { triangles: i.triangles, lines: i.lines, calls: i.calls };
+  }
+  // Whether this frame is faithful, read from the geometry itself: every drawn triangle, line or organ
+  // instance has a birth step <= the step shown, every hidden one a later step. Counts of each kind of wrong.
+  frameCheck() {
+    let drawnLater = 0, hiddenEarlier = 0, items = 0;
+    for (const g of this.growth) {
+      const geo = g.mesh.geometry;
+      if (g.kind === 'instances') {
+        const a = geo.attributes._BIRTH_STEP;
+        for (let j = 0; j < a.count; j++, items++) {
+          if (j < g.mesh.count && a.getX(j) > this.step) drawnLater++;
+          if (j >= g.mesh.count && a.getX(j) <= this.step) hiddenEarlier++;
+        }
+        continue;
+      }
+      const a = geo.attributes._birth_step, idx = geo.index.array, per = g.perItem;
+      const drawn = Math.min(geo.drawRange.count, idx.length) / per;
+      for (let j = 0; j < idx.length / per; j++, items++) {
+        let step = 0;
+        for (let k = 0; k < per; k++) step = Math.max(step, a.getX(idx[per * j + k]));
+        if (j < drawn && step > this.step) drawnLater++;
+        if (j >= drawn && step <= this.step) hiddenEarlier++;
+      }
+    }
+    return { step: this.step, items, drawnLater, hiddenEarlier };
   }
   // What is drawn: the renderer's counts of the last frame, and the plant's index and instance counts
   // at this step (visible parts only).
