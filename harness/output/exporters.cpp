@@ -126,17 +126,19 @@ std::string attribute_word(const std::string& name) {
 
 // The PLY float properties of an attribute: its name for one component, NAME_0, NAME_1, ... for more. A
 // name the writer uses itself (x, red, ...) gets a leading '_'.
-// The glTF name of a vertex attribute called `name` on a primitive whose attributes are `taken`: _WORD, with
-// '_' appended while it equals one of them ignoring case. three.js's GLTFLoader lower-cases application
-// attributes, so a user attribute "birth_step" would otherwise overwrite _BIRTH_STEP in a viewer.
-std::string free_attribute_name(const std::string& name, const std::vector<std::string>& taken) {
-  const auto lower = [](std::string s) {
-    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return s;
-  };
+// The glTF name of a vertex attribute called `name` on a primitive: _WORD, with '_' appended while it equals,
+// ignoring case, a name the primitive already has (`taken(match)`: whether `match` holds for one of them).
+// three.js's GLTFLoader lower-cases application attributes, so a user attribute "birth_step" would otherwise
+// overwrite _BIRTH_STEP in a viewer.
+template <class Taken>
+std::string free_attribute_name(const std::string& name, const Taken& taken) {
   std::string out = std::string(1, '_').append(attribute_word(name));
-  while (std::any_of(taken.begin(), taken.end(), [&](const std::string& t) { return lower(t) == lower(out); }))
-    out += "_";
+  const auto same = [&](std::string_view k) {
+    return k.size() == out.size() && std::equal(k.begin(), k.end(), out.begin(), [](char x, char y) {
+             return std::tolower(static_cast<unsigned char>(x)) == std::tolower(static_cast<unsigned char>(y));
+           });
+  };
+  while (taken(same)) out += "_";
   return out;
 }
 
@@ -401,8 +403,9 @@ std::map<std::string, int> shared_attributes(GltfBuilder& b, const OutputMesh& m
     attrs[kBirthStep] = b.vertex_floats(steps.data(), nv, 1);
   }
   for (const auto& a : m.attributes) {
-    std::vector<std::string> taken;
-    for (const auto& [k, v] : attrs) taken.push_back(k);
+    const auto taken = [&](const auto& match) {
+      return std::any_of(attrs.begin(), attrs.end(), [&](const auto& kv) { return match(kv.first); });
+    };
     attrs[free_attribute_name(a.name, taken)] = b.vertex_floats(a.values.data(), nv, a.components);
   }
   return attrs;
@@ -876,8 +879,11 @@ Json piece_attributes(CompactGlb& g, const OutputMesh& m, const Piece& p, const 
     for (std::size_t i = 0; i < n; ++i)
       for (std::size_t k = 0; k < c; ++k)
         values[i * c + k] = a.values[p.vertices[i] * static_cast<std::size_t>(a.components) + k];
-    std::vector<std::string> taken;
-    for (auto it = attrs.begin(); it != attrs.end(); ++it) taken.push_back(it.key());
+    const auto taken = [&](const auto& match) {
+      for (auto it = attrs.begin(); it != attrs.end(); ++it)
+        if (match(it.key())) return true;
+      return false;
+    };
     attrs[free_attribute_name(a.name, taken)] =
         g.accessor(g.attribute_view(values.data(), n, 4 * c, true), kFloat, n, kTypes[c - 1]);
   }
