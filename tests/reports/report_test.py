@@ -1,4 +1,6 @@
 """Unit tests of reports/report.py's statistics and tables (run by ctest with /usr/bin/python3)."""
+import base64
+import gzip
 import json
 import math
 import os
@@ -458,6 +460,38 @@ class Page(unittest.TestCase):
                 self.assertNotIn("passwd", page)
                 self.assertNotIn("link.png", page)
             self.assertTrue(os.path.exists(os.path.join(out, "fig-time-vs-size.png")))
+
+    def test_a_trial_id_names_a_folder_under_trials_only(self):
+        # A plant.glb outside the results folder, reached by a '..' id, is neither copied nor viewed; the
+        # folder's own trial's plant is, gzipped, with its scene from the results' "scenes" map.
+        with tempfile.TemporaryDirectory() as d:
+            res = os.path.join(d, "res")
+            os.makedirs(os.path.join(res, "trials", "b", "wall", "s1"))
+            os.makedirs(os.path.join(res, "scenes"))
+            os.makedirs(os.path.join(d, "outside"))
+            write(os.path.join(d, "outside", "plant.glb"), "glTF-secret")
+            write(os.path.join(res, "trials", "b", "wall", "s1", "plant.glb"), "glTF-own")
+            write(os.path.join(res, "scenes", "wall-1234.glb"), "glTF-scene")
+            bad = trial("a", "wall", 1, [0.01], 1000)
+            bad["id"] = "../../outside"
+            good = trial("b", "wall", 1, [0.02], 900)
+            good["scene_hash"] = "1234"
+            doc = document([bad, good])
+            doc["scenes"] = {"1234": "scenes/wall-1234.glb"}
+            path = os.path.join(res, "results.json")
+            with open(path, "w") as f:
+                json.dump(doc, f)
+            out = os.path.join(d, "out")
+            report.write_report(doc, path, out, ["png"])
+            scripts = sorted(os.path.relpath(os.path.join(r, f), out) for r, _, fs in os.walk(out) for f in fs
+                             if f.endswith(".glb.js"))
+            self.assertEqual(scripts, ["scenes/wall-1234.glb.js", "trials/b_wall_s1/plant.glb.js"])
+            text = read(os.path.join(out, "trials", "b_wall_s1", "plant.glb.js"))
+            data = text.split('="', 1)[1].rsplit('";', 1)[0]
+            self.assertEqual(gzip.decompress(base64.b64decode(data)), b"glTF-own")
+            page = read(os.path.join(out, "trials", "b_wall_s1.html"))
+            self.assertIn("data-scene='../scenes/wall-1234.glb.js'", page)
+            self.assertIn("data-plant='b_wall_s1/plant.glb.js'", page)
 
     def test_noisy_repetitions_banner(self):
         steady, noisy = [0.010, 0.0101, 0.0102], [0.01, 0.02, 0.03]  # CV 1%, 50%
