@@ -14,7 +14,12 @@ install(TARGETS growbench RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT 
 # docs/metrics.md relative to itself, and the binary (core/data_path.hpp) reads from here once the
 # checkout it was built from is gone.
 set(GROWBENCH_INSTALL_DATADIR ${CMAKE_INSTALL_DATADIR}/growbench)
-install(FILES reports/report.py reports/paper_tables.py reports/history.py DESTINATION ${GROWBENCH_INSTALL_DATADIR}/reports COMPONENT runtime)
+install(FILES reports/report.py reports/paper_tables.py reports/viewer.py reports/explore.py reports/history.py
+              reports/history_view.py DESTINATION ${GROWBENCH_INSTALL_DATADIR}/reports COMPONENT runtime)
+# The report's 3D viewer, as scripts/install-deps built it (reports/viewer.py finds it relative to itself);
+# without it, reports have no 3D views and say why.
+install(DIRECTORY tools/viewer/dist/ DESTINATION ${GROWBENCH_INSTALL_DATADIR}/tools/viewer/dist COMPONENT runtime
+        OPTIONAL)
 install(FILES harness/record/results.schema.json DESTINATION ${GROWBENCH_INSTALL_DATADIR}/harness/record
         COMPONENT runtime)
 install(FILES docs/metrics.md DESTINATION ${GROWBENCH_INSTALL_DATADIR}/docs COMPONENT runtime)
