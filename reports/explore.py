@@ -2,8 +2,8 @@
 whose points open the trials' pages. Plain HTML and SVG with a short script inside index.html, so it works
 from file:// with nothing else loaded. The data is the cells' own numbers, embedded as JSON.
 
-Each point and row is one trial cell: its growth time is the median over its repetitions (one trial when
-there is one), its metrics the cell's. A plant judged other than valid is drawn hollow and grey and said so:
+Each point and row is one trial cell: its growth time is the median over its repetitions the suite wrote
+(Cell.growth_median; one trial when there is one), its metrics the cell's. A plant judged other than valid is drawn hollow and grey and said so:
 it is shown, never compared as a result.
 """
 
@@ -35,8 +35,7 @@ def trial_row(c, page):
             "params": {k: v for k, v in params.items() if isinstance(v, (str, bool)) or number(v) is not None},
             "verdict": c.verdict or ("valid" if c.ok else "-"), "valid": bool(c.valid),
             "reasons": "; ".join(c.reasons), "trials": len(c.growth),
-            "growth_s": number(statistics.median(c.growth)) if c.growth and all(number(g) is not None for g in c.growth)
-                        else None, "nodes": c.nodes or None, "glb": number(c.bytes.get("glb")),
+            "growth_s": number(c.growth_median()) if c.growth else None, "nodes": c.nodes or None, "glb": number(c.bytes.get("glb")),
             "growth_peak_mb": statistics.median(peaks) / 2 ** 20 if peaks else None,
             "metrics": {k: number(v) for k, v in sorted(c.metrics.items()) if not isinstance(v, (list, dict))}}
 
