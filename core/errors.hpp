@@ -17,6 +17,15 @@ class InputError : public std::runtime_error {
   explicit InputError(const char* what) : InputError(std::string(what)) {}
 };
 
+// A plugin algorithm failed on its own account: it returned an error, or handed over a plant the host
+// refuses (a parent out of order, a coordinate that is not finite, an organ turned by a non-unit
+// quaternion). Not growbench's bug and not the scene's fault: the CLI names the plugin and exits with 2,
+// a suite records `plugin_error`.
+class PluginError : public std::runtime_error {
+ public:
+  explicit PluginError(const std::string& what) : std::runtime_error(escape_utf8(what)) {}
+};
+
 // Memory ran out, or would: an allocation failed in a library, or a size estimated before building
 // exceeds what the process may use. A std::bad_alloc, so every handler of allocation failure counts it
 // as out_of_memory, but with a message saying what needed the memory.

@@ -24,6 +24,7 @@ enum class Outcome : std::uint8_t {
   failed,         // anything else: an internal error, a bug
   timeout,        // a trial killed at its time limit
   crashed,        // a trial killed by a signal
+  plugin_error,   // a plugin algorithm failed, or handed over an invalid plant (PluginError)
 };
 
 struct OutcomeCodes {
@@ -34,7 +35,7 @@ struct OutcomeCodes {
 };
 
 // A sample's statuses: a trial that failed (an internal error) is recorded as crashed, as a signal is.
-inline constexpr std::array<OutcomeCodes, 7> kOutcomes = {{
+inline constexpr std::array<OutcomeCodes, 8> kOutcomes = {{
     {Outcome::ok, "ok", 0, 0},
     {Outcome::regression, "regression", 1, -1},
     {Outcome::invalid_input, "invalid_input", 2, 2},
@@ -42,6 +43,7 @@ inline constexpr std::array<OutcomeCodes, 7> kOutcomes = {{
     {Outcome::failed, "crashed", 3, 4},
     {Outcome::timeout, "timeout", 3, -1},
     {Outcome::crashed, "crashed", 3, -1},
+    {Outcome::plugin_error, "plugin_error", 2, 5},  // a plugin is input the user brought
 }};
 
 static_assert(
@@ -53,8 +55,8 @@ static_assert(
     "kOutcomes is indexed by Outcome");
 
 // The statuses a suite records for a trial, each once.
-inline constexpr std::array<std::string_view, 5> kTrialStatuses = {"ok", "crashed", "timeout", "out_of_memory",
-                                                                   "invalid_input"};
+inline constexpr std::array<std::string_view, 6> kTrialStatuses = {
+    "ok", "crashed", "timeout", "out_of_memory", "invalid_input", "plugin_error"};
 
 constexpr const OutcomeCodes& codes_of(Outcome o) {
   return kOutcomes[static_cast<std::size_t>(o)];
@@ -75,9 +77,11 @@ constexpr Outcome outcome_of_trial_exit(int code) {
   return Outcome::failed;
 }
 
-// Throws the exception the harness reads back as `o` (InputError, std::bad_alloc, or std::runtime_error).
+// Throws the exception the harness reads back as `o` (InputError, std::bad_alloc, PluginError or
+// std::runtime_error).
 [[noreturn]] inline void throw_as(Outcome o, const std::string& message) {
   if (o == Outcome::invalid_input) throw InputError(message);
+  if (o == Outcome::plugin_error) throw PluginError(message);
   if (o == Outcome::out_of_memory) throw std::bad_alloc();
   throw std::runtime_error(message);
 }

@@ -330,7 +330,7 @@ const AlgorithmEntry& load_plugin(const std::string& given) {
   Loaded& l = loaded().emplace_back(Loaded{path, std::move(info), {}});
   const AlgorithmInfo* ip = &l.info;
   l.entry = AlgorithmEntry{[ip]() -> const AlgorithmInfo& { return *ip; },
-                           [t, ip]() { return make_plugin_algorithm(t, *ip); },
+                           [t, ip, path]() { return make_plugin_algorithm(t, *ip, path); },
                            {},
                            std::move(origin)};
   return l.entry;

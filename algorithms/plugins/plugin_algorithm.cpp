@@ -17,8 +17,8 @@
 namespace growbench {
 namespace {
 
-// What a plugin's status says of how its call ended (include/growbench/plugin.h); a status the ABI does not
-// define is a failure.
+// What a plugin's status says of how its call ended (include/growbench/plugin.h): its own failure, and any
+// status the ABI does not define, is the plugin's error, not growbench's.
 Outcome outcome_of_status(std::int32_t status) {
   switch (status) {
     case GROWBENCH_OK:
@@ -28,7 +28,7 @@ Outcome outcome_of_status(std::int32_t status) {
     case GROWBENCH_OUT_OF_MEMORY:
       return Outcome::out_of_memory;
     default:
-      return Outcome::failed;
+      return Outcome::plugin_error;
   }
 }
 
@@ -57,7 +57,8 @@ growbench_shape shape_view(const Shape& s) {
 
 class PluginAlgorithm final : public GrowthAlgorithm {
  public:
-  PluginAlgorithm(const growbench_plugin* t, const AlgorithmInfo& info) : t_(t), info_(info) {}
+  PluginAlgorithm(const growbench_plugin* t, const AlgorithmInfo& info, const std::string& path)
+      : t_(t), info_(info), who_(fmt::format("algorithm '{}' (plugin {})", info.name, path)) {}
   ~PluginAlgorithm() override {
     if (inst_) t_->destroy(inst_);
   }
@@ -201,8 +202,7 @@ class PluginAlgorithm final : public GrowthAlgorithm {
       message = failure_.empty() ? "no message given" : failure_;
       failure_.clear();
     }
-    throw_as(outcome_of_status(status),
-             fmt::format("algorithm '{}' (a plugin) failed in {}: {}", info_.name, where, message));
+    throw_as(outcome_of_status(status), fmt::format("{} failed in {}: {}", who_, where, message));
   }
   void check(std::int32_t status, const std::string& where) const {
     if (status != GROWBENCH_OK) raise(status, where);
@@ -210,8 +210,7 @@ class PluginAlgorithm final : public GrowthAlgorithm {
 
   void copy_plant(const growbench_plant_view& v) const {
     auto bad = [&](const std::string& what) {
-      return std::runtime_error(
-          fmt::format("algorithm '{}' (a plugin) returned a malformed plant: {}", info_.name, what));
+      return PluginError(fmt::format("{} returned a malformed plant: {}", who_, what));
     };
     if ((v.node_count && !v.nodes) || (v.organ_count && !v.organs)) throw bad("a NULL array with a non-zero count");
     plant_.clear();
@@ -250,6 +249,7 @@ class PluginAlgorithm final : public GrowthAlgorithm {
 
   const growbench_plugin* t_;
   const AlgorithmInfo& info_;
+  std::string who_;  // "algorithm 'NAME' (plugin PATH)", what its failures say
   growbench_instance* inst_ = nullptr;
   const HostQueries* q_ = nullptr;
   std::uint64_t seed_ = 0;
@@ -354,8 +354,9 @@ void PluginAlgorithm::make_host() {
 
 }  // namespace
 
-std::unique_ptr<GrowthAlgorithm> make_plugin_algorithm(const growbench_plugin* table, const AlgorithmInfo& info) {
-  return std::make_unique<PluginAlgorithm>(table, info);
+std::unique_ptr<GrowthAlgorithm> make_plugin_algorithm(const growbench_plugin* table, const AlgorithmInfo& info,
+                                                       const std::string& path) {
+  return std::make_unique<PluginAlgorithm>(table, info, path);
 }
 
 }  // namespace growbench

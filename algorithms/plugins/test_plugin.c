@@ -5,7 +5,8 @@
  *    along the seed's direction until `length` nodes or a solid (host->inside) stops it; a leaf at each
  *    tip. Its `fault` parameter makes it crash, hang, exhaust memory or report errors, for the tests of
  *    how a suite records a misbehaving plugin (an exit() it never reports, a message of a megabyte, a flood of stderr,
- * a full disk). 1 no entry point; 2 another ABI version; 3 a built-in's name; 4 a malformed parameter table;
+ * a full disk), give NaN to the queries (nan_query) or hand over an invalid plant (bad_parent, nan_node).
+ * 1 no entry point; 2 another ABI version; 3 a built-in's name; 4 a malformed parameter table;
  * 5 an entry() that crashes; 6 an entry() that calls exit(0); 7 an entry() that closes every descriptor and
  * waits forever. */
 #define _POSIX_C_SOURCE 200809L /* close() and pause() under C99 without extensions */
@@ -22,8 +23,10 @@
 #define TEST_PLUGIN_VARIANT 0
 #endif
 
-static const char* const kFaults[] = {"none",  "crash", "hang",         "oom",   "fail",
-                                      "input", "exit3", "long_message", "flood", "disk_full"};
+static const char* const kFaults[] = {"none",      "crash",      "hang",         "oom",   "fail",
+                                      "input",     "exit3",      "long_message", "flood", "disk_full",
+                                      "nan_query", "bad_parent", "nan_node"};
+enum { kFaultCount = sizeof kFaults / sizeof kFaults[0] };
 
 static const growbench_param kParams[] = {
     {"length", GROWBENCH_PARAM_INT, {20, 0.0, 0, NULL, {0, 0, 0}}, 1, 100000, "", "nodes per stalk", NULL, 0},
@@ -32,7 +35,15 @@ static const growbench_param kParams[] = {
 #else
     {"step", GROWBENCH_PARAM_REAL, {0, 0.02, 0, NULL, {0, 0, 0}}, 0.001, 1.0, "m", "length of one step", NULL, 0},
 #endif
-    {"fault", GROWBENCH_PARAM_CHOICE, {0, 0.0, 0, "none", {0, 0, 0}}, 1, 0, "", "misbehave, for tests", kFaults, 10},
+    {"fault",
+     GROWBENCH_PARAM_CHOICE,
+     {0, 0.0, 0, "none", {0, 0, 0}},
+     1,
+     0,
+     "",
+     "misbehave, for tests",
+     kFaults,
+     kFaultCount},
 };
 
 static const char* const kTestParams[] = {"length=8"};
@@ -66,7 +77,7 @@ static int32_t start(growbench_instance* instance, const growbench_scene* scene,
   s->scene = scene;
   s->length = params[0].integer;
   s->step = (float)params[1].real;
-  for (s->fault = 0; s->fault < 10 && strcmp(kFaults[s->fault], params[2].text) != 0; ++s->fault) {
+  for (s->fault = 0; s->fault < kFaultCount && strcmp(kFaults[s->fault], params[2].text) != 0; ++s->fault) {
   }
   if (s->fault == 5) {
     s->host->fail(s->host->context, "fault=input: this scene will not do");
@@ -92,6 +103,39 @@ static int32_t start(growbench_instance* instance, const growbench_scene* scene,
     s->tip[i] = (int64_t)s->node_count++;
   }
   return GROWBENCH_OK;
+}
+
+/* fault=nan_query: rays, occluded and light_visible given NaN and infinite inputs answer "no hit", "not
+ * occluded" and "not lit" (docs/plugins.md), and the process goes on. */
+static int queries_take_nan(state* s) {
+  const float nan = NAN, inf = INFINITY;
+  const growbench_vec3 bad[3] = {{nan, 0.5f, 0.0f}, {inf, 0.0f, 0.0f}, {0.0f, -inf, nan}};
+  growbench_ray rays[4];
+  growbench_ray_hit hits[4];
+  uint8_t occluded[4], lit[3];
+  int k;
+  for (k = 0; k < 3; ++k) {
+    rays[k].origin = bad[k];
+    rays[k].direction = bad[(k + 1) % 3];
+    rays[k].tmin = 0.0f;
+    rays[k].tmax = inf;
+  }
+  rays[3].origin = s->scene->seeds[0].position; /* a finite origin with a NaN interval */
+  rays[3].direction = s->scene->seeds[0].direction;
+  rays[3].tmin = nan;
+  rays[3].tmax = nan;
+  memset(hits, 0xff, sizeof hits);
+  memset(occluded, 7, sizeof occluded);
+  memset(lit, 7, sizeof lit);
+  s->host->rays(s->host->context, rays, 4, hits);
+  s->host->occluded(s->host->context, rays, 4, occluded);
+  s->host->light_visible(s->host->context, bad, 3, 1e-4f, lit);
+  for (k = 0; k < 4; ++k)
+    if (hits[k].hit != 0 || occluded[k] != 0 || (k < 3 && lit[k] != 0)) {
+      s->host->fail(s->host->context, "fault=nan_query: a query on NaN or infinite input answered something");
+      return 0;
+    }
+  return 1;
 }
 
 static int32_t step(growbench_instance* instance) {
@@ -137,6 +181,7 @@ static int32_t step(growbench_instance* instance) {
     }
     return -GROWBENCH_ERROR;
   }
+  if (s->fault == 10 && !queries_take_nan(s)) return -GROWBENCH_ERROR;
   ++s->steps;
   for (i = 0; i < s->scene->seed_count; ++i) {
     const growbench_vec3 d = s->scene->seeds[i].direction;
@@ -188,6 +233,8 @@ static int32_t finish(growbench_instance* instance) {
 static int32_t plant(growbench_instance* instance, growbench_plant_view* out) {
   state* s = (state*)instance;
   memset(out, 0, sizeof(*out));
+  if (s->fault == 11 && s->node_count > 1) s->nodes[0].parent = 1; /* a parent after its child */
+  if (s->fault == 12 && s->node_count > 1) s->nodes[s->node_count - 1].position.y = NAN;
   out->nodes = s->nodes;
   out->node_count = s->node_count;
   out->organs = s->organs;

@@ -1,7 +1,7 @@
 // growbench: the command line. main builds the app, asks each subcommand (one file each, command.hpp) to
 // register, parses, and runs the chosen one. It is the one place that turns exceptions into outcomes and
-// outcomes into exit statuses (core/outcome.hpp, README "Exit status"): bad input and command-line errors 2,
-// anything else, being a bug, 3 with a request for a report.
+// outcomes into exit statuses (core/outcome.hpp, README "Exit status"): bad input, a plugin's own failure and
+// command-line errors 2, anything else, being a bug, 3 with a request for a report.
 #include <exception>
 #include <functional>
 #include <new>
@@ -36,6 +36,12 @@ gb::Outcome run_command(const gb::cli::Command& command) {
   } catch (const gb::InputError& e) {
     fmt::print(stderr, "growbench: error: {}\n", e.what());
     return gb::Outcome::invalid_input;
+  } catch (const gb::PluginError& e) {
+    fmt::print(stderr,
+               "growbench: error: {}\nThis is the plugin's failure, not growbench's (docs/plugins.md says what the "
+               "host checks).\n",
+               e.what());
+    return gb::Outcome::plugin_error;
   } catch (const std::exception& e) {
     const gb::Outcome o = gb::outcome_of(e);
     if (o == gb::Outcome::out_of_memory)
@@ -45,6 +51,14 @@ gb::Outcome run_command(const gb::cli::Command& command) {
   } catch (...) {
     return internal_error("an exception of unknown type");
   }
+}
+
+// Every repeatable option takes one value per use, as --set and --plugin are documented: CLI11 would let
+// `--plugin X.so walker` (or `--plugin=X.so walker`) take the positional `walker` as a second plugin.
+void one_value_per_use(CLI::App& app) {
+  for (CLI::Option* o : app.get_options())
+    if (!o->get_positional()) o->allow_extra_args(false);
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) one_value_per_use(*sub);
 }
 
 }  // namespace
@@ -73,6 +87,7 @@ int main(int argc, char** argv) {
                                      cli::add_trial(app),   cli::add_ab(app),       cli::add_compare(app),
                                      cli::add_merge(app),   cli::add_baseline(app), cli::add_report(app),
                                      cli::add_lsystem(app), cli::add_summary(app),  cli::add_schema(app)};
+    one_value_per_use(app);
     try {
       app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

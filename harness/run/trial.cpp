@@ -264,6 +264,7 @@ bool is_out_of_memory(const std::exception& e) {
 
 Outcome outcome_of(const std::exception& e) {
   if (dynamic_cast<const InputError*>(&e)) return Outcome::invalid_input;
+  if (dynamic_cast<const PluginError*>(&e)) return Outcome::plugin_error;
   return is_out_of_memory(e) ? Outcome::out_of_memory : Outcome::failed;
 }
 
@@ -598,9 +599,13 @@ TrialRecord run_trial_record(const TrialSpec& spec, const std::function<void(con
   grow(spec, params, st, timer, rec, progress);
   const Plant& plant = st.algo->plant();
   // An algorithm whose input can draw an invalid plant (an L-system's grammar is a program) refuses it in
-  // finish(), as bad input; any other invalid plant is a bug.
-  if (const std::string bad = plant.validate(); !bad.empty())
+  // finish(), as bad input; a plugin's invalid plant is the plugin's error; a built-in's is a bug.
+  if (const std::string bad = plant.validate(); !bad.empty()) {
+    if (entry.plugin)
+      throw PluginError(fmt::format("algorithm '{}' (plugin {}) handed over an invalid plant: {}", spec.algorithm,
+                                    entry.plugin->path, bad));
     throw std::logic_error(fmt::format("algorithm '{}' produced an invalid plant: {}", spec.algorithm, bad));
+  }
   organ_pass(spec, organ_options, organ_params, mesher, st, timer, rec);
   if (plant_out) *plant_out = st.styled ? *st.styled : plant;
   mesh_export_measure(spec, mesher, st, timer, rec);

@@ -35,7 +35,8 @@ nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const P
 // Whether a failure is memory running out, whichever library noticed it: std::bad_alloc, or Embree's
 // RTC_ERROR_OUT_OF_MEMORY (as scenes/ reports an Embree error: "Embree: ... (error 4)").
 bool is_out_of_memory(const std::exception& e);
-// What an exception says of how the work ended: invalid_input for an InputError, out_of_memory, else failed.
+// What an exception says of how the work ended: invalid_input for an InputError, plugin_error for a
+// PluginError, out_of_memory, else failed.
 Outcome outcome_of(const std::exception& e);
 
 // The build and machine this binary runs on (commit and dirty flag, compiler, flags, build type,
