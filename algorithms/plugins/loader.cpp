@@ -336,6 +336,15 @@ const AlgorithmEntry& load_plugin(const std::string& given) {
   return l.entry;
 }
 
+// The directories in GROWBENCH_PLUGIN_PATH hold whatever was put there; one bad file must not stop a command
+// that never asked for it, so it is skipped, said on stderr. A plugin a command names (--plugin, a suite's
+// "plugins") is an error instead.
+namespace {
+void warn_skipped(const std::string& why) {
+  fmt::print(stderr, "growbench: warning: GROWBENCH_PLUGIN_PATH: skipped: {}\n", why);
+}
+}  // namespace
+
 void load_plugins(const std::vector<std::string>& paths) {
   for (const auto& p : paths) load_plugin(p);
   const char* env = std::getenv("GROWBENCH_PLUGIN_PATH");
@@ -347,13 +356,19 @@ void load_plugins(const std::vector<std::string>& paths) {
     start = end + 1;
     if (dir.empty()) continue;
     std::error_code ec;
-    if (!fs::is_directory(dir, ec))
-      throw InputError(fmt::format("GROWBENCH_PLUGIN_PATH: '{}' is not a directory", dir));
+    if (!fs::is_directory(dir, ec)) {
+      warn_skipped(fmt::format("'{}' is not a directory", dir));
+      continue;
+    }
     std::vector<std::string> files;
     for (const auto& f : fs::directory_iterator(dir, ec))
       if (f.path().extension() == ".so") files.push_back(f.path().string());
     std::sort(files.begin(), files.end());
-    for (const auto& f : files) load_plugin(f);
+    for (const auto& f : files) try {
+        load_plugin(f);
+      } catch (const InputError& e) {
+        warn_skipped(e.what());
+      }
   }
 }
 

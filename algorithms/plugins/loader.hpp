@@ -24,7 +24,8 @@ const AlgorithmEntry& load_plugin(const std::string& path);
 // duplicates) and test parameters. InputError "PATH: malformed plugin table: ..." naming the row.
 AlgorithmInfo read_plugin_table(const std::string& path, const growbench_plugin& table);
 // Loads `paths` in order, then every *.so in the directories GROWBENCH_PLUGIN_PATH names (separated
-// by ':', each directory's files in name order).
+// by ':', each directory's files in name order). A file there that does not load, or an entry that is not a
+// directory, is a warning on stderr naming it and why, and is skipped.
 void load_plugins(const std::vector<std::string>& paths);
 // The plugins' algorithms, in loading order.
 std::vector<const AlgorithmEntry*> plugin_algorithms();

@@ -122,6 +122,30 @@ TEST(PluginLoader, DirectoriesFromTheEnvironment) {
   EXPECT_NE(found.out.find("line  [plugin]"), std::string::npos) << found.out;
 }
 
+// One bad file in GROWBENCH_PLUGIN_PATH ended every command, even `run -a spacecol`: it is a warning naming it.
+TEST(PluginLoader, ABadFileInTheEnvironmentsDirectoriesIsAWarning) {
+  const fs::path dir = test::temp_dir("plugin_env_bad");
+  fs::copy_file(fixture("abi_99"), dir / "abi_99.so");
+  test::write_text(dir / "notes.so", "not an ELF file\n");
+  fs::copy_file(fixture("line"), dir / "line.so");
+  ::setenv("GROWBENCH_PLUGIN_PATH", (dir.string() + ":/nonexistent/plugins").c_str(), 1);
+  const auto r = test::run_growbench("list line");
+  const auto run = test::run_growbench("run -a spacecol -s wall --max-steps 2 -q -o " +
+                                       test::temp_dir("plugin_env_bad_run").string());
+  ::unsetenv("GROWBENCH_PLUGIN_PATH");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("line  [plugin]"), std::string::npos) << r.out;  // the good one still loads
+  EXPECT_NE(r.out.find("growbench: warning: GROWBENCH_PLUGIN_PATH: skipped: " + (dir / "abi_99.so").string() +
+                       ": built for plugin ABI version 99"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("skipped: " + (dir / "notes.so").string() + ": not a loadable shared library"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("skipped: '/nonexistent/plugins' is not a directory"), std::string::npos) << r.out;
+  EXPECT_EQ(run.status, 0) << run.out;
+}
+
 TrialSpec line_spec(const std::string& scene) {
   TrialSpec spec;
   spec.algorithm = "line";
