@@ -311,6 +311,43 @@ TEST(CPlugin, ASuiteRecordsAMisbehavingPluginAndGoesOn) {
   EXPECT_EQ(res.context.plugins[0].path, fs::canonical(dir / "line.so").string());
 }
 
+// A suite's time_limit_s, at the top level and per entry, drives host->cancelled(): a cooperative plugin (fault=hang
+// waits for it) stops and keeps its partial plant, stopped by the time limit, where timeout_s would have killed it.
+// A limit at or past timeout_s, which could never act, is refused.
+TEST(CPlugin, ASuiteTimeLimitCancelsACooperativePluginAndKeepsItsPlant) {
+  const fs::path dir = test::temp_dir("plugin_time_limit");
+  fs::copy_file(fixture("line"), dir / "line.so");
+  test::write_text(dir / "suite.json", R"({"schema_version": 1, "name": "limits", "repetitions": 1, "warmup": 0,
+    "timeout_s": 20, "time_limit_s": 0.4, "plugins": ["line.so"], "scenes": ["wall"], "algorithms": [
+      {"name": "line", "label": "global", "params": {"fault": "hang"}},
+      {"name": "line", "label": "own", "time_limit_s": 0.2, "params": {"fault": "hang"}}]})");
+  const auto r =
+      test::run_growbench(fmt::format("suite {} -o {} -q", (dir / "suite.json").string(), (dir / "out").string()));
+  ASSERT_EQ(r.status, 0) << r.out;
+  const ResultsFile res = read_results((dir / "out" / "results.json").string());
+  ASSERT_EQ(res.trials.size(), 2u);
+  const Scene wall = load_scene("wall");
+  for (const auto& c : res.trials) {
+    EXPECT_EQ(c.status, "ok") << c.label;
+    ASSERT_TRUE(c.results.plant.has_value()) << c.label;
+    EXPECT_EQ(c.results.plant->stopped_by, "time_limit") << c.label;
+    // The first step waited for the cancellation and then grew: a seed node and one more per seed.
+    EXPECT_EQ(c.results.plant->counts.nodes, 2 * wall.seeds.size()) << c.label;
+    ASSERT_TRUE(c.samples.at(0).phases.has_value()) << c.label;
+    const double growth = (*c.samples.at(0).phases)[Phase::growth].value().wall_s;
+    const double limit = c.label == "own" ? 0.2 : 0.4;
+    EXPECT_GE(growth, limit) << c.label;
+    EXPECT_LT(growth, 10.0) << c.label;
+  }
+  test::write_text(dir / "late.json", R"({"schema_version": 1, "name": "late", "timeout_s": 5, "plugins": ["line.so"],
+    "scenes": ["wall"], "algorithms": [{"name": "line", "time_limit_s": 5}]})");
+  const auto late = test::run_growbench(fmt::format("suite {} --plan", (dir / "late.json").string()));
+  EXPECT_EQ(late.status, 2) << late.out;
+  EXPECT_NE(late.out.find("/algorithms/0/time_limit_s: 5 s is not under the suite's timeout_s (5 s)"),
+            std::string::npos)
+      << late.out;
+}
+
 // A trial that failed for want of disk space was journaled as failed, and --resume on a disk with room never
 // ran it again: the suite stops with 2 before journaling it, and the resumed run grows it.
 TEST(CPlugin, ATrialStarvedOfDiskRunsAgainOnResumeWithTheSamePlugin) {

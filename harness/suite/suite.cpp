@@ -157,6 +157,7 @@ class SuiteReader : public JsonPathReader {
   struct Common {
     TrialSpec spec;  // its settings
     std::vector<std::uint64_t> seeds = {1};
+    double timeout_s = 0.0;  // the suite's
   };
   struct SceneEntry {
     std::string spec, name;
@@ -202,7 +203,9 @@ class SuiteReader : public JsonPathReader {
       s.memory_limit_bytes = static_cast<std::uint64_t>(number(j["memory_limit_mb"], "/memory_limit_mb", 64, 1e7))
                              << 20;
     Common c;
+    c.timeout_s = s.timeout_s;
     read_settings_into(j, "", c.spec);
+    check_time_limit(c.spec, "", c.timeout_s);
     if (j.contains("seeds")) {
       if (!j["seeds"].is_array() || j["seeds"].empty()) fail("/seeds", "expected a non-empty array of seeds");
       c.seeds.clear();
@@ -225,6 +228,17 @@ class SuiteReader : public JsonPathReader {
   void read_settings_into(const json& j, const std::string& path, TrialSpec& spec) const {
     for (const char* key : kSettings)
       if (j.contains(key)) read_spec_field(spec, key, j[key], file(), fmt::format("{}/{}", path, key));
+  }
+
+  // time_limit_s is what drives an algorithm's cancellation (host->cancelled() for a plugin): it stops growth
+  // and keeps the plant. timeout_s kills the trial's process and loses it, so a limit at or past the timeout
+  // would never be reached.
+  void check_time_limit(const TrialSpec& spec, const std::string& path, double timeout_s) const {
+    if (spec.time_limit_s > 0.0 && spec.time_limit_s >= timeout_s)
+      fail(path + "/time_limit_s",
+           fmt::format("{} s is not under the suite's timeout_s ({} s): the trial would be killed, and its plant lost, "
+                       "before the time limit stops growth",
+                       spec.time_limit_s, timeout_s));
   }
 
   std::vector<SceneEntry> read_scenes(const json& j) const {
@@ -284,6 +298,7 @@ class SuiteReader : public JsonPathReader {
       a.name = e["name"].get<std::string>();
       a.label = name_field(e, path, "label", "", "the entry's label");
       read_settings_into(e, path, a.spec);
+      check_time_limit(a.spec, path, common.timeout_s);
       if (e.contains("fault")) {
         read_spec_field(a.spec, "fault", e["fault"], file(), path + "/fault");
         if (const std::string bad = fault_problem(a.spec.fault); !bad.empty()) fail(path + "/fault", bad);
