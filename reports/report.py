@@ -1204,6 +1204,15 @@ def machine_state_rows(ctx):
     return rows
 
 
+def plugin_rows(ctx):
+    """One context row per plugin the run loaded: which file, which build of it (its content hash), its own
+    version and the ABI it speaks, so that a figure says exactly which program grew it."""
+    return [(f"plugin {p.get('name', '?')}",
+             f"{p.get('path', '?')} (version {p.get('version') or '-'}, ABI {p.get('abi_version', '?')}, "
+             f"xxh3 {p.get('hash', '?')})")
+            for p in ctx.get("plugins", []) if isinstance(p, dict)]
+
+
 def write_html(path, doc, results_path, rows, figs, grids, failed, caption, metrics_doc=None, peers=(), cells=(),
                explore_section=""):
     e = html.escape
@@ -1230,6 +1239,7 @@ def write_html(path, doc, results_path, rows, figs, grids, failed, caption, metr
                  *machine_state_rows(ctx),
                  ("build", f"{ctx.get('compiler', '?')}, {ctx.get('build_type', '?')}, flags '{ctx.get('cxx_flags', '').strip()}'"),
                  ("libraries", ", ".join(f"{k} {v}" for k, v in deps.items())),
+                 *plugin_rows(ctx),
                  ("repetitions", f"{doc.get('repetitions', '?')} per cell, each trial in its own process"),
                  ("renders", f"POV-Ray {renders.get('quality', '-')} ({renders.get('povray', 'not rendered')}), "
                              f"{renders.get('ok', 0)} ok, {renders.get('failed', 0)} failed" if renders else "not rendered")]:

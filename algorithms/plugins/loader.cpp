@@ -315,10 +315,18 @@ void check_name_free(const std::string& path, const std::string& name) {
 
 }  // namespace
 
-const AlgorithmEntry& load_plugin(const std::string& given) {
+namespace {
+
+std::string canonical_path(const std::string& given) {
   std::error_code ec;
   const fs::path abs = fs::weakly_canonical(fs::absolute(given, ec), ec);
-  const std::string path = abs.empty() ? given : abs.string();
+  return abs.empty() ? given : abs.string();
+}
+
+}  // namespace
+
+const AlgorithmEntry& load_plugin(const std::string& given) {
+  const std::string path = canonical_path(given);
   for (const auto& l : loaded())
     if (l.path == path) return l.entry;
   probe_in_child(path);
@@ -376,6 +384,16 @@ std::vector<const AlgorithmEntry*> plugin_algorithms() {
   std::vector<const AlgorithmEntry*> v;
   for (const auto& l : loaded()) v.push_back(&l.entry);
   return v;
+}
+
+PluginOrigin describe_plugin(const std::string& given) {
+  const std::string path = canonical_path(given);
+  for (const auto& l : loaded())
+    if (l.path == path) return *l.entry.plugin;
+  probe_in_child(path);
+  const growbench_plugin* t = open_plugin(path);
+  const AlgorithmInfo info = read_plugin_table(path, *t);
+  return PluginOrigin{info.name, path, file_hash(path), t->abi_version, text_or_empty(t->version)};
 }
 
 std::vector<PluginOrigin> loaded_plugins() {

@@ -29,6 +29,9 @@ AlgorithmInfo read_plugin_table(const std::string& path, const growbench_plugin&
 void load_plugins(const std::vector<std::string>& paths);
 // The plugins' algorithms, in loading order.
 std::vector<const AlgorithmEntry*> plugin_algorithms();
+// Where the plugin at `path` comes from (its name, file hash, ABI and own version), read as load_plugin reads
+// it but without registering it: for a plugin another process runs (ab's side B). Same errors.
+PluginOrigin describe_plugin(const std::string& path);
 // Where each loaded plugin came from, in loading order (what a run's context records).
 std::vector<PluginOrigin> loaded_plugins();
 

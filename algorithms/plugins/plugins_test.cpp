@@ -11,7 +11,9 @@
 #include <gtest/gtest.h>
 
 #include "algorithms/plugins/loader.hpp"
+#include "core/file_hash.hpp"
 #include "core/memory.hpp"
+#include "harness/record/files.hpp"
 #include "harness/record/record.hpp"
 #include "harness/run/trial.hpp"
 #include "scenes/scene_library.hpp"
@@ -346,6 +348,38 @@ TEST(CPlugin, ASuiteTimeLimitCancelsACooperativePluginAndKeepsItsPlant) {
   EXPECT_NE(late.out.find("/algorithms/0/time_limit_s: 5 s is not under the suite's timeout_s (5 s)"),
             std::string::npos)
       << late.out;
+}
+
+// ab.json named no plugin for side B: each side lists its plugins with path, hash, ABI and version, B's being
+// --plugin-b's files (here a copy of the plugin with a byte appended: another build of the same name).
+TEST(PluginAb, AbJsonNamesEachSidesPluginBuild) {
+  const fs::path dir = test::temp_dir("plugin_ab");
+  fs::copy_file(fixture("line"), dir / "line.so");
+  fs::copy_file(fixture("line"), dir / "line_b.so");
+  std::ofstream(dir / "line_b.so", std::ios::app | std::ios::binary) << '\n';
+  test::write_text(dir / "suite.json", R"({"schema_version": 1, "name": "ab_plugins", "timeout_s": 60,
+    "scenes": ["wall"], "algorithms": [{"name": "line", "params": {"length": 4}}]})");
+  const std::string g = GROWBENCH_BINARY;
+  const auto r = test::run_growbench(fmt::format(
+      "ab {} {} {} --plugin {} --plugin-b {} --min-reps 3 --max-reps 3 --no-confirm -q -o {}", g, g,
+      (dir / "suite.json").string(), (dir / "line.so").string(), (dir / "line_b.so").string(), (dir / "out").string()));
+  ASSERT_NE(r.status, 2) << r.out;
+  const nlohmann::json ab = read_json_file((dir / "out" / "ab.json").string());
+  const nlohmann::json& a = ab.at("binaries").at("A").at("plugins");
+  const nlohmann::json& b = ab.at("binaries").at("B").at("plugins");
+  ASSERT_EQ(a.size(), 1u) << ab.dump();
+  ASSERT_EQ(b.size(), 1u) << ab.dump();
+  EXPECT_EQ(a[0].at("path"), fs::canonical(dir / "line.so").string());
+  EXPECT_EQ(b[0].at("path"), fs::canonical(dir / "line_b.so").string());
+  EXPECT_EQ(a[0].at("hash"), file_hash((dir / "line.so").string()));
+  EXPECT_EQ(b[0].at("hash"), file_hash((dir / "line_b.so").string()));
+  EXPECT_NE(a[0].at("hash"), b[0].at("hash"));
+  EXPECT_EQ(b[0].at("name"), "line");
+  EXPECT_EQ(b[0].at("abi_version"), 1);
+  EXPECT_NE(r.out.find(fmt::format("B plugins: line {} (xxh3 {})", fs::canonical(dir / "line_b.so").string(),
+                                   b[0].at("hash").get<std::string>())),
+            std::string::npos)
+      << r.out;
 }
 
 // A trial that failed for want of disk space was journaled as failed, and --resume on a disk with room never

@@ -18,6 +18,7 @@
 #include "harness/run/process.hpp"
 #include "harness/stats/stats.hpp"
 #include "harness/run/trial.hpp"
+#include "algorithms/plugins/loader.hpp"
 
 namespace growbench {
 namespace {
@@ -306,7 +307,17 @@ void judge_cell(const Cell& cell, const std::vector<std::string>& metrics, const
 }
 
 // The table: a header, the cells' rows, then how to read it and the tally.
-std::string table_of(const Findings& f, const Binaries& bins, int trials_run, const AbOptions& o) {
+// "NAME (xxh3 HASH), ..." for a side's plugins, or nothing.
+std::string plugins_line(const char* side, const json& plugins) {
+  std::string s;
+  for (const auto& p : plugins)
+    s += fmt::format("{}{} {} (xxh3 {})", s.empty() ? "" : ", ", p.at("name").get<std::string>(),
+                     p.at("path").get<std::string>(), p.at("hash").get<std::string>());
+  return s.empty() ? "" : fmt::format("{} plugins: {}\n", side, s);
+}
+
+std::string table_of(const Findings& f, const Binaries& bins, const std::array<json, 2>& plugins, int trials_run,
+                     const AbOptions& o) {
   std::string table =
       fmt::format("{:<30} {:<14} {:>3} {:>10} {:>10} {:>22} {:>7} {:>22} {:>7}  {}\n", "cell", "metric", "n",
                   "A median", "B median", "B/A [95% CI]", "p MW", "pairs B/A [95% CI]", "p pairs", "verdict");
@@ -314,27 +325,40 @@ std::string table_of(const Findings& f, const Binaries& bins, int trials_run, co
   std::string counts;
   for (const auto& [k, n] : f.tally) counts += fmt::format("{}{} {}", counts.empty() ? "" : ", ", n, k);
   table += fmt::format(
-      "\nA = {}\nB = {}\n{} trials in pairs, A B and B A alternately. A metric is flagged when p < {} and the median "
+      "\nA = {}\nB = {}\n{}{}{} trials in pairs, A B and B A alternately. A metric is flagged when p < {} and the "
+      "median "
       "ratio is beyond {:.2f} with its bootstrap 95% interval excluding 1, either for the two samples (Mann-Whitney) "
       "or for "
       "the pairs' ratios (Wilcoxon signed-rank; drift that moves both sides of a pair cancels there); a flagged cell "
       "is "
       "rerun and counts only if the rerun flags it again. 'no change': an interval within [1/{:.2f}, {:.2f}].\n{}\n"
       "verdict: {}\n",
-      bins[0], bins[1], trials_run, o.alpha, o.effect, o.effect, o.effect, counts,
-      f.regression ? "REGRESSION (B is slower, confirmed)" : "no confirmed regression");
+      bins[0], bins[1], plugins_line("A", plugins[0]), plugins_line("B", plugins[1]), trials_run, o.alpha, o.effect,
+      o.effect, o.effect, counts, f.regression ? "REGRESSION (B is slower, confirmed)" : "no confirmed regression");
   return table;
 }
 
-// ab.json: what ran, with which binaries and options, and every cell's samples and verdicts.
-json doc_of(Findings&& f, const Suite& suite, const AbOptions& o, const Binaries& bins, const fs::path& out,
-            int trials_run) {
+// The plugins side `s` runs, each with its file's hash, ABI and version: this process's (the suite's and
+// --plugin's), or for side B the --plugin-b files when given.
+json plugins_of_side(const AbOptions& o, int s) {
+  json out = json::array();
+  if (s == 1 && !o.b_plugins.empty()) {
+    for (const auto& p : o.b_plugins) out.push_back(to_json(describe_plugin(p)));
+  } else {
+    for (const auto& p : loaded_plugins()) out.push_back(to_json(p));
+  }
+  return out;
+}
+
+// ab.json: what ran, with which binaries, plugins and options, and every cell's samples and verdicts.
+json doc_of(Findings&& f, const Suite& suite, const AbOptions& o, const Binaries& bins,
+            const std::array<json, 2>& plugins, const fs::path& out, int trials_run) {
   json doc = {{"kind", "growbench-ab"},
               {"schema_version", 1},
               {"suite", {{"name", suite.name}, {"file", suite.file}, {"hash", suite.hash}}},
               {"binaries",
-               {{"A", {{"path", bins[0]}, {"version", version_of(bins[0], out)}}},
-                {"B", {{"path", bins[1]}, {"version", version_of(bins[1], out)}}}}},
+               {{"A", {{"path", bins[0]}, {"version", version_of(bins[0], out)}, {"plugins", plugins[0]}}},
+                {"B", {{"path", bins[1]}, {"version", version_of(bins[1], out)}, {"plugins", plugins[1]}}}}},
               {"options",
                {{"effect", o.effect},
                 {"alpha", o.alpha},
@@ -359,6 +383,7 @@ AbResult run_ab(const Suite& suite, const AbOptions& o) {
   const fs::path out = o.out_dir.empty() ? fs::path("out/ab") / suite.name : fs::path(o.out_dir);
   const FolderLock lock = FolderLock::take(out.string(), "ab");
   const Binaries bins = {fs::absolute(o.a_binary).string(), fs::absolute(o.b_binary).string()};
+  const std::array<json, 2> plugins = {plugins_of_side(o, 0), plugins_of_side(o, 1)};  // B's checked before trials
   std::vector<Cell> cells = make_cells(suite, out, o.b_plugins);
 
   Trials trials(suite, o, bins, cells);
@@ -375,8 +400,8 @@ AbResult run_ab(const Suite& suite, const AbOptions& o) {
   for (const Cell& cell : cells) judge_cell(cell, trials.metrics(), o, f);
   AbResult res;
   res.regression = f.regression;
-  res.table = table_of(f, bins, trials.trials_run(), o);
-  res.doc = doc_of(std::move(f), suite, o, bins, out, trials.trials_run());
+  res.table = table_of(f, bins, plugins, trials.trials_run(), o);
+  res.doc = doc_of(std::move(f), suite, o, bins, plugins, out, trials.trials_run());
   write_file_atomic((out / "ab.json").string(), json_text(res.doc, 1));
   return res;
 }

@@ -52,6 +52,7 @@ std::string CompareResult::table() const {
       fmt::format("{} cells compared, {} changed quantities, {} failing, {} missing cells: {}\n", cells_compared,
                   changes.size(), failing, missing_cells.size(), fails() ? "REGRESSION" : "OK");
   std::string out = verdict;
+  for (const auto& n : plugin_notes) out += n + "\n";
   if (!changes.empty() || !missing_cells.empty() || !new_cells.empty() || small_changes > 0 || !timings.empty())
     out += "\n";
   std::size_t wc = 4, wq = 8, wv = 3;
@@ -107,6 +108,39 @@ struct GateCell {
   BaselineCell cell;
   const std::vector<SuiteSample>* samples = nullptr;
 };
+
+const std::vector<PluginOrigin>& plugins_of(const GateFile& f) {
+  if (const auto* r = std::get_if<ResultsFile>(&f)) return r->context.plugins;
+  return std::get<Baseline>(f).context.plugins;
+}
+
+// What differs between the plugins two runs loaded, by algorithm name: a plugin that is another build (its
+// file's hash) or another ABI or version, or that only one side loaded. A note, not a failure: the cells say
+// whether the plants changed.
+std::vector<std::string> plugin_notes(const GateFile& base, const GateFile& now) {
+  std::vector<std::string> notes;
+  std::map<std::string, const PluginOrigin*> after;
+  for (const auto& p : plugins_of(now)) after[p.name] = &p;
+  for (const auto& b : plugins_of(base)) {
+    const auto it = after.find(b.name);
+    if (it == after.end()) {
+      notes.push_back(
+          fmt::format("plugin {}: loaded in the base ({}, xxh3 {}), not in the new results", b.name, b.path, b.hash));
+      continue;
+    }
+    const PluginOrigin& n = *it->second;
+    if (n.hash != b.hash || n.abi_version != b.abi_version || n.version != b.version)
+      notes.push_back(
+          fmt::format("plugin {}: another build: base {} (version {}, ABI {}, xxh3 {}), new {} (version {}, "
+                      "ABI {}, xxh3 {})",
+                      b.name, b.path, b.version, b.abi_version, b.hash, n.path, n.version, n.abi_version, n.hash));
+    after.erase(it);
+  }
+  for (const auto& [name, n] : after)
+    notes.push_back(
+        fmt::format("plugin {}: loaded in the new results ({}, xxh3 {}), not in the base", name, n->path, n->hash));
+  return notes;
+}
 
 std::vector<GateCell> gate_cells(const GateFile& f) {
   std::vector<GateCell> out;
@@ -253,6 +287,7 @@ CompareResult compare_results(const GateFile& base, const GateFile& now, const C
   }
   for (const auto& [id, t] : now_cells)
     if (!seen.count(id)) r.new_cells.push_back(id);
+  r.plugin_notes = plugin_notes(base, now);
   return r;
 }
 

@@ -50,7 +50,8 @@ struct CompareResult {
   std::vector<Change> changes;            // every changed quantity, failing or not
   std::size_t cells_compared = 0;
   std::vector<std::string> missing_cells, new_cells;
-  std::size_t small_changes = 0;  // instruction changes under 0.1% and the floor, counted but not listed
+  std::vector<std::string> plugin_notes;  // plugins of another build, or loaded on one side only
+  std::size_t small_changes = 0;          // instruction changes under 0.1% and the floor, counted but not listed
   [[nodiscard]] bool fails() const;
   // A readable table of the changes and a one-line verdict.
   [[nodiscard]] std::string table() const;

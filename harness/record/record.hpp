@@ -724,6 +724,7 @@ struct ResultsFile {
 struct BaselineContext {
   std::string growbench_commit, dirty, compiler, cxx_flags, build_type;
   nlohmann::json dependencies = nlohmann::json::object();
+  std::vector<PluginOrigin> plugins;  // so that compare can say a plugin is another build
 
   static constexpr std::string_view kSchemaName = "baseline_context";
   static constexpr auto fields() {
@@ -734,7 +735,8 @@ struct BaselineContext {
         field("compiler", &B::compiler),
         field("cxx_flags", &B::cxx_flags),
         field("build_type", &B::build_type),
-        field("dependencies", &B::dependencies).refine(R"({"additionalProperties": {"type": ["string", "number"]}})")};
+        field("dependencies", &B::dependencies).refine(R"({"additionalProperties": {"type": ["string", "number"]}})"),
+        field("plugins", &B::plugins).with(kOmitEmpty)};
   }
 };
 

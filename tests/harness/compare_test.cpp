@@ -61,6 +61,35 @@ TEST(Compare, AnyBehaviourChangeFails) {
   }
 }
 
+// compare said nothing when a plugin was another build: it names the plugin, both files and both hashes, and
+// says a plugin loaded on one side only. A note, not a failure: the cells say whether the plants changed.
+TEST(Compare, SaysWhenAPluginIsAnotherBuild) {
+  auto with_plugins = [](json plugins) {
+    json r = results({cell("walker/wall/s1")});
+    r["context"] = {{"plugins", std::move(plugins)}};
+    return r;
+  };
+  auto origin = [](const std::string& name, const std::string& path, const std::string& hash) {
+    return json{{"name", name}, {"path", path}, {"hash", hash}, {"abi_version", 1}, {"version", "1.0"}};
+  };
+  const json a = with_plugins(
+      {origin("walker", "/a/walker.so", "00000000000000aa"), origin("dla", "/a/dla.so", "00000000000000dd")});
+  const json b = with_plugins(
+      {origin("walker", "/b/walker.so", "00000000000000bb"), origin("line", "/b/line.so", "00000000000000cc")});
+  const auto r = compare_results(a, b);
+  EXPECT_FALSE(r.fails());
+  EXPECT_EQ(r.plugin_notes,
+            (std::vector<std::string>{
+                "plugin walker: another build: base /a/walker.so (version 1.0, ABI 1, xxh3 "
+                "00000000000000aa), new /b/walker.so (version 1.0, ABI 1, xxh3 00000000000000bb)",
+                "plugin dla: loaded in the base (/a/dla.so, xxh3 00000000000000dd), not in the new results",
+                "plugin line: loaded in the new results (/b/line.so, xxh3 00000000000000cc), not in the base"}));
+  EXPECT_NE(r.table().find("plugin walker: another build"), std::string::npos) << r.table();
+  // A baseline keeps the plugins, so the note survives `baseline update`.
+  EXPECT_EQ(compare_results(baseline_of(a), b).plugin_notes.size(), 3u);
+  EXPECT_TRUE(compare_results(a, a).plugin_notes.empty());
+}
+
 TEST(Compare, TimingsAreJudgedAndReportedButNeverFail) {
   // Ten repetitions each: growth 10 ms +-1% against 11 ms +-1% (slower), and an unchanged cell.
   auto timed = [](const std::string& id, double centre) {

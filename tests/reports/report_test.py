@@ -433,6 +433,16 @@ class Page(unittest.TestCase):
         self.assertNotIn("machine-banner", page)
         self.assertNotIn("load average", page)
 
+    def test_the_context_names_each_plugin_with_its_build(self):
+        ctx = {"hardware_threads": 2, "cpu_model": "test",
+               "plugins": [{"name": "walker", "path": "/home/r/walker.so", "hash": "0123456789abcdef",
+                            "abi_version": 1, "version": "1.2"}]}
+        page, _ = self.write(document([trial("walker", "wall", 1, [0.01], 1000)], ctx))
+        self.assertIn("<tr><th>plugin walker</th><td>/home/r/walker.so (version 1.2, ABI 1, xxh3 0123456789abcdef)"
+                      "</td></tr>", page)
+        page, _ = self.write(document([trial("a", "wall", 1, [0.01], 1000)], {"hardware_threads": 2}))
+        self.assertNotIn("<th>plugin ", page)
+
     def test_a_results_file_names_only_its_own_renders(self):
         # Grids and a trial's render named outside the results folder (absolute, '..', a symlink out) are left
         # out, neither copied nor linked; the folder's own grid is copied. A label of TeX is drawn as text.
