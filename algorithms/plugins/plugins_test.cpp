@@ -382,6 +382,31 @@ TEST(PluginAb, AbJsonNamesEachSidesPluginBuild) {
       << r.out;
 }
 
+// plugin-test gives an outside author the conformance checks the built-ins pass: a working plugin passes them;
+// a plant that differs from process to process fails determinism and the thread check, and an invalid plant
+// fails validity, each named with what was seen, and the command exits 2.
+TEST(PluginTest, RunsTheBuiltInsConformanceChecksOnAPlugin) {
+  const std::string p = fixture("line");
+  const auto ok = test::run_growbench("plugin-test " + p + " -s wall -s boulder -q");
+  EXPECT_EQ(ok.status, 0) << ok.out;
+  EXPECT_NE(ok.out.find("plugin-test line: passed on all 2 scenes"), std::string::npos) << ok.out;
+  for (const char* check : {"valid plant", "grows", "one tree per seed", "no node inside a solid", "1 and 2 threads",
+                            "deterministic", "stops at its time limit"})
+    EXPECT_NE(ok.out.find(fmt::format("  ok   {:<24}", check)), std::string::npos) << check << "\n" << ok.out;
+
+  const auto moved = test::run_growbench("plugin-test " + p + " -s wall -q --set fault=by_process");
+  EXPECT_EQ(moved.status, 2) << moved.out;
+  EXPECT_NE(moved.out.find("  FAIL 1 and 2 threads          geometry hash "), std::string::npos) << moved.out;
+  EXPECT_NE(moved.out.find("  FAIL deterministic            geometry hash "), std::string::npos) << moved.out;
+  EXPECT_NE(moved.out.find("plugin-test line: failed on 1 of 1 scenes: wall"), std::string::npos) << moved.out;
+
+  const auto invalid = test::run_growbench("plugin-test " + p + " -s wall -q --set fault=bad_parent");
+  EXPECT_EQ(invalid.status, 2) << invalid.out;
+  EXPECT_NE(invalid.out.find("  FAIL valid plant              plugin_error: algorithm 'line' (plugin "),
+            std::string::npos)
+      << invalid.out;
+}
+
 // A trial that failed for want of disk space was journaled as failed, and --resume on a disk with room never
 // ran it again: the suite stops with 2 before journaling it, and the resumed run grows it.
 TEST(CPlugin, ATrialStarvedOfDiskRunsAgainOnResumeWithTheSamePlugin) {

@@ -5,7 +5,8 @@
  *    along the seed's direction until `length` nodes or a solid (host->inside) stops it; a leaf at each
  *    tip. Its `fault` parameter makes it crash, hang, exhaust memory or report errors, for the tests of
  *    how a suite records a misbehaving plugin (an exit() it never reports, a message of a megabyte, a flood of stderr,
- * a full disk), give NaN to the queries (nan_query) or hand over an invalid plant (bad_parent, nan_node).
+ * a full disk), give NaN to the queries (nan_query), hand over an invalid plant (bad_parent, nan_node) or
+ * one that differs from process to process (by_process).
  * 1 no entry point; 2 another ABI version; 3 a built-in's name; 4 a malformed parameter table;
  * 5 an entry() that crashes; 6 an entry() that calls exit(0); 7 an entry() that closes every descriptor and
  * waits forever. */
@@ -23,9 +24,9 @@
 #define TEST_PLUGIN_VARIANT 0
 #endif
 
-static const char* const kFaults[] = {"none",      "crash",      "hang",         "oom",   "fail",
-                                      "input",     "exit3",      "long_message", "flood", "disk_full",
-                                      "nan_query", "bad_parent", "nan_node"};
+static const char* const kFaults[] = {"none",      "crash",      "hang",         "oom",       "fail",
+                                      "input",     "exit3",      "long_message", "flood",     "disk_full",
+                                      "nan_query", "bad_parent", "nan_node",     "by_process"};
 enum { kFaultCount = sizeof kFaults / sizeof kFaults[0] };
 
 static const growbench_param kParams[] = {
@@ -97,6 +98,7 @@ static int32_t start(growbench_instance* instance, const growbench_scene* scene,
   for (i = 0; i < scene->seed_count; ++i) {
     growbench_node* n = &s->nodes[s->node_count];
     n->position = scene->seeds[i].position;
+    if (s->fault == 13) n->position.x += 1e-6f * (float)(getpid() % 9973); /* a plant that differs by process */
     n->radius = 0.004f;
     n->parent = -1;
     n->shoot = i;

@@ -88,6 +88,7 @@ Command add_merge(CLI::App& app);
 Command add_baseline(CLI::App& app);  // baseline update
 Command add_report(CLI::App& app);
 Command add_lsystem(CLI::App& app);
+Command add_plugin_test(CLI::App& app);
 Command add_summary(CLI::App& app);
 Command add_schema(CLI::App& app);  // internal: not listed in --help
 

@@ -82,11 +82,11 @@ int main(int argc, char** argv) {
       return fmt::format("growbench: error: {}\nRun `{} --help` for more information.\n", e.what(), help);
     });
     // In the order --help lists them (a braced list is evaluated in order).
-    const cli::Command commands[] = {cli::add_list(app),    cli::add_scenes(app),   cli::add_run(app),
-                                     cli::add_suite(app),   cli::add_history(app),  cli::add_render(app),
-                                     cli::add_trial(app),   cli::add_ab(app),       cli::add_compare(app),
-                                     cli::add_merge(app),   cli::add_baseline(app), cli::add_report(app),
-                                     cli::add_lsystem(app), cli::add_summary(app),  cli::add_schema(app)};
+    const cli::Command commands[] = {
+        cli::add_list(app),    cli::add_scenes(app),  cli::add_run(app),         cli::add_suite(app),
+        cli::add_history(app), cli::add_render(app),  cli::add_trial(app),       cli::add_ab(app),
+        cli::add_compare(app), cli::add_merge(app),   cli::add_baseline(app),    cli::add_report(app),
+        cli::add_lsystem(app), cli::add_summary(app), cli::add_plugin_test(app), cli::add_schema(app)};
     one_value_per_use(app);
     try {
       app.parse(argc, argv);
