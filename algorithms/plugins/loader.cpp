@@ -213,11 +213,11 @@ const growbench_plugin* open_plugin(const std::string& path) {
   const auto entry = reinterpret_cast<growbench_plugin_entry_fn>(sym);
   const growbench_plugin* t = entry();
   if (!t) throw InputError(fmt::format("{}: {}() returned NULL", path, GROWBENCH_PLUGIN_ENTRY_SYMBOL));
-  if (t->abi_version != GROWBENCH_PLUGIN_ABI_VERSION)
+  if (t->abi_version < GROWBENCH_PLUGIN_ABI_OLDEST || t->abi_version > GROWBENCH_PLUGIN_ABI_VERSION)
     throw InputError(
-        fmt::format("{}: built for plugin ABI version {}, but this growbench speaks version {}; rebuild "
+        fmt::format("{}: built for plugin ABI version {}, but this growbench speaks versions {} to {}; rebuild "
                     "it against this growbench's SDK",
-                    path, t->abi_version, GROWBENCH_PLUGIN_ABI_VERSION));
+                    path, t->abi_version, GROWBENCH_PLUGIN_ABI_OLDEST, GROWBENCH_PLUGIN_ABI_VERSION));
   return t;
 }
 

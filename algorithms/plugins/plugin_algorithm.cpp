@@ -2,13 +2,21 @@
 // C functions, and its plant copied back into a Plant.
 #include "algorithms/plugins/plugin_algorithm.hpp"
 
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstddef>
 #include <mutex>
 #include <new>
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
 
+#include "algorithms/organ_shapes.hpp"
 #include "algorithms/plugins/abi_convert.hpp"
 #include "core/errors.hpp"
 #include "core/outcome.hpp"
@@ -209,9 +217,7 @@ class PluginAlgorithm final : public GrowthAlgorithm {
   }
 
   void copy_plant(const growbench_plant_view& v) const {
-    auto bad = [&](const std::string& what) {
-      return PluginError(fmt::format("{} returned a malformed plant: {}", who_, what));
-    };
+    auto bad = [&](const std::string& what) { return malformed(what); };
     if ((v.node_count && !v.nodes) || (v.organ_count && !v.organs)) throw bad("a NULL array with a non-zero count");
     plant_.clear();
     plant_.nodes.reserve(v.node_count);
@@ -235,6 +241,16 @@ class PluginAlgorithm final : public GrowthAlgorithm {
       g.stamp = {o.stamp[0], o.stamp[1], o.stamp[2]};
       plant_.organs.push_back(g);
     }
+    copy_polygons(v);
+    if (t_->abi_version >= 2) copy_styles(v);
+  }
+
+  [[nodiscard]] PluginError malformed(const std::string& what) const {
+    return PluginError(fmt::format("{} returned a malformed plant: {}", who_, what));
+  }
+
+  void copy_polygons(const growbench_plant_view& v) const {
+    auto bad = [&](const std::string& what) { return malformed(what); };
     if (v.polygon_count == 0) return;
     if (!v.polygon_offsets || !v.polygon_vertices) throw bad("polygons without their arrays");
     if (v.polygon_offsets[0] != 0) throw bad("polygon_offsets[0] is not 0");
@@ -247,9 +263,61 @@ class PluginAlgorithm final : public GrowthAlgorithm {
     }
   }
 
+  // Version 2's organ shapes and tints and named node attributes, checked as a built-in's are where they enter.
+  void copy_styles(const growbench_plant_view& v) const {
+    if ((v.organ_shape_count && !v.organ_shapes) || (v.node_attribute_count && !v.node_attributes))
+      throw malformed("a NULL array with a non-zero count");
+    for (std::uint32_t k = 0; k < v.organ_shape_count; ++k) {
+      if (!v.organ_shapes[k]) throw malformed(fmt::format("organ shape {} is NULL", k));
+      plant_.organ_shapes.emplace_back(v.organ_shapes[k]);
+    }
+    if (plant_.organ_shapes != checked_shapes_) {  // a shape is parsed (an OBJ read) once, not every step
+      try {
+        for (const auto& s : plant_.organ_shapes) (void)organ_shape_named(s, "organ_shapes");
+      } catch (const InputError& e) {
+        throw malformed(e.what());
+      }
+      checked_shapes_ = plant_.organ_shapes;
+    }
+    for (std::uint64_t i = 0; i < plant_.organs.size(); ++i) {
+      if (v.organ_shape) plant_.organs[i].shape = v.organ_shape[i];
+      if (v.organ_tint) plant_.organs[i].tint = abi::of(v.organ_tint[i]);
+    }
+    for (std::uint32_t k = 0; k < v.node_attribute_count; ++k) plant_.node_attributes.push_back(attribute(v, k));
+  }
+
+  [[nodiscard]] NodeAttribute attribute(const growbench_plant_view& v, std::uint32_t k) const {
+    const growbench_attribute& a = v.node_attributes[k];
+    const std::string name = a.name ? a.name : "";
+    const bool named = !name.empty() && name.size() <= 64 &&
+                       (std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_') &&
+                       std::all_of(name.begin(), name.end(),
+                                   [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
+    if (!named)
+      throw malformed(
+          fmt::format("node attribute {} is named '{}' (expected a letter or '_', then letters, digits "
+                      "and '_', at most 64 bytes)",
+                      k, escape_utf8(name)));
+    for (const auto& b : plant_.node_attributes)
+      if (b.name == name) throw malformed(fmt::format("node attribute '{}' is given twice", name));
+    if (a.components < 1 || a.components > 4 || (name == "Cd" && a.components != 3))
+      throw malformed(
+          fmt::format("node attribute '{}' has {} components (expected 1 to 4, and 3 for Cd)", name, a.components));
+    if (v.node_count && !a.values) throw malformed(fmt::format("node attribute '{}' has no values", name));
+    NodeAttribute out{name, static_cast<int>(a.components), {}};
+    out.values.assign(a.values, a.values + v.node_count * a.components);
+    for (std::size_t i = 0; i < out.values.size(); ++i)
+      if (!std::isfinite(out.values[i]) || (name == "Cd" && (out.values[i] < 0.0f || out.values[i] > 4.0f)))
+        throw malformed(fmt::format("node attribute '{}' has value {} at node {}{}", name, out.values[i],
+                                    i / a.components,
+                                    name == "Cd" ? " (expected finite, in [0, 4])" : " (expected finite)"));
+    return out;
+  }
+
   const growbench_plugin* t_;
   const AlgorithmInfo& info_;
-  std::string who_;  // "algorithm 'NAME' (plugin PATH)", what its failures say
+  std::string who_;                                  // "algorithm 'NAME' (plugin PATH)", what its failures say
+  mutable std::vector<std::string> checked_shapes_;  // organ shapes already found valid
   growbench_instance* inst_ = nullptr;
   const HostQueries* q_ = nullptr;
   std::uint64_t seed_ = 0;
@@ -281,6 +349,16 @@ struct HostFunctions {
     if (a.failure_.empty()) a.failure_ = message ? message : "";
   }
   static std::int32_t cancelled(void* c) { return self(c).cancelled() ? 1 : 0; }
+  // The trial's thread count limits TBB already (its global_control); halving to `grain` with the simple
+  // partitioner makes the chunks a function of the range alone.
+  static void parallel_for(void*, std::uint64_t begin, std::uint64_t end, std::uint64_t grain,
+                           void (*body)(void*, std::uint64_t, std::uint64_t), void* user) {
+    if (end <= begin || !body) return;
+    const std::uint64_t g = grain > 0 ? grain : std::max<std::uint64_t>(1, (end - begin) / 64);
+    tbb::parallel_for(
+        tbb::blocked_range<std::uint64_t>(begin, end, g),
+        [&](const tbb::blocked_range<std::uint64_t>& r) { body(user, r.begin(), r.end()); }, tbb::simple_partitioner());
+  }
   static std::uint64_t random_bits(void* c, std::uint64_t stream, std::uint64_t counter) {
     return growbench::random_bits(self(c).seed_, stream, counter);
   }
@@ -333,8 +411,10 @@ struct HostFunctions {
 
 void PluginAlgorithm::make_host() {
   host_ = {};
-  host_.abi_version = GROWBENCH_PLUGIN_ABI_VERSION;
-  host_.struct_size = sizeof(growbench_host);
+  // A version-1 plugin is given the table a version-1 host gave: its version, and its size.
+  const bool v1 = t_->abi_version < 2;
+  host_.abi_version = v1 ? t_->abi_version : GROWBENCH_PLUGIN_ABI_VERSION;
+  host_.struct_size = v1 ? offsetof(growbench_host, parallel_for) : sizeof(growbench_host);
   host_.context = this;
   host_.threads =
       static_cast<std::uint32_t>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
@@ -350,6 +430,7 @@ void PluginAlgorithm::make_host() {
   host_.inside_shape = &HostFunctions::inside_shape;
   host_.sample_surface = &HostFunctions::sample_surface;
   host_.light_visible = &HostFunctions::light_visible;
+  if (!v1) host_.parallel_for = &HostFunctions::parallel_for;
 }
 
 }  // namespace

@@ -57,8 +57,9 @@ TEST(PluginLoader, ALibraryWithoutTheEntryPoint) {
 
 TEST(PluginLoader, AnotherAbiVersionSaysBoth) {
   const std::string p = copy_of("abi_99", "abi_99");
-  EXPECT_EQ(load_error(p), p + ": built for plugin ABI version 99, but this growbench speaks version 1; rebuild it "
-                               "against this growbench's SDK");
+  EXPECT_EQ(load_error(p),
+            p + ": built for plugin ABI version 99, but this growbench speaks versions 1 to 2; rebuild it "
+                "against this growbench's SDK");
 }
 
 TEST(PluginLoader, TheNameOfABuiltIn) {
@@ -179,6 +180,58 @@ TEST(CPlugin, GrowsAndItsRecordNamesThePlugin) {
   EXPECT_TRUE(std::regex_match(o.hash, std::regex("[0-9a-f]{16}"))) << o.hash;
   EXPECT_EQ(o.abi_version, 1u);
   EXPECT_EQ(o.version, "1");
+}
+
+// A version-1 plugin still loads under the version-2 host, is given version 1's host table (the plugin checks
+// it), and grows the plant it grew under the version-1 host: these hashes are what that host recorded.
+TEST(CPlugin, AVersionOnePluginGrowsTheSamePlantAsBefore) {
+  for (const auto& [scene, hash] : std::vector<std::pair<std::string, std::string>>{{"wall", "f07bc76b318c4df5"},
+                                                                                    {"boulder", "476908631602603f"}}) {
+    TrialSpec spec = line_spec(scene);
+    spec.metrics = true;
+    const TrialRecord r = run_trial_record(spec);
+    EXPECT_EQ(r.results.geometry_hash, hash) << scene;
+    ASSERT_TRUE(r.context.has_value());
+    EXPECT_EQ(r.context->plugins.at(0).abi_version, 1u);
+  }
+}
+
+// Version 2 carries what only built-ins could give: organ shapes and tints, named per-node attributes (here
+// computed with the host's parallel_for), into the plant, its PLY and its skeleton, the same for 1 and 2 threads.
+TEST(CPlugin, VersionTwoCarriesOrganShapesTintsAndNodeAttributes) {
+  TrialSpec spec = line_spec("wall");
+  spec.algorithm = "line_v2";
+  spec.plugins = {fixture("line_v2")};
+  spec.threads = 1;
+  Plant one, two;
+  const TrialRecord r1 = run_trial_record(spec, {}, &one);
+  spec.threads = 2;
+  spec.out_dir = test::temp_dir("plugin_v2").string();
+  const TrialRecord r2 = run_trial_record(spec, {}, &two);
+  EXPECT_EQ(r1.results.geometry_hash, r2.results.geometry_hash);
+  EXPECT_EQ(r1.context->plugins.at(0).abi_version, 2u);
+  EXPECT_EQ(one.organ_shapes, std::vector<std::string>{"blossom"});
+  ASSERT_GE(one.organs.size(), 2u);
+  for (std::size_t k = 0; k < one.organs.size(); ++k) {
+    EXPECT_EQ(one.organs[k].shape, k % 2 == 0 ? 0 : kKindShape) << k;
+    EXPECT_EQ(one.organs[k].tint, glm::vec3(1.0f, 0.5f + 0.5f * static_cast<float>(k % 3), 0.25f)) << k;
+  }
+  ASSERT_EQ(one.node_attributes.size(), 2u);
+  EXPECT_EQ(one.node_attributes[0].name, "height");
+  EXPECT_EQ(one.node_attributes[1].name, "Cd");
+  ASSERT_EQ(one.node_attributes[0].values.size(), one.nodes.size());
+  ASSERT_EQ(one.node_attributes[1].values.size(), 3 * one.nodes.size());
+  for (std::size_t i = 0; i < one.nodes.size(); ++i) {  // every chunk of the parallel loop ran
+    EXPECT_EQ(one.node_attributes[0].values[i], one.nodes[i].position.y) << i;
+    EXPECT_EQ(one.node_attributes[1].values[3 * i], 0.2f) << i;
+  }
+  for (const char* file : {"plant.ply", "skeleton.ply"}) {
+    std::ifstream in(fs::path(spec.out_dir) / file, std::ios::binary);
+    std::string header(2048, '\0');
+    in.read(header.data(), static_cast<std::streamsize>(header.size()));
+    EXPECT_NE(header.find("property float height\n"), std::string::npos) << file;
+    EXPECT_NE(header.find("property uchar red\n"), std::string::npos) << file;
+  }
 }
 
 TEST(CPlugin, ItsErrorsKeepTheirKindAndMessage) {

@@ -9,9 +9,12 @@
  * one that differs from process to process (by_process).
  * 1 no entry point; 2 another ABI version; 3 a built-in's name; 4 a malformed parameter table;
  * 5 an entry() that crashes; 6 an entry() that calls exit(0); 7 an entry() that closes every descriptor and
- * waits forever. */
+ * waits forever. All of these declare ABI version 1 and check that they are given version 1's host table.
+ * 8 "line_v2": the line in ABI version 2, with blossoms and tinted leaves (organ shapes and tints) and per-node
+ * `height` and `Cd` attributes computed with the host's parallel_for. */
 #define _POSIX_C_SOURCE 200809L /* close() and pause() under C99 without extensions */
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <signal.h>
 #include <stdlib.h>
@@ -61,7 +64,28 @@ typedef struct state {
   uint64_t organ_count;
   int64_t* tip; /* per seed: its stalk's last node, or -1 when it has stopped */
   int64_t steps;
+  /* line_v2's styles: per organ a shape and a tint; per node a height and a colour */
+  uint16_t* organ_shape;
+  growbench_vec3* organ_tint;
+  float* height;
+  float* color;
+  growbench_attribute attributes[2];
 } state;
+
+#if TEST_PLUGIN_VARIANT == 8
+/* line_v2 colours each node by its height, one chunk of nodes at a time on the host's threads. */
+static void style_nodes(void* user, uint64_t begin, uint64_t end) {
+  state* s = (state*)user;
+  uint64_t k;
+  for (k = begin; k < end; ++k) {
+    const float h = s->nodes[k].position.y;
+    s->height[k] = h;
+    s->color[3 * k] = 0.2f;
+    s->color[3 * k + 1] = h > 1.0f ? 1.0f : (h < 0.0f ? 0.0f : h);
+    s->color[3 * k + 2] = 0.1f;
+  }
+}
+#endif
 
 static growbench_instance* create(const growbench_host* host) {
   state* s = (state*)calloc(1, sizeof(state));
@@ -76,6 +100,13 @@ static int32_t start(growbench_instance* instance, const growbench_scene* scene,
   uint32_t i;
   (void)seed;
   s->scene = scene;
+#if TEST_PLUGIN_VARIANT == 0
+  /* A version-1 plugin must be given the host table a version-1 host gave. */
+  if (s->host->abi_version != 1 || s->host->struct_size != offsetof(growbench_host, parallel_for)) {
+    s->host->fail(s->host->context, "a version-1 plugin was given a newer host table");
+    return GROWBENCH_ERROR;
+  }
+#endif
   s->length = params[0].integer;
   s->step = (float)params[1].real;
   for (s->fault = 0; s->fault < kFaultCount && strcmp(kFaults[s->fault], params[2].text) != 0; ++s->fault) {
@@ -229,6 +260,29 @@ static int32_t finish(growbench_instance* instance) {
       o->node = (int32_t)k;
     }
   }
+#if TEST_PLUGIN_VARIANT == 8
+  s->organ_shape = (uint16_t*)calloc(s->organ_count + 1, sizeof(uint16_t));
+  s->organ_tint = (growbench_vec3*)calloc(s->organ_count + 1, sizeof(growbench_vec3));
+  s->height = (float*)calloc(s->node_count + 1, sizeof(float));
+  s->color = (float*)calloc(3 * s->node_count + 1, sizeof(float));
+  if (!s->organ_shape || !s->organ_tint || !s->height || !s->color) {
+    s->host->fail(s->host->context, "out of memory");
+    return GROWBENCH_OUT_OF_MEMORY;
+  }
+  for (k = 0; k < s->organ_count; ++k) { /* blossoms and kind-shaped leaves in turn, tinted by order */
+    s->organ_shape[k] = k % 2 == 0 ? 0 : GROWBENCH_KIND_SHAPE;
+    s->organ_tint[k].x = 1.0f;
+    s->organ_tint[k].y = 0.5f + 0.5f * (float)(k % 3);
+    s->organ_tint[k].z = 0.25f;
+  }
+  s->host->parallel_for(s->host->context, 0, s->node_count, 3, style_nodes, s);
+  s->attributes[0].name = "height";
+  s->attributes[0].components = 1;
+  s->attributes[0].values = s->height;
+  s->attributes[1].name = "Cd";
+  s->attributes[1].components = 3;
+  s->attributes[1].values = s->color;
+#endif
   return GROWBENCH_OK;
 }
 
@@ -241,6 +295,15 @@ static int32_t plant(growbench_instance* instance, growbench_plant_view* out) {
   out->node_count = s->node_count;
   out->organs = s->organs;
   out->organ_count = s->organ_count;
+  if (s->organ_shape) {
+    static const char* const shapes[] = {"blossom"};
+    out->organ_shapes = shapes;
+    out->organ_shape_count = 1;
+    out->organ_shape = s->organ_shape;
+    out->organ_tint = s->organ_tint;
+    out->node_attributes = s->attributes;
+    out->node_attribute_count = 2;
+  }
   return GROWBENCH_OK;
 }
 
@@ -256,18 +319,26 @@ static void destroy(growbench_instance* instance) {
   free(s->nodes);
   free(s->organs);
   free(s->tip);
+  free(s->organ_shape);
+  free(s->organ_tint);
+  free(s->height);
+  free(s->color);
   free(s);
 }
 
 static const growbench_plugin kPlugin = {
 #if TEST_PLUGIN_VARIANT == 2
     99u,
-#else
+#elif TEST_PLUGIN_VARIANT == 8
     GROWBENCH_PLUGIN_ABI_VERSION,
+#else
+    1u, /* the tests' version-1 plugin: it fills only version 1's members */
 #endif
     sizeof(growbench_plugin),
 #if TEST_PLUGIN_VARIANT == 3
     "spacecol",
+#elif TEST_PLUGIN_VARIANT == 8
+    "line_v2",
 #else
     "line",
 #endif

@@ -123,6 +123,7 @@ class Walker final : public sdk::Algorithm {
                     .doc("where leaves go: none, at branch tips, or at tips and every leaf_interval nodes"),
                 sdk::integer("leaf_interval", 6).range(1, 1000).doc("a leaf every k nodes along a shoot"),
                 sdk::real("leaf_size", 0.04).range(0, 10).unit("m").doc("leaf blade length"),
+                sdk::boolean("blossoms", true).doc("branch tips bear blossoms (the built-in shape), tinted by order"),
             },
             {"max_nodes=600"}};
   }
@@ -146,6 +147,7 @@ class Walker final : public sdk::Algorithm {
     leaves_ = c.params.text("leaves");
     leaf_interval_ = static_cast<std::uint32_t>(c.params.integer("leaf_interval"));
     leaf_size_ = static_cast<float>(c.params.real("leaf_size"));
+    blossoms_ = c.params.boolean("blossoms");
     if (scene_->seed_count == 0) throw sdk::InputError("algorithm 'walker': the scene has no seeds");
     if (cling_ >= reach_) throw sdk::InputError("algorithm 'walker': cling must be less than reach");
   }
@@ -201,6 +203,7 @@ class Walker final : public sdk::Algorithm {
       node.radius = sum[i] > 0.0f ? std::pow(sum[i], 1.0f / n) : tip_radius_;
       if (node.parent >= 0) sum[static_cast<std::size_t>(node.parent)] += std::pow(node.radius, n);
     }
+    paint();
     if (leaves_ == "none" || leaf_size_ <= 0.0f) return;
     std::vector<std::uint8_t> has_child(plant.nodes.size(), 0);
     for (const growbench_node& node : plant.nodes)
@@ -210,7 +213,7 @@ class Walker final : public sdk::Algorithm {
       if (node.parent < 0) continue;
       const bool tip = has_child[i] == 0;
       const bool interval = leaves_ == "interval" && depth_[i] % leaf_interval_ == 0;
-      if (tip || interval) add_leaf(i);
+      if (tip || interval) add_leaf(i, tip && blossoms_);
     }
   }
 
@@ -327,8 +330,31 @@ class Walker final : public sdk::Algorithm {
     }
   }
 
-  // A leaf at node i, its blade leaning out from the surface along the shoot, its upper side outwards.
-  void add_leaf(std::size_t i) {
+  // Per node, two named attributes that reach the PLY, glTF and skeleton files: "Cd", the branches' colour
+  // (young green to old bark by the step a node appeared), and "shoot_depth", nodes from its shoot's start.
+  // Each node's values depend on that node alone, so the host's parallel loop gives the same plant on any
+  // number of threads.
+  void paint() {
+    const std::size_t n = plant.nodes.size();
+    sdk::Attribute& color = plant.attribute("Cd", 3);
+    sdk::Attribute& depth = plant.attribute("shoot_depth", 1);
+    color.values.resize(3 * n);
+    depth.values.resize(n);
+    const float last = static_cast<float>(std::max<std::uint32_t>(step_index_, 1));
+    sdk::Host(host_).parallel_for(0, n, [&](std::uint64_t begin, std::uint64_t end) {
+      for (std::uint64_t i = begin; i < end; ++i) {
+        const float age = 1.0f - static_cast<float>(plant.nodes[i].birth_step) / last;  // 1: the oldest
+        color.values[3 * i] = 0.16f + 0.10f * age;
+        color.values[3 * i + 1] = 0.38f - 0.24f * age;
+        color.values[3 * i + 2] = 0.08f;
+        depth.values[i] = static_cast<float>(depth_[i]);
+      }
+    });
+  }
+
+  // A leaf at node i, its blade leaning out from the surface along the shoot, its upper side outwards; or,
+  // at a tip, a blossom: the built-in shape, paler on higher orders.
+  void add_leaf(std::size_t i, bool blossom) {
     const growbench_node& node = plant.nodes[i];
     const Vec3 from = plant.nodes[static_cast<std::size_t>(node.parent)].position;
     const Vec3 up{0.0f, 1.0f, 0.0f};
@@ -340,9 +366,15 @@ class Walker final : public sdk::Algorithm {
     leaf.position = node.position;
     quaternion_from_frame(cross(y, z), y, z, leaf.orientation);
     leaf.size = leaf_size_;
-    leaf.kind = GROWBENCH_ORGAN_LEAF;
+    leaf.kind = blossom ? GROWBENCH_ORGAN_FLOWER : GROWBENCH_ORGAN_LEAF;
     leaf.node = static_cast<std::int32_t>(i);
-    plant.organs.push_back(leaf);
+    if (!blossom) {
+      plant.add_organ(leaf);
+      return;
+    }
+    if (plant.organ_shapes.empty()) plant.organ_shapes = {"blossom"};
+    const float pale = std::min(1.0f, 0.25f * static_cast<float>(node.order));
+    plant.add_organ(leaf, 0, Vec3{1.0f, 0.7f + 0.3f * pale, 0.75f + 0.25f * pale});
   }
 
   const growbench_host* host_ = nullptr;
@@ -354,6 +386,7 @@ class Walker final : public sdk::Algorithm {
   std::uint32_t max_order_ = 0, leaf_interval_ = 1;
   std::uint64_t max_nodes_ = 0;
   std::string leaves_;
+  bool blossoms_ = false;
 
   std::vector<Tip> tips_;
   // Per node: nodes from the start of its shoot, and the normal of the surface it clings to.

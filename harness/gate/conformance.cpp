@@ -89,27 +89,29 @@ Finding run_one(const TrialSpec& spec, bool look_inside, double timeout_s) {
 ConformanceCheck same_plant(const std::string& name, const Finding& a, const Finding& b) {
   if (!b.error.empty()) return {name, false, b.error};
   if (a.hash == b.hash) return {name, true, "same geometry hash"};
-  return {name, false, fmt::format("geometry hash {} against {} ({} against {} nodes)", a.hash, b.hash, a.nodes, b.nodes)};
+  return {name, false,
+          fmt::format("geometry hash {} against {} ({} against {} nodes)", a.hash, b.hash, a.nodes, b.nodes)};
 }
 
 // What the first run shows of the plant itself.
 void check_plant(const Finding& one, std::vector<ConformanceCheck>& checks) {
-  checks.push_back({"valid plant", one.error.empty(), one.error.empty() ? "finite, parents before children" : one.error});
+  checks.push_back(
+      {"valid plant", one.error.empty(), one.error.empty() ? "finite, parents before children" : one.error});
   if (!one.error.empty()) return;
   checks.push_back({"grows", one.nodes > 1, fmt::format("{} nodes", one.nodes)});
-  checks.push_back({"one tree per seed", one.roots == one.seeds,
-                    fmt::format("{} roots for {} seeds", one.roots, one.seeds)});
-  checks.push_back({"no node inside a solid", one.inside == 0,
-                    one.inside == 0 ? "none"
-                                    : fmt::format("{} nodes, the first node {}", one.inside, one.first_inside)});
+  checks.push_back(
+      {"one tree per seed", one.roots == one.seeds, fmt::format("{} roots for {} seeds", one.roots, one.seeds)});
+  checks.push_back(
+      {"no node inside a solid", one.inside == 0,
+       one.inside == 0 ? "none" : fmt::format("{} nodes, the first node {}", one.inside, one.first_inside)});
 }
 
 ConformanceCheck cancellation(const Finding& c, const ConformanceOptions& o) {
   const std::string name = "stops at its time limit";
   if (!c.error.empty()) return {name, false, c.error};
   const double bound = o.cancel_after_s + o.cancel_grace_s;
-  const std::string seen = fmt::format("growth {:.3f} s under a {:g} s limit, stopped by {}", c.growth_s,
-                                       o.cancel_after_s, c.stopped_by);
+  const std::string seen =
+      fmt::format("growth {:.3f} s under a {:g} s limit, stopped by {}", c.growth_s, o.cancel_after_s, c.stopped_by);
   if (c.growth_s > bound)
     return {name, false, seen + fmt::format("; past {:g} s: a long step should return once host->cancelled()", bound)};
   if (c.stopped_by != "time_limit") return {name, true, seen + " (ended before the limit: not exercised)"};

@@ -19,7 +19,7 @@ struct ConformanceOptions {
 };
 
 struct ConformanceCheck {
-  std::string name;    // "grows", "valid plant", "one tree per seed", "no node inside a solid", ...
+  std::string name;  // "grows", "valid plant", "one tree per seed", "no node inside a solid", ...
   bool pass = false;
   std::string detail;  // what was seen
 };
@@ -35,8 +35,8 @@ struct SceneConformance {
 // parents before children, unit organ turns) of one tree per seed with no node inside a solid; that one and
 // two threads, and two runs, grow the same plant bit for bit; and that the time limit (host->cancelled())
 // stops growth within cancel_grace_s, keeping a valid plant. The algorithm's test_params apply to all but
-// the last, which grows with its defaults so that it lasts past the limit. Must be called before this process starts any
-// thread (it forks).
+// the last, which grows with its defaults so that it lasts past the limit. Must be called before this process starts
+// any thread (it forks).
 SceneConformance check_conformance(const std::string& algorithm, const std::string& scene,
                                    const ConformanceOptions& options);
 

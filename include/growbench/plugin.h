@@ -1,4 +1,4 @@
-/* growbench plugin ABI, version 1: the boundary between the growbench harness (the host) and a growth
+/* growbench plugin ABI, version 2: the boundary between the growbench harness (the host) and a growth
  * algorithm built as a shared library (the plugin).
  *
  * C99, and nothing but plain data and function pointers cross it, so a plugin may be written in C, C++
@@ -29,7 +29,10 @@
 extern "C" {
 #endif
 
-#define GROWBENCH_PLUGIN_ABI_VERSION 1u
+#define GROWBENCH_PLUGIN_ABI_VERSION 2u
+/* The oldest version a host of this version still loads. A version-1 plugin fills only the members of
+ * growbench_plant_view that version 1 had; the host reads nothing more from it. */
+#define GROWBENCH_PLUGIN_ABI_OLDEST 1u
 
 #if defined(_WIN32)
 #define GROWBENCH_PLUGIN_EXPORT __declspec(dllexport)
@@ -236,6 +239,15 @@ typedef struct growbench_host {
   void (*sample_surface)(void* context, uint64_t seed, uint64_t first_index, uint64_t n, growbench_surface_sample* out);
   /* Whether each point sees the scene's light (a ray towards it, started `bias` along it): 1 or 0. */
   void (*light_visible)(void* context, const growbench_vec3* points, uint64_t n, float bias, uint8_t* out);
+
+  /* Version 2. Calls body(user, chunk_begin, chunk_end) over disjoint chunks that cover [begin, end), on
+   * at most `threads` threads at once (the trial's thread count), and returns when every chunk is done.
+   * The chunks are those of halving [begin, end) until a piece holds at most `grain` indices (0: the
+   * host's choice), so they depend only on (begin, end, grain), never on timing: results written per
+   * index, or per chunk and combined in index order, are the same for any thread count. body must not
+   * throw or longjmp out; it may call the queries above. */
+  void (*parallel_for)(void* context, uint64_t begin, uint64_t end, uint64_t grain,
+                       void (*body)(void* user, uint64_t chunk_begin, uint64_t chunk_end), void* user);
 } growbench_host;
 
 /* ------------------------------------------------------------------ the plant */
@@ -271,6 +283,17 @@ typedef struct growbench_organ {
  * into the instance. Polygon i has the vertices polygon_vertices[polygon_offsets[i] ..
  * polygon_offsets[i + 1]), so polygon_offsets has polygon_count + 1 entries (or is NULL when there are
  * no polygons). */
+/* Version 2: a named value per node, carried to the PLY, glTF and skeleton files as the L-system's a()
+ * attributes are. "Cd" with 3 components is the branches' colour (linear RGB, each in [0, 4]). */
+typedef struct growbench_attribute {
+  const char* name;    /* a letter or '_', then letters, digits and '_'; at most 64 bytes; unique */
+  uint32_t components; /* 1 to 4 */
+  const float* values; /* node_count * components, node by node; finite */
+} growbench_attribute;
+
+/* The organ_shape of an organ that takes its kind's shape (leaf, blossom, bud). */
+#define GROWBENCH_KIND_SHAPE 0xFFFFu
+
 typedef struct growbench_plant_view {
   const growbench_node* nodes;
   uint64_t node_count;
@@ -279,6 +302,18 @@ typedef struct growbench_plant_view {
   const growbench_vec3* polygon_vertices;
   const uint64_t* polygon_offsets;
   uint64_t polygon_count;
+
+  /* Version 2; each may be NULL (count 0). The shapes organs name: a built-in shape's name ("leaf",
+   * "blossom", "half_bloom", "bud", with settings as `growbench list` shows) or an OBJ file's path. */
+  const char* const* organ_shapes;
+  uint32_t organ_shape_count;
+  /* Per organ (organ_count entries): an index into organ_shapes, or GROWBENCH_KIND_SHAPE. */
+  const uint16_t* organ_shape;
+  /* Per organ: its colour as a factor on its shape's, each component in [0, 4]. */
+  const growbench_vec3* organ_tint;
+  /* Named per-node values. */
+  const growbench_attribute* node_attributes;
+  uint32_t node_attribute_count;
 } growbench_plant_view;
 
 typedef struct growbench_stat {

@@ -29,6 +29,7 @@
 #include <stdexcept>
 #include <string>
 #include <tuple>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -283,6 +284,18 @@ class Host {
     h_->light_visible(h_->context, p, n, bias, out);
   }
 
+  // body(chunk_begin, chunk_end) over disjoint chunks covering [begin, end), on the trial's threads. The
+  // chunks depend only on (begin, end, grain), so results written per index are the same for any thread
+  // count. body must not throw: catch inside it and report after the loop.
+  template <class F>
+  void parallel_for(std::uint64_t begin, std::uint64_t end, F&& body, std::uint64_t grain = 0) const {
+    using Body = std::remove_reference_t<F>;
+    h_->parallel_for(
+        h_->context, begin, end, grain,
+        [](void* user, std::uint64_t b, std::uint64_t e) { (*static_cast<Body*>(user))(b, e); },
+        const_cast<void*>(static_cast<const void*>(&body)));
+  }
+
  private:
   const growbench_host* h_;
 };
@@ -297,12 +310,43 @@ struct Context {
 
 // ------------------------------------------------------------------ the plant
 
+// A named value per node (see growbench_attribute): "Cd" with 3 components colours the branches.
+struct Attribute {
+  std::string name;
+  std::uint32_t components = 1;
+  std::vector<float> values;  // nodes.size() * components, node by node
+};
+
 // The plant as the plugin builds it; view() hands it to the host without a copy.
 struct Plant {
   std::vector<growbench_node> nodes;
   std::vector<growbench_organ> organs;
   std::vector<Vec3> polygon_vertices;
   std::vector<std::uint64_t> polygon_offsets;  // polygon_offsets.size() == polygons + 1, or empty
+  // The shapes organs name: built-in shape names ("leaf", "blossom", "half_bloom", "bud") or OBJ paths.
+  std::vector<std::string> organ_shapes;
+  // Per organ, or empty: an index into organ_shapes (GROWBENCH_KIND_SHAPE: its kind's shape), and a
+  // colour factor on its shape's colour (each component in [0, 4]).
+  std::vector<std::uint16_t> organ_shape;
+  std::vector<Vec3> organ_tint;
+  std::vector<Attribute> attributes;
+
+  // Appends an organ and, when given, its shape (an index into organ_shapes) and tint.
+  void add_organ(const growbench_organ& organ, std::uint16_t shape = GROWBENCH_KIND_SHAPE,
+                 Vec3 tint = Vec3{1.0f, 1.0f, 1.0f}) {
+    organs.push_back(organ);
+    organ_shape.resize(organs.size() - 1, GROWBENCH_KIND_SHAPE);
+    organ_tint.resize(organs.size() - 1, Vec3{1.0f, 1.0f, 1.0f});
+    organ_shape.push_back(shape);
+    organ_tint.push_back(tint);
+  }
+  // The attribute `name`, made with `components` per node when new; its values grow with the nodes.
+  Attribute& attribute(const std::string& name, std::uint32_t components = 1) {
+    for (auto& a : attributes)
+      if (a.name == name) return a;
+    attributes.push_back({name, components, {}});
+    return attributes.back();
+  }
 
   // Appends a node and returns its index.
   std::int32_t add_node(const Vec3& position, float radius, std::int32_t parent, std::uint32_t order,
@@ -315,6 +359,8 @@ struct Plant {
     polygon_vertices.insert(polygon_vertices.end(), vertices.begin(), vertices.end());
     polygon_offsets.push_back(polygon_vertices.size());
   }
+  // The view of the plant. Per-organ arrays shorter than organs are padded, and attributes padded or cut to
+  // the node count, so the host never reads past them.
   [[nodiscard]] growbench_plant_view view() const {
     growbench_plant_view v{};
     v.nodes = nodes.data();
@@ -324,8 +370,44 @@ struct Plant {
     v.polygon_vertices = polygon_vertices.data();
     v.polygon_offsets = polygon_offsets.empty() ? nullptr : polygon_offsets.data();
     v.polygon_count = polygon_offsets.empty() ? 0 : polygon_offsets.size() - 1;
+    shape_ptrs_.clear();
+    for (const auto& s : organ_shapes) shape_ptrs_.push_back(s.c_str());
+    v.organ_shapes = shape_ptrs_.data();
+    v.organ_shape_count = static_cast<std::uint32_t>(shape_ptrs_.size());
+    v.organ_shape = per_organ(organ_shape, padded_shape_, std::uint16_t{GROWBENCH_KIND_SHAPE});
+    v.organ_tint = per_organ(organ_tint, padded_tint_, Vec3{1.0f, 1.0f, 1.0f});
+    attribute_views_.clear();
+    padded_values_.resize(attributes.size());
+    for (std::size_t k = 0; k < attributes.size(); ++k) {
+      const Attribute& a = attributes[k];
+      const float* values = a.values.data();
+      if (a.values.size() != nodes.size() * a.components) {
+        padded_values_[k] = a.values;
+        padded_values_[k].resize(nodes.size() * a.components, 0.0f);
+        values = padded_values_[k].data();
+      }
+      attribute_views_.push_back({a.name.c_str(), a.components, values});
+    }
+    v.node_attributes = attribute_views_.data();
+    v.node_attribute_count = static_cast<std::uint32_t>(attribute_views_.size());
     return v;
   }
+
+ private:
+  // `given` as an array of organs.size(), padded with `fill` into `padded` when shorter; null when empty.
+  template <class T>
+  const T* per_organ(const std::vector<T>& given, std::vector<T>& padded, T fill) const {
+    if (given.empty()) return nullptr;
+    if (given.size() == organs.size()) return given.data();
+    padded = given;
+    padded.resize(organs.size(), fill);
+    return padded.data();
+  }
+  mutable std::vector<const char*> shape_ptrs_;
+  mutable std::vector<growbench_attribute> attribute_views_;
+  mutable std::vector<std::uint16_t> padded_shape_;
+  mutable std::vector<Vec3> padded_tint_;
+  mutable std::vector<std::vector<float>> padded_values_;
 };
 
 // ------------------------------------------------------------------ the algorithm
