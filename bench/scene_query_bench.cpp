@@ -3,6 +3,7 @@
 #include <nanoflann.hpp>
 
 #include "core/random.hpp"
+#include "scenes/host_queries.hpp"
 #include "scenes/scene_library.hpp"
 #include "scenes/scene_query.hpp"
 
@@ -54,6 +55,22 @@ void BM_SignedDistance(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_SignedDistance);
+
+// One batched closest-point call of N points through the C++ host interface the built-ins use (DirectQueries):
+// the per-call cost beside bench/python/query_cost.py's, the same call from Python with numpy.
+void BM_ClosestPointsBatch(benchmark::State& state) {
+  auto& b = bunny();
+  const DirectQueries host(b.query);
+  const auto n = static_cast<std::size_t>(state.range(0));
+  const float radius = state.range(1) == 0 ? std::numeric_limits<float>::infinity() : 0.05f;
+  std::vector<ClosestHit> out(n);
+  for (auto _ : state) {
+    host.closest_points({b.pts.data(), n}, radius, false, out);
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(n));
+}
+BENCHMARK(BM_ClosestPointsBatch)->ArgNames({"points", "bounded"})->ArgsProduct({{1, 1024}, {0, 1}});
 
 void BM_QueryBuild(benchmark::State& state) {
   const Scene s = load_scene("mesh:stanford-bunny");

@@ -9,6 +9,8 @@ include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
 install(TARGETS growbench RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
+# The Python bridge, which the binary finds at lib/growbench beside its bin/ (core/data_path.hpp).
+install(TARGETS python_bridge LIBRARY DESTINATION lib/growbench COMPONENT runtime)
 
 # The data keeps the checkout's layout under share/growbench: report.py finds the results schema and
 # docs/metrics.md relative to itself, and the binary (core/data_path.hpp) reads from here once the

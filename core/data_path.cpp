@@ -24,6 +24,11 @@ std::string data_path(std::string_view relative) {
   return source.string();  // for the error message: where it was looked for first
 }
 
+std::string module_path(std::string_view name) {
+  if (running_from_build_tree()) return (fs::path(GROWBENCH_BINARY_DIR) / "plugins" / name).string();
+  return (self_exe().parent_path().parent_path() / "lib" / "growbench" / name).string();
+}
+
 bool running_from_build_tree() {
   const std::string exe = self_exe().string(), build = GROWBENCH_BINARY_DIR;
   return !build.empty() && exe.compare(0, build.size(), build) == 0;

@@ -11,6 +11,10 @@ namespace growbench {
 // `relative` is a path in the checkout, e.g. "scenes/meshes".
 std::string data_path(std::string_view relative);
 
+// A module the binary loads at run time (plugins/python_bridge.so): in the build tree's plugins/ while
+// running from it, otherwise in the lib/growbench/ beside the installed binary.
+std::string module_path(std::string_view name);
+
 // Whether this binary runs from the build tree it was built in (not an installed copy).
 bool running_from_build_tree();
 

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -23,6 +24,7 @@
 #include <fmt/format.h>
 
 #include "algorithms/plugins/plugin_algorithm.hpp"
+#include "core/data_path.hpp"
 #include "core/errors.hpp"
 #include "core/file_hash.hpp"
 #include "core/utf8.hpp"
@@ -189,6 +191,29 @@ AlgorithmInfo read_plugin_table(const std::string& path, const growbench_plugin&
 
 namespace {
 
+// An algorithm written in Python: the bridge module makes its table (algorithms/plugins/python/bridge.cpp).
+// RTLD_GLOBAL: numpy's extension modules take the interpreter's symbols from the process.
+const growbench_plugin* open_python(const std::string& path) {
+  const std::string bridge = module_path("python_bridge.so");
+  void* handle = dlopen(bridge.c_str(), RTLD_NOW | RTLD_GLOBAL);
+  if (!handle) {
+    const char* why = dlerror();
+    throw InputError(fmt::format("{}: algorithms in Python need {}, which did not load ({})", path, bridge,
+                                 why ? why : "dlopen failed"));
+  }
+  using Make = const growbench_plugin* (*)(const char*, char*, std::size_t);
+  const auto make = reinterpret_cast<Make>(dlsym(handle, "growbench_python_plugin"));
+  if (!make) throw InputError(fmt::format("{}: {} has no growbench_python_plugin()", path, bridge));
+  std::array<char, 8192> why{};
+  const growbench_plugin* t = make(path.c_str(), why.data(), why.size());
+  if (!t) throw InputError(fmt::format("{}: {}", path, why.data()));
+  return t;
+}
+
+bool is_python(const std::string& path) {
+  return fs::path(path).extension() == ".py";
+}
+
 const growbench_plugin* open_plugin(const std::string& path) {
   std::error_code ec;
   if (!fs::exists(path, ec)) throw InputError(fmt::format("{}: no such plugin file", path));
@@ -199,6 +224,7 @@ const growbench_plugin* open_plugin(const std::string& path) {
         fmt::format("{}: not a regular file (a FIFO, a device or a socket); expected a plugin's "
                     "shared library file",
                     path));
+  if (is_python(path)) return open_python(path);
   // RTLD_LOCAL: one plugin's symbols never satisfy another's. Never closed (see loader.hpp).
   void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!handle) {

@@ -17,6 +17,7 @@
 #include "harness/record/record.hpp"
 #include "harness/run/trial.hpp"
 #include "scenes/scene_library.hpp"
+#include "scenes/scene_query.hpp"
 #include "test_util.hpp"
 
 namespace growbench {
@@ -458,6 +459,93 @@ TEST(PluginTest, RunsTheBuiltInsConformanceChecksOnAPlugin) {
   EXPECT_NE(invalid.out.find("  FAIL valid plant              plugin_error: algorithm 'line' (plugin "),
             std::string::npos)
       << invalid.out;
+}
+
+// An algorithm written in Python (examples/python/spacecol.py, numpy) loads with --plugin file.py, grows through
+// the host's batched queries the same plant on 1 and 2 threads, and hands over organ shapes, tints and
+// attributes through the version-2 view.
+TEST(PythonPlugin, TheNumpyExampleGrowsLikeAnyPlugin) {
+  const std::string script = std::string(GROWBENCH_SOURCE_DIR) + "/examples/python/spacecol.py";
+  TrialSpec spec;
+  spec.algorithm = "spacecol_py";
+  spec.scene = "boulder";
+  spec.plugins = {script};
+  spec.params = {"point_count=6000"};
+  spec.threads = 1;
+  Plant one;
+  const TrialRecord r1 = run_trial_record(spec, {}, &one);
+  spec.threads = 2;
+  const TrialRecord r2 = run_trial_record(spec);
+  EXPECT_EQ(r1.results.geometry_hash, r2.results.geometry_hash);
+  EXPECT_GT(one.nodes.size(), 100u);
+  EXPECT_EQ(one.validate(), "");
+  EXPECT_EQ(r1.context->plugins.at(0).path, fs::canonical(script).string());
+  EXPECT_EQ(r1.context->plugins.at(0).abi_version, 2u);
+  EXPECT_EQ(one.organ_shapes, std::vector<std::string>{"blossom"});
+  ASSERT_FALSE(one.organs.empty());
+  EXPECT_EQ(one.organs[0].kind, OrganKind::Flower);
+  ASSERT_EQ(one.node_attributes.size(), 2u);
+  EXPECT_EQ(one.node_attributes[0].name, "Cd");
+  EXPECT_EQ(one.node_attributes[1].name, "depth");
+  const Scene boulder = load_scene("boulder");
+  SceneQuery q(boulder);
+  for (const auto& n : one.nodes) ASSERT_FALSE(q.inside(n.position));
+}
+
+// A script's own errors are named with the file: Python's exception and its line, with the trial's status
+// following what was raised (growbench.InputError: invalid input; anything else: the plugin's error).
+TEST(PythonPlugin, AScriptsErrorsNameTheFileAndLine) {
+  const fs::path dir = test::temp_dir("python_errors");
+  const std::string header = "import growbench\nclass A:\n    name = 'py_{}'\n";
+  const std::string body =
+      "    def start(self, scene, host, params, seed):\n        {}\n"
+      "    def step(self):\n        {}\n"
+      "    def plant(self):\n        return {{'positions': [[0, 0, 0]], 'parent': [-1]}}\nPLUGIN = A\n";
+  struct Case {
+    std::string name, start, step, command_error;
+    int status;
+  };
+  const std::vector<Case> cases = {
+      {"syntax", "pass", "return False +", "SyntaxError", 2},
+      {"input", "raise growbench.InputError('this scene will not do')", "return False",
+       "failed in start: InputError: this scene will not do", 2},
+      {"fails", "pass", "raise RuntimeError('gave up')", "failed in step: RuntimeError: gave up", 2},
+  };
+  for (const auto& c : cases) {
+    const std::string path =
+        test::write_text(dir / (c.name + ".py"),
+                         fmt::format(fmt::runtime(header), c.name) + fmt::format(fmt::runtime(body), c.start, c.step));
+    const auto r = test::run_growbench(
+        fmt::format("run --plugin {} -a py_{} -s wall -q -o {}", path, c.name, (dir / c.name).string()));
+    EXPECT_EQ(r.status, c.status) << c.name << ": " << r.out;
+    EXPECT_NE(r.out.find(c.command_error), std::string::npos) << c.name << ": " << r.out;
+    EXPECT_NE(r.out.find(path), std::string::npos) << c.name << ": " << r.out;
+    EXPECT_EQ(r.out.find("internal error"), std::string::npos) << c.name << ": " << r.out;
+  }
+  const std::string none = test::write_text(dir / "none.py", "x = 1\n");
+  const auto r = test::run_growbench("list --plugin " + none);
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find(none + ": " + none + ": no PLUGIN; end the file with PLUGIN = YourAlgorithmClass"),
+            std::string::npos)
+      << r.out;
+}
+
+// bench/python/query_cost.py, the cost of a batched query from Python, runs and reports its figures (their size
+// is the benchmark's, not a test's, to judge).
+TEST(PythonPlugin, TheQueryCostBenchmarkReportsItsFigures) {
+  TrialSpec spec;
+  spec.algorithm = "query_cost";
+  spec.scene = "boulder";
+  spec.plugins = {std::string(GROWBENCH_SOURCE_DIR) + "/bench/python/query_cost.py"};
+  spec.params = {"seconds=0.01"};
+  const TrialRecord r = run_trial_record(spec);
+  for (const char* bound : {"bounded", "unbounded"})
+    for (const char* n : {"1", "1024"})
+      for (const char* unit : {"us_per_call", "ns_per_point"}) {
+        const std::string key = fmt::format("closest_points_{}_{}_{}", bound, n, unit);
+        ASSERT_TRUE(r.results.algorithm_stats.count(key)) << key;
+        EXPECT_GT(r.results.algorithm_stats.at(key), 0.0) << key;
+      }
 }
 
 // A trial that failed for want of disk space was journaled as failed, and --resume on a disk with room never

@@ -92,7 +92,7 @@ TEST(ExitStatus, HelpIsZeroAndEveryCommandLineErrorIsTwo) {
   // cases below) to pass.
   const std::vector<std::string> commands = listed_commands();
   EXPECT_EQ(commands, (std::vector<std::string>{"list", "scenes", "run", "suite", "history", "render", "ab", "compare",
-                                                "merge", "baseline", "report", "lsystem", "summary"}));
+                                                "merge", "baseline", "report", "lsystem", "summary", "plugin-test"}));
   std::vector<std::string> all = commands;
   for (const char* nested : {"history add", "history plot", "baseline update"}) all.emplace_back(nested);
   for (const auto& c : all) {
@@ -139,6 +139,7 @@ TEST(ExitStatus, BadInputIsTwoForEveryCommandWithItsSourceNamed) {
       {"report " + bad, bad + ":2:1: invalid JSON"},
       {"lsystem busj", "did you mean 'bush'"},
       {"summary " + bad, bad + ":2:1: invalid JSON"},
+      {"plugin-test " + d + "/missing.so", d + "/missing.so: no such plugin file"},
   };
   for (const auto& c : cases) {
     const auto r = growbench(c.args);
