@@ -89,6 +89,7 @@ class PluginAlgorithm final : public GrowthAlgorithm {
   bool step() override {
     const std::int32_t r = t_->step(inst_);
     ++version_;
+    check_host_error("step");
     if (r < 0) raise(-r, "step");
     if (r > 1) raise(GROWBENCH_ERROR, fmt::format("step (returned {}, expected 1, 0 or an error)", r));
     return r == 1;
@@ -96,6 +97,7 @@ class PluginAlgorithm final : public GrowthAlgorithm {
 
   void finish() override {
     check(t_->finish(inst_), "finish");
+    check_host_error("finish");
     ++version_;
   }
 
@@ -215,6 +217,10 @@ class PluginAlgorithm final : public GrowthAlgorithm {
   void check(std::int32_t status, const std::string& where) const {
     if (status != GROWBENCH_OK) raise(status, where);
   }
+  void check_host_error(const std::string& where) const {
+    std::lock_guard lock(fail_mutex_);
+    if (!host_error_.empty()) throw std::runtime_error(fmt::format("{} in {}: {}", who_, where, host_error_));
+  }
 
   void copy_plant(const growbench_plant_view& v) const {
     auto bad = [&](const std::string& what) { return malformed(what); };
@@ -328,6 +334,7 @@ class PluginAlgorithm final : public GrowthAlgorithm {
   std::vector<growbench_zone> zones_;
   mutable std::mutex fail_mutex_;
   mutable std::string failure_;
+  mutable std::string host_error_;               // a failure of the host's own loop inside a plugin's call
   std::uint64_t version_ = 0;                    // bumped by every call that may change the plant
   mutable std::uint64_t plant_version_ = ~0ull;  // the version plant_ was copied at
   mutable Plant plant_;
@@ -351,13 +358,22 @@ struct HostFunctions {
   static std::int32_t cancelled(void* c) { return self(c).cancelled() ? 1 : 0; }
   // The trial's thread count limits TBB already (its global_control); halving to `grain` with the simple
   // partitioner makes the chunks a function of the range alone.
-  static void parallel_for(void*, std::uint64_t begin, std::uint64_t end, std::uint64_t grain,
+  // Nothing may throw into the plugin's C frames: a failure of the loop itself (memory for TBB's tasks) is kept
+  // and raised by the host once the plugin's call returns.
+  static void parallel_for(void* c, std::uint64_t begin, std::uint64_t end, std::uint64_t grain,
                            void (*body)(void*, std::uint64_t, std::uint64_t), void* user) {
     if (end <= begin || !body) return;
     const std::uint64_t g = grain > 0 ? grain : std::max<std::uint64_t>(1, (end - begin) / 64);
-    tbb::parallel_for(
-        tbb::blocked_range<std::uint64_t>(begin, end, g),
-        [&](const tbb::blocked_range<std::uint64_t>& r) { body(user, r.begin(), r.end()); }, tbb::simple_partitioner());
+    try {
+      tbb::parallel_for(
+          tbb::blocked_range<std::uint64_t>(begin, end, g),
+          [&](const tbb::blocked_range<std::uint64_t>& r) { body(user, r.begin(), r.end()); },
+          tbb::simple_partitioner());
+    } catch (const std::exception& e) {
+      PluginAlgorithm& a = self(c);
+      std::lock_guard lock(a.fail_mutex_);
+      if (a.host_error_.empty()) a.host_error_ = fmt::format("the host's parallel_for failed: {}", e.what());
+    }
   }
   static std::uint64_t random_bits(void* c, std::uint64_t stream, std::uint64_t counter) {
     return growbench::random_bits(self(c).seed_, stream, counter);

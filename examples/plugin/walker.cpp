@@ -336,7 +336,7 @@ class Walker final : public sdk::Algorithm {
   // number of threads.
   void paint() {
     const std::size_t n = plant.nodes.size();
-    sdk::Attribute& color = plant.attribute("Cd", 3);
+    sdk::Attribute& color = plant.attribute("Cd", 3);  // references stay valid: attributes is a deque
     sdk::Attribute& depth = plant.attribute("shoot_depth", 1);
     color.values.resize(3 * n);
     depth.values.resize(n);

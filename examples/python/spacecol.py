@@ -161,6 +161,10 @@ class SpaceColonization:
         q[flipped] = [0.0, 1.0, 0.0, 0.0]
         return (q / np.linalg.norm(q, axis=1, keepdims=True)).astype(np.float32)
 
+    def counts(self):
+        """(nodes, organs), read after every step: cheaper than building the plant dict."""
+        return len(self.positions), len(self.tips) if hasattr(self, "tips") else 0
+
     def stats(self):
         return {"points_left": float(len(self.points))}
 

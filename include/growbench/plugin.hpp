@@ -18,6 +18,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -286,14 +287,26 @@ class Host {
 
   // body(chunk_begin, chunk_end) over disjoint chunks covering [begin, end), on the trial's threads. The
   // chunks depend only on (begin, end, grain), so results written per index are the same for any thread
-  // count. body must not throw: catch inside it and report after the loop.
+  // count. An exception from body is kept (the first one) and rethrown here after every chunk has run.
   template <class F>
   void parallel_for(std::uint64_t begin, std::uint64_t end, F&& body, std::uint64_t grain = 0) const {
-    using Body = std::remove_reference_t<F>;
+    struct Call {
+      std::remove_reference_t<F>* body;
+      std::exception_ptr error;
+      std::atomic<bool> failed{false};
+    } call{&body, nullptr};
     h_->parallel_for(
         h_->context, begin, end, grain,
-        [](void* user, std::uint64_t b, std::uint64_t e) { (*static_cast<Body*>(user))(b, e); },
-        const_cast<void*>(static_cast<const void*>(&body)));
+        [](void* user, std::uint64_t b, std::uint64_t e) {
+          auto& c = *static_cast<Call*>(user);
+          try {
+            (*c.body)(b, e);
+          } catch (...) {
+            if (!c.failed.exchange(true)) c.error = std::current_exception();
+          }
+        },
+        &call);
+    if (call.error) std::rethrow_exception(call.error);
   }
 
  private:
@@ -329,7 +342,7 @@ struct Plant {
   // colour factor on its shape's colour (each component in [0, 4]).
   std::vector<std::uint16_t> organ_shape;
   std::vector<Vec3> organ_tint;
-  std::vector<Attribute> attributes;
+  std::deque<Attribute> attributes;  // a deque: attribute() never moves one already made
 
   // Appends an organ and, when given, its shape (an index into organ_shapes) and tint.
   void add_organ(const growbench_organ& organ, std::uint16_t shape = GROWBENCH_KIND_SHAPE,

@@ -4,11 +4,16 @@
 // the script's table. The interpreter is Debian's CPython, embedded once per process and never finalized;
 // Python runs only on the thread that drives the trial (the host's parallel loops are for native code).
 #include <array>
+#include <climits>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <deque>
 #include <memory>
+#include <new>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <pybind11/embed.h>
@@ -257,10 +262,15 @@ struct Instance {
   std::vector<growbench_vec3> organ_tint;
   std::vector<std::string> attribute_names;
   std::vector<std::vector<float>> attribute_values;
+  std::vector<std::uint32_t> attribute_components;
+  bool stale = true;  // the Python plant changed since it was last taken (start, step and finish change it)
   std::vector<growbench_attribute> attributes;
   std::vector<std::string> stat_names;
   std::vector<growbench_stat> stats;
 };
+
+// growbench.InputError, looked up once the module exists (no lookup, which could throw, in a handler).
+PyObject* g_input_error = nullptr;
 
 std::string text_of(const py::handle& h, const char* fallback = "") {
   return h.is_none() ? fallback : py::str(h).cast<std::string>();
@@ -272,7 +282,7 @@ int32_t guarded(const growbench_host* host, F&& f) {
   try {
     return f();
   } catch (py::error_already_set& e) {
-    const bool input = e.matches(py::module_::import("growbench").attr("InputError"));
+    const bool input = e.matches(g_input_error);
     const bool memory = e.matches(PyExc_MemoryError);
     std::string what = e.what();  // the exception and its traceback
     host->fail(host->context, what.c_str());
@@ -352,10 +362,23 @@ std::vector<T> column(const py::dict& d, const char* key, std::size_t n, std::si
 void take_nodes(Instance& s, const py::dict& d) {
   if (!d.contains("positions")) throw py::value_error("plant: expected the key 'positions', an (N, 3) array");
   const auto [pts, n] = points_of(d["positions"], "plant['positions']");
-  const auto radius = column<float>(d, "radius", n), order = column<float>(d, "order", n);
-  const auto parent = column<std::int64_t>(d, "parent", n), shoot = column<std::int64_t>(d, "shoot", n);
+  const auto radius = column<float>(d, "radius", n);
+  const auto parent = column<std::int64_t>(d, "parent", n);
+  const auto order = column<std::int64_t>(d, "order", n), shoot = column<std::int64_t>(d, "shoot", n);
   const auto birth = column<std::int64_t>(d, "birth_step", n);
   if (parent.empty() && n > 0) throw py::value_error("plant: expected the key 'parent', N parent indices (-1: a root)");
+  // Integers that do not fit their C members are refused, not wrapped into valid-looking ones.
+  auto fits = [](const std::vector<std::int64_t>& v, std::int64_t lo, std::int64_t hi, const char* key) {
+    for (std::size_t i = 0; i < v.size(); ++i)
+      if (v[i] < lo || v[i] > hi)
+        throw py::value_error(std::string("plant['") + key + "'][" + std::to_string(i) + "] is " +
+                              std::to_string(v[i]) + ", outside [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                              "]");
+  };
+  fits(parent, -1, INT32_MAX, "parent");
+  fits(order, 0, UINT32_MAX, "order");
+  fits(shoot, 0, UINT32_MAX, "shoot");
+  fits(birth, 0, UINT32_MAX, "birth_step");
   s.nodes.assign(n, growbench_node{});
   for (std::size_t i = 0; i < n; ++i) {
     growbench_node& g = s.nodes[i];
@@ -370,10 +393,18 @@ void take_nodes(Instance& s, const py::dict& d) {
 
 void take_organs(Instance& s, const py::dict& d) {
   s.organs.clear();
+  s.organ_shape.clear();
+  s.organ_tint.clear();
+  s.shape_names.clear();
   if (!d.contains("organ_positions")) return;
   const auto [pts, m] = points_of(d["organ_positions"], "plant['organ_positions']");
   const auto turn = column<float>(d, "organ_orientations", m, 4), size = column<float>(d, "organ_sizes", m);
   const auto kind = column<std::int32_t>(d, "organ_kinds", m), node = column<std::int32_t>(d, "organ_nodes", m);
+  const auto shape = column<std::int64_t>(d, "organ_shape", m);
+  for (std::size_t i = 0; i < shape.size(); ++i)
+    if (shape[i] < 0 || shape[i] > GROWBENCH_KIND_SHAPE)
+      throw py::value_error("plant['organ_shape'][" + std::to_string(i) + "] is " + std::to_string(shape[i]) +
+                            ": expected an index into organ_shapes, or growbench.KIND_SHAPE");
   s.organs.assign(m, growbench_organ{});
   for (std::size_t i = 0; i < m; ++i) {
     growbench_organ& o = s.organs[i];
@@ -384,7 +415,7 @@ void take_organs(Instance& s, const py::dict& d) {
     o.kind = kind.empty() ? GROWBENCH_ORGAN_LEAF : kind[i];
     o.node = node.empty() ? -1 : node[i];
   }
-  s.organ_shape = column<std::uint16_t>(d, "organ_shape", m);
+  s.organ_shape.assign(shape.begin(), shape.end());
   const auto tint = column<float>(d, "organ_tint", m, 3);
   s.organ_tint.assign(tint.size() / 3, growbench_vec3{});
   if (!tint.empty()) std::memcpy(s.organ_tint.data(), tint.data(), tint.size() * sizeof(float));
@@ -395,6 +426,7 @@ void take_organs(Instance& s, const py::dict& d) {
 void take_attributes(Instance& s, const py::dict& d) {
   s.attribute_names.clear();
   s.attribute_values.clear();
+  s.attribute_components.clear();
   if (!d.contains("attributes")) return;
   for (const auto& [key, value] : d["attributes"].cast<py::dict>()) {
     auto a = F32::ensure(value);
@@ -404,6 +436,7 @@ void take_attributes(Instance& s, const py::dict& d) {
       throw py::value_error("plant['attributes']['" + text_of(key) + "']: expected N or (N, k) values");
     s.attribute_names.push_back(text_of(key));
     s.attribute_values.emplace_back(a.data(), a.data() + a.size());
+    s.attribute_components.push_back(static_cast<std::uint32_t>(k));
   }
 }
 
@@ -421,9 +454,7 @@ void fill_view(Instance& s, growbench_plant_view* out) {
   out->organ_tint = s.organ_tint.empty() ? nullptr : s.organ_tint.data();
   s.attributes.clear();
   for (std::size_t k = 0; k < s.attribute_names.size(); ++k)
-    s.attributes.push_back({s.attribute_names[k].c_str(),
-                            static_cast<uint32_t>(s.nodes.empty() ? 1 : s.attribute_values[k].size() / s.nodes.size()),
-                            s.attribute_values[k].data()});
+    s.attributes.push_back({s.attribute_names[k].c_str(), s.attribute_components[k], s.attribute_values[k].data()});
   out->node_attributes = s.attributes.data();
   out->node_attribute_count = static_cast<uint32_t>(s.attributes.size());
 }
@@ -435,7 +466,8 @@ std::array<Script*, kSlots> g_scripts{};
 
 template <int N>
 growbench_instance* create(const growbench_host* host) {
-  auto* inst = new Instance;
+  auto* inst = new (std::nothrow) Instance;
+  if (!inst) return nullptr;
   inst->host = host;
   inst->script = g_scripts[N];
   const int32_t r = guarded(host, [&] {
@@ -452,6 +484,7 @@ growbench_instance* create(const growbench_host* host) {
 int32_t start(growbench_instance* i, const growbench_scene* scene, const growbench_value* values, uint64_t seed) {
   Instance& s = self(i);
   return guarded(s.host, [&] {
+    s.stale = true;
     s.self.attr("start")(scene_object(*scene), Host(s.host), params_object(*s.script, values), seed);
     return int32_t{GROWBENCH_OK};
   });
@@ -461,6 +494,7 @@ int32_t step(growbench_instance* i) {
   Instance& s = self(i);
   bool more = false;
   const int32_t r = guarded(s.host, [&] {
+    s.stale = true;
     more = py::bool_(s.self.attr("step")());
     return int32_t{GROWBENCH_OK};
   });
@@ -470,19 +504,46 @@ int32_t step(growbench_instance* i) {
 int32_t finish(growbench_instance* i) {
   Instance& s = self(i);
   return guarded(s.host, [&] {
+    s.stale = true;
     if (py::hasattr(s.self, "finish")) s.self.attr("finish")();
     return int32_t{GROWBENCH_OK};
   });
 }
 
+// The Python plant, taken once per change: plant() and counts() after the same step share it.
+void take_plant(Instance& s) {
+  if (!s.stale) return;
+  const py::dict d = s.self.attr("plant")();
+  take_nodes(s, d);
+  take_organs(s, d);
+  take_attributes(s, d);
+  s.stale = false;
+}
+
 int32_t plant(growbench_instance* i, growbench_plant_view* out) {
   Instance& s = self(i);
   return guarded(s.host, [&] {
-    const py::dict d = s.self.attr("plant")();
-    take_nodes(s, d);
-    take_organs(s, d);
-    take_attributes(s, d);
+    take_plant(s);
     fill_view(s, out);
+    return int32_t{GROWBENCH_OK};
+  });
+}
+
+// The counts the host reads after every step: the class's counts() when it has one (cheaper than building
+// the plant dict), else the plant's, taken once per step.
+void counts(growbench_instance* i, uint64_t* nodes, uint64_t* organs) {
+  Instance& s = self(i);
+  *nodes = *organs = 0;
+  guarded(s.host, [&] {
+    if (py::hasattr(s.self, "counts")) {
+      const auto c = s.self.attr("counts")().cast<std::pair<std::uint64_t, std::uint64_t>>();
+      *nodes = c.first;
+      *organs = c.second;
+    } else {
+      take_plant(s);
+      *nodes = s.nodes.size();
+      *organs = s.organs.size();
+    }
     return int32_t{GROWBENCH_OK};
   });
 }
@@ -550,14 +611,17 @@ growbench_param param_row(Script& sc, const py::dict& d) {
 }
 
 // The script's class: the module's PLUGIN.
-py::object load_class(const std::string& path) {
+py::object load_class(const std::string& path, int slot) {
   py::module_ sys = py::module_::import("sys");
   const std::string dir = path.substr(0, path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/'));
   if (!dir.empty()) sys.attr("path").attr("insert")(0, dir);
   py::module_ util = py::module_::import("importlib.util");
-  const py::object spec = util.attr("spec_from_file_location")("growbench_plugin_script", path);
+  // In sys.modules under its own name, as an imported module is (dataclasses and pickle look it up there).
+  const std::string name = "growbench_plugin_" + std::to_string(slot);
+  const py::object spec = util.attr("spec_from_file_location")(name, path);
   if (spec.is_none()) throw py::value_error(path + ": not a Python file");
   const py::object mod = util.attr("module_from_spec")(spec);
+  sys.attr("modules")[py::str(name)] = mod;
   spec.attr("loader").attr("exec_module")(mod);
   if (!py::hasattr(mod, "PLUGIN"))
     throw py::value_error(path + ": no PLUGIN; end the file with PLUGIN = YourAlgorithmClass (docs/plugins.md)");
@@ -589,8 +653,25 @@ void fill_table(Script& sc, int slot) {
   t.step = &step;
   t.finish = &finish;
   t.plant = &plant;
+  t.counts = &counts;
   t.stats = &stats;
   t.destroy = &destroy;
+}
+
+}  // namespace
+
+namespace {
+
+// Python without signal handlers of its own, and with string hashing fixed: each trial is a fresh process,
+// and a random hash seed would let a script that walks a set of strings grow another plant in each.
+void start_interpreter() {
+  PyConfig config;
+  PyConfig_InitPythonConfig(&config);
+  config.install_signal_handlers = 0;
+  config.use_hash_seed = 1;
+  config.hash_seed = 0;
+  py::initialize_interpreter(&config);
+  g_input_error = py::module_::import("growbench").attr("InputError").ptr();
 }
 
 }  // namespace
@@ -607,9 +688,9 @@ extern "C" GROWBENCH_PLUGIN_EXPORT const growbench_plugin* growbench_python_plug
   while (slot < kSlots && g_scripts[slot]) ++slot;
   if (slot == kSlots) return say("more than 8 Python algorithms in one process");
   try {
-    if (!Py_IsInitialized()) py::initialize_interpreter(false);  // no signal handlers of Python's own
+    if (!Py_IsInitialized()) start_interpreter();
     auto sc = std::make_unique<Script>();
-    sc->cls = load_class(path);
+    sc->cls = load_class(path, slot);
     fill_table(*sc, slot);
     g_scripts[slot] = sc.release();
     return &g_scripts[slot]->table;
