@@ -29,6 +29,10 @@ bool embree_takes(const glm::vec3& o, const glm::vec3& d, float tmin, float tmax
   return big.x <= large && big.y <= large && big.z <= large && !std::isnan(tmin) && !std::isnan(tmax);
 }
 
+bool finite_point(const glm::vec3& p) {
+  return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+}
+
 RTCRay make_ray(const glm::vec3& o, const glm::vec3& d, float tmin, float tmax) {
   RTCRay ray{};
   ray.org_x = o.x;
@@ -633,6 +637,7 @@ bool SceneQuery::inside_mesh(std::uint32_t mesh, const glm::vec3& p) const {
 }
 
 ClosestHit SceneQuery::closest_point(const glm::vec3& p, float max_distance, bool climbable_only) const {
+  if (!finite_point(p)) return {};  // no surface is nearest to a point that is not one
   PointQueryState st{&embree_->main->meshes, {}, climbable_only && !not_climbable_.empty() ? &not_climbable_ : nullptr};
   // The vertex bound counts every mesh, so it only bounds an unfiltered query.
   const float radius = std::isfinite(max_distance) ? max_distance
@@ -665,6 +670,7 @@ bool SceneQuery::light_visible(const glm::vec3& p, float bias) const {
 
 float SceneQuery::signed_distance(const glm::vec3& p) const {
   if (!sdf_) throw std::logic_error("SceneQuery: the distance field was not built");
+  if (!finite_point(p)) return std::numeric_limits<float>::quiet_NaN();
   const float v = sdf_->sample(p);
   const float band = sdf_->background();
   if (std::abs(v) < 0.999f * band) return v;

@@ -88,16 +88,32 @@ void SdfGrid::build(const std::vector<const TriangleMesh*>& meshes, const std::v
 
 SdfGrid::~SdfGrid() = default;
 
+namespace {
+
+// A point OpenVDB's 32-bit coordinates cannot address (NaN among them, whose floor is undefined) lies beyond
+// the narrow band, where the field holds its background.
+bool addressable(const openvdb::Vec3d& index) {
+  const double reach = SdfGrid::max_voxel_reach();
+  return std::abs(index.x()) <= reach && std::abs(index.y()) <= reach && std::abs(index.z()) <= reach;
+}
+
+}  // namespace
+
 float SdfGrid::sample(const glm::vec3& p) const {
   // An unregistered accessor: cheap to make, so one per call keeps concurrent queries safe.
   openvdb::tree::ValueAccessor<const openvdb::FloatTree, false> acc(impl_->grid->constTree());
   const openvdb::Vec3d ijk = impl_->grid->transform().worldToIndex(openvdb::Vec3d(p.x, p.y, p.z));
+  if (!addressable(ijk)) return background_;
   return openvdb::tools::BoxSampler::sample(acc, ijk);
 }
 
 float SdfGrid::sample_gradient(const glm::vec3& p, glm::vec3& gradient) const {
   openvdb::tree::ValueAccessor<const openvdb::FloatTree, false> acc(impl_->grid->constTree());
   const openvdb::Vec3d xyz = impl_->grid->transform().worldToIndex(openvdb::Vec3d(p.x, p.y, p.z));
+  if (!addressable(xyz)) {
+    gradient = glm::vec3(0.0f);
+    return background_;
+  }
   const openvdb::Coord ijk = openvdb::Coord::floor(xyz);
   float v[2][2][2];
   openvdb::tools::BoxSampler::getValues(v, acc, ijk);

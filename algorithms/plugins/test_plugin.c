@@ -145,7 +145,9 @@ static int queries_take_nan(state* s) {
   const growbench_vec3 bad[3] = {{nan, 0.5f, 0.0f}, {inf, 0.0f, 0.0f}, {0.0f, -inf, nan}};
   growbench_ray rays[4];
   growbench_ray_hit hits[4];
-  uint8_t occluded[4], lit[3];
+  uint8_t occluded[4], lit[3], inside[3];
+  growbench_closest_hit near[3];
+  float distance[3];
   int k;
   for (k = 0; k < 3; ++k) {
     rays[k].origin = bad[k];
@@ -166,6 +168,20 @@ static int queries_take_nan(state* s) {
   for (k = 0; k < 4; ++k)
     if (hits[k].hit != 0 || occluded[k] != 0 || (k < 3 && lit[k] != 0)) {
       s->host->fail(s->host->context, "fault=nan_query: a query on NaN or infinite input answered something");
+      return 0;
+    }
+  /* Points: inside nothing, near no surface, at a distance that is NaN. */
+  memset(inside, 7, sizeof inside);
+  memset(near, 0xff, sizeof near);
+  s->host->inside(s->host->context, bad, 3, inside);
+  s->host->closest_points(s->host->context, bad, 3, INFINITY, 0, near);
+  for (k = 0; k < 3; ++k) distance[k] = 0.0f;
+  if (s->scene->has_sdf && s->host->signed_distance(s->host->context, bad, 3, distance, NULL) == GROWBENCH_OK)
+    for (k = 0; k < 3; ++k)
+      if (!isnan(distance[k])) inside[k] = 9;
+  for (k = 0; k < 3; ++k)
+    if (inside[k] != 0 || near[k].found != 0) {
+      s->host->fail(s->host->context, "fault=nan_query: a point query on NaN or infinite input answered something");
       return 0;
     }
   return 1;
