@@ -6,11 +6,13 @@
 #include <cctype>
 #include <cmath>
 #include <cstddef>
+#include <filesystem>
 #include <mutex>
 #include <new>
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <stb_image_write.h>
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
@@ -63,6 +65,37 @@ growbench_shape shape_view(const Shape& s) {
   return v;
 }
 
+// The texture coordinates and surface frame at p on triangle t of m, which has them (growbench_surface_frame).
+growbench_surface_frame surface_frame(const TriangleMesh& m, std::uint32_t t, const glm::vec3& p) {
+  const glm::uvec3 c = m.triangles[t], k = m.uv_triangles[t];
+  const glm::vec3 a = m.vertices[c.x], e1 = m.vertices[c.y] - a, e2 = m.vertices[c.z] - a;
+  const glm::vec2 ta = m.uvs[k.x], d1 = m.uvs[k.y] - ta, d2 = m.uvs[k.z] - ta;
+  growbench_surface_frame f{};
+  // Barycentric coordinates of p's projection onto the triangle's plane (in double: slivers are common).
+  const glm::dvec3 de1(e1), de2(e2), dp = glm::dvec3(p) - glm::dvec3(a);
+  const double d11 = glm::dot(de1, de1), d12 = glm::dot(de1, de2), d22 = glm::dot(de2, de2);
+  const double det = d11 * d22 - d12 * d12;
+  if (!(det > 0.0)) return f;  // a degenerate triangle has no frame
+  const double p1 = glm::dot(dp, de1), p2 = glm::dot(dp, de2);
+  const double b1 = (d22 * p1 - d12 * p2) / det, b2 = (d11 * p2 - d12 * p1) / det;
+  const glm::dvec2 uv = glm::dvec2(ta) + b1 * glm::dvec2(d1) + b2 * glm::dvec2(d2);
+  f.found = 1;
+  f.u = static_cast<float>(uv.x);
+  f.v = static_cast<float>(uv.y);
+  f.normal = abi::of(glm::normalize(glm::cross(e1, e2)));
+  // dp/du and dp/dv from e1 = dp_du d1.x + dp_dv d1.y and e2 likewise; zero where the UVs are degenerate.
+  const float uv_det = d1.x * d2.y - d2.x * d1.y;
+  if (uv_det != 0.0f && std::isfinite(1.0f / uv_det)) {
+    f.dp_du = abi::of((e1 * d2.y - e2 * d1.y) / uv_det);
+    f.dp_dv = abi::of((e2 * d1.x - e1 * d2.x) / uv_det);
+  }
+  return f;
+}
+
+bool is_name_part(char c) {
+  return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+}
+
 class PluginAlgorithm final : public GrowthAlgorithm {
  public:
   PluginAlgorithm(const growbench_plugin* t, const AlgorithmInfo& info, const std::string& path)
@@ -77,6 +110,7 @@ class PluginAlgorithm final : public GrowthAlgorithm {
 
   void start(const Scene& scene, const SceneQuery& query, const Params& params, std::uint64_t seed) override {
     q_ = &query.host_queries();
+    scene_in_ = &scene;
     seed_ = seed;
     describe_scene(scene, query);
     make_host();
@@ -113,6 +147,20 @@ class PluginAlgorithm final : public GrowthAlgorithm {
 
   std::size_t node_count() const override { return counts().first; }
   std::size_t organ_count() const override { return counts().second; }
+
+  std::vector<OutputFile> write_outputs(const OutputRequest& r) const override {
+    const Plant& p = plant();
+    std::vector<OutputFile> out;
+    for (std::size_t k = 0; k < p.decals.size(); ++k) {
+      const std::string name = r.prefix + p.decals[k].image;
+      const std::string path = (std::filesystem::path(r.dir) / name).string();
+      const auto [w, h] = decal_sizes_[k];
+      if (stbi_write_png(path.c_str(), w, h, 4, decal_pixels_[k].data(), w * 4) == 0)
+        throw std::runtime_error(fmt::format("{}: cannot write the decal image {}", who_, path));
+      out.push_back({name, static_cast<std::uint64_t>(std::filesystem::file_size(path))});
+    }
+    return out;
+  }
 
   std::vector<std::pair<std::string, double>> stats() const override {
     std::vector<std::pair<std::string, double>> out;
@@ -249,6 +297,71 @@ class PluginAlgorithm final : public GrowthAlgorithm {
     }
     copy_polygons(v);
     if (t_->abi_version >= 2) copy_styles(v);
+    if (t_->abi_version >= 3) {
+      copy_groups(v);
+      copy_decals(v);
+    }
+  }
+
+  // Version 3's node groups, checked as the L-system's g and group_prefix are.
+  void copy_groups(const growbench_plant_view& v) const {
+    const std::string prefix = v.group_prefix ? v.group_prefix : "";
+    if (!std::all_of(prefix.begin(), prefix.end(), is_name_part) || prefix.size() > 64)
+      throw malformed(
+          fmt::format("group_prefix '{}' (expected letters, digits and '_', at most 64 bytes: it "
+                      "names the meshes' groups)",
+                      escape_utf8(prefix)));
+    if (!v.node_groups) return;
+    plant_.node_groups.assign(v.node_groups, v.node_groups + v.node_count);
+    for (std::size_t i = 0; i < plant_.node_groups.size(); ++i)
+      if (plant_.node_groups[i] < -1)
+        throw malformed(
+            fmt::format("node {} has group {} (expected -1 for none, or 0 and up)", i, plant_.node_groups[i]));
+    plant_.group_prefix = prefix;
+  }
+
+  // Version 3's decals: the images are copied, and written as PNGs by write_outputs().
+  void copy_decals(const growbench_plant_view& v) const {
+    if (v.decal_count && !v.decals) throw malformed("a NULL array with a non-zero count");
+    decal_pixels_.clear();
+    decal_sizes_.clear();
+    for (std::uint32_t k = 0; k < v.decal_count; ++k) {
+      const growbench_decal& d = v.decals[k];
+      if (const std::string why = decal_problem(d); !why.empty()) throw malformed(fmt::format("decal {} {}", k, why));
+      SurfaceDecal s;
+      s.image = fmt::format("decal{}.png", k);
+      s.mesh = d.mesh;
+      s.origin = abi::of(d.origin);
+      s.u_axis = abi::of(d.u_axis);
+      s.v_axis = abi::of(d.v_axis);
+      plant_.decals.push_back(s);
+      decal_pixels_.emplace_back(d.rgba, d.rgba + std::size_t{d.width} * d.height * 4);
+      decal_sizes_.resize(k + 1);
+      decal_sizes_[k] = {static_cast<int>(d.width), static_cast<int>(d.height)};
+    }
+  }
+
+  [[nodiscard]] std::string decal_problem(const growbench_decal& d) const {
+    constexpr std::uint32_t kMaxSide = 8192;
+    if (d.width < 1 || d.height < 1 || d.width > kMaxSide || d.height > kMaxSide)
+      return fmt::format("is {} x {} pixels (expected 1 to {} each way)", d.width, d.height, kMaxSide);
+    if (!d.rgba) return "has no pixels (rgba is NULL)";
+    const auto& meshes = scene_in_->meshes;
+    if (d.mesh >= 0) {
+      if (static_cast<std::size_t>(d.mesh) >= meshes.size())
+        return fmt::format("follows mesh {}, but the scene has {} meshes", d.mesh, meshes.size());
+      if (!meshes[static_cast<std::size_t>(d.mesh)].has_uvs())
+        return fmt::format("follows mesh {} ('{}'), which has no texture coordinates", d.mesh,
+                           escape_utf8(meshes[static_cast<std::size_t>(d.mesh)].name));
+      return "";
+    }
+    if (d.mesh != GROWBENCH_PLANAR_DECAL)
+      return fmt::format("has mesh {} (expected a mesh index, or GROWBENCH_PLANAR_DECAL)", d.mesh);
+    const glm::vec3 o = abi::of(d.origin), u = abi::of(d.u_axis), w = abi::of(d.v_axis);
+    const glm::vec3 n = glm::cross(u, w);
+    if (!std::isfinite(glm::dot(o, o) + glm::dot(u, u) + glm::dot(w, w)) || !(glm::dot(n, n) > 0.0f))
+      return "is planar with a non-finite origin or axes, or parallel axes";
+    return "";
   }
 
   [[nodiscard]] PluginError malformed(const std::string& what) const {
@@ -338,6 +451,9 @@ class PluginAlgorithm final : public GrowthAlgorithm {
   std::uint64_t version_ = 0;                    // bumped by every call that may change the plant
   mutable std::uint64_t plant_version_ = ~0ull;  // the version plant_ was copied at
   mutable Plant plant_;
+  const Scene* scene_in_ = nullptr;
+  mutable std::vector<std::vector<std::uint8_t>> decal_pixels_;  // per plant_.decals
+  mutable std::vector<std::pair<int, int>> decal_sizes_;
 
   // The host table's functions: `context` is the PluginAlgorithm.
   static PluginAlgorithm& self(void* c) { return *static_cast<PluginAlgorithm*>(c); }
@@ -422,15 +538,36 @@ struct HostFunctions {
   static void light_visible(void* c, const growbench_vec3* p, std::uint64_t n, float bias, std::uint8_t* out) {
     self(c).q_->light_visible(points(p, n), bias, {out, static_cast<std::size_t>(n)});
   }
+  static std::int32_t mesh_uvs(void* c, std::uint32_t mesh, const float** uvs, std::uint64_t* count,
+                               const std::uint32_t** triangles) {
+    const auto& meshes = self(c).scene_in_->meshes;
+    const bool has = mesh < meshes.size() && meshes[mesh].has_uvs();
+    static_assert(sizeof(glm::vec2) == 2 * sizeof(float) && sizeof(glm::uvec3) == 3 * sizeof(std::uint32_t));
+    if (uvs) *uvs = has ? &meshes[mesh].uvs[0].x : nullptr;
+    if (count) *count = has ? meshes[mesh].uvs.size() : 0;
+    if (triangles) *triangles = has ? &meshes[mesh].uv_triangles[0].x : nullptr;
+    return has ? 1 : 0;
+  }
+  static void surface_frames(void* c, const growbench_surface_point* p, std::uint64_t n, growbench_surface_frame* out) {
+    const auto& meshes = self(c).scene_in_->meshes;
+    for (std::uint64_t i = 0; i < n; ++i) {
+      const glm::vec3 x = abi::of(p[i].point);
+      const bool ok = p[i].mesh < meshes.size() && meshes[p[i].mesh].has_uvs() &&
+                      p[i].triangle < meshes[p[i].mesh].triangles.size() && std::isfinite(x.x + x.y + x.z);
+      out[i] = ok ? surface_frame(meshes[p[i].mesh], p[i].triangle, x) : growbench_surface_frame{};
+    }
+  }
   static PluginAlgorithm& self(void* c) { return PluginAlgorithm::self(c); }
 };
 
 void PluginAlgorithm::make_host() {
   host_ = {};
-  // A version-1 plugin is given the table a version-1 host gave: its version, and its size.
-  const bool v1 = t_->abi_version < 2;
-  host_.abi_version = v1 ? t_->abi_version : GROWBENCH_PLUGIN_ABI_VERSION;
-  host_.struct_size = v1 ? offsetof(growbench_host, parallel_for) : sizeof(growbench_host);
+  // A plugin of an older version is given the table a host of its version gave: that version, and its size.
+  const std::uint32_t v = std::min(t_->abi_version, GROWBENCH_PLUGIN_ABI_VERSION);
+  host_.abi_version = v;
+  host_.struct_size = v < 2   ? offsetof(growbench_host, parallel_for)
+                      : v < 3 ? offsetof(growbench_host, mesh_uvs)
+                              : sizeof(growbench_host);
   host_.context = this;
   host_.threads =
       static_cast<std::uint32_t>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
@@ -446,7 +583,11 @@ void PluginAlgorithm::make_host() {
   host_.inside_shape = &HostFunctions::inside_shape;
   host_.sample_surface = &HostFunctions::sample_surface;
   host_.light_visible = &HostFunctions::light_visible;
-  if (!v1) host_.parallel_for = &HostFunctions::parallel_for;
+  if (v >= 2) host_.parallel_for = &HostFunctions::parallel_for;
+  if (v >= 3) {
+    host_.mesh_uvs = &HostFunctions::mesh_uvs;
+    host_.surface_frames = &HostFunctions::surface_frames;
+  }
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <stb_image.h>
 
 #include "algorithms/plugins/loader.hpp"
 #include "core/file_hash.hpp"
@@ -59,7 +60,7 @@ TEST(PluginLoader, ALibraryWithoutTheEntryPoint) {
 TEST(PluginLoader, AnotherAbiVersionSaysBoth) {
   const std::string p = copy_of("abi_99", "abi_99");
   EXPECT_EQ(load_error(p),
-            p + ": built for plugin ABI version 99, but this growbench speaks versions 1 to 2; rebuild it "
+            p + ": built for plugin ABI version 99, but this growbench speaks versions 1 to 3; rebuild it "
                 "against this growbench's SDK");
 }
 
@@ -183,7 +184,7 @@ TEST(CPlugin, GrowsAndItsRecordNamesThePlugin) {
   EXPECT_EQ(o.version, "1");
 }
 
-// A version-1 plugin still loads under the version-2 host, is given version 1's host table (the plugin checks
+// A version-1 plugin still loads under a newer host, is given version 1's host table (the plugin checks
 // it), and grows the plant it grew under the version-1 host: this hash is what that host recorded. The wall's
 // stalks meet nothing, so their floats are the same in every build; where a stalk stops at a solid (the
 // boulder) an inside test within rounding of the rock may go either way under other compiler flags (ASan's).
@@ -233,6 +234,90 @@ TEST(CPlugin, VersionTwoCarriesOrganShapesTintsAndNodeAttributes) {
     in.read(header.data(), static_cast<std::streamsize>(header.size()));
     EXPECT_NE(header.find("property float height\n"), std::string::npos) << file;
     EXPECT_NE(header.find("property uchar red\n"), std::string::npos) << file;
+  }
+}
+
+// Version 3 reads the scene's texture coordinates and gives back node groups and a decal. The plugin probes the
+// surface frame where the line down -Z through the middle of the uv-cube meets its front face (z = +1 in the
+// file), whose corners the file maps to u in [0.375, 0.625] and v in [0.25, 0.5] with u along +X and v along +Y:
+// its middle is (0.5, 0.375), and a quarter of u or v spans the face's side. The decal follows that mesh, is
+// written as a PNG of the plugin's pixels, and the groups become the skeleton's group property and the OBJ's parts.
+TEST(CPlugin, VersionThreeReadsTextureCoordinatesAndGivesGroupsAndADecal) {
+  TrialSpec spec = line_spec("mesh:uv-cube");
+  spec.algorithm = "line_v3";
+  spec.plugins = {fixture("line_v3")};
+  spec.out_dir = test::temp_dir("plugin_v3").string();
+  Plant plant;
+  const TrialRecord r = run_trial_record(spec, {}, &plant);
+  EXPECT_EQ(r.context->plugins.at(0).abi_version, 3u);
+  const Scene scene = load_scene("mesh:uv-cube");
+  const auto& st = r.results.algorithm_stats;
+  const auto cube = static_cast<std::size_t>(st.at("uv_mesh"));
+  ASSERT_LT(cube, scene.meshes.size());
+  EXPECT_EQ(st.at("uv_count"), static_cast<double>(scene.meshes[cube].uvs.size()));
+  EXPECT_EQ(st.at("uv_count"), 14.0);  // the file's vt lines
+  EXPECT_NEAR(st.at("probe_u"), 0.5, 1e-5);
+  EXPECT_NEAR(st.at("probe_v"), 0.375, 1e-5);
+  EXPECT_NEAR(st.at("probe_du_x"), 1.0, 1e-5);
+  EXPECT_NEAR(st.at("probe_dv_y"), 1.0, 1e-5);
+  EXPECT_NEAR(st.at("probe_normal_z"), 1.0, 1e-5);
+  const Aabb b = scene.meshes[cube].bounds();
+  EXPECT_NEAR(st.at("probe_du_length") * 0.25, b.max.x - b.min.x, 1e-4);
+  EXPECT_NEAR(st.at("probe_dv_length") * 0.25, b.max.y - b.min.y, 1e-4);
+
+  ASSERT_EQ(plant.decals.size(), 1u);
+  EXPECT_EQ(plant.decals[0].mesh, static_cast<std::int32_t>(cube));
+  EXPECT_EQ(plant.decals[0].image, "decal0.png");
+  int w = 0, h = 0, n = 0;
+  const std::string png = (fs::path(spec.out_dir) / "decal0.png").string();
+  std::unique_ptr<unsigned char, void (*)(void*)> px(stbi_load(png.c_str(), &w, &h, &n, 4), stbi_image_free);
+  ASSERT_TRUE(px) << png;
+  ASSERT_EQ(w, 4);
+  ASSERT_EQ(h, 2);
+  for (int k = 0; k < 8; ++k) {  // red by column, green by row, as the plugin painted them
+    EXPECT_EQ(px.get()[4 * k], 60 * (k % 4)) << k;
+    EXPECT_EQ(px.get()[4 * k + 1], 120 * (k / 4)) << k;
+    EXPECT_EQ(px.get()[4 * k + 2], 200) << k;
+  }
+
+  EXPECT_EQ(plant.group_prefix, "stalk");
+  ASSERT_EQ(plant.node_groups.size(), plant.nodes.size());
+  for (std::size_t i = 0; i < plant.nodes.size(); ++i)
+    EXPECT_EQ(plant.node_groups[i], i == 0 ? -1 : static_cast<std::int32_t>(plant.nodes[i].shoot)) << i;
+  std::ifstream in(fs::path(spec.out_dir) / "skeleton.ply", std::ios::binary);
+  std::string header(2048, '\0');
+  in.read(header.data(), static_cast<std::streamsize>(header.size()));
+  EXPECT_NE(header.find("property int group\n"), std::string::npos);
+  std::ifstream obj_in(fs::path(spec.out_dir) / "plant.obj");
+  const std::string obj((std::istreambuf_iterator<char>(obj_in)), std::istreambuf_iterator<char>());
+  for (std::size_t i = 0; i < load_scene("mesh:uv-cube").seeds.size(); ++i)  // a part per stalk, named for it
+    EXPECT_NE(obj.find(fmt::format("g branches stalk{}\n", i)), std::string::npos) << i;
+}
+
+// Where no mesh has texture coordinates the host says so, and the plugin's planar decal is kept as given. A
+// decal the scene cannot hold is the plugin's error, named as such.
+TEST(CPlugin, VersionThreeWithoutTextureCoordinatesAndWithABadDecal) {
+  TrialSpec spec = line_spec("wall");
+  spec.algorithm = "line_v3";
+  spec.plugins = {fixture("line_v3")};
+  Plant plant;
+  const TrialRecord r = run_trial_record(spec, {}, &plant);
+  EXPECT_EQ(r.results.algorithm_stats.at("uv_mesh"), -1.0);
+  EXPECT_EQ(r.results.algorithm_stats.at("uv_count"), 0.0);
+  ASSERT_EQ(plant.decals.size(), 1u);
+  EXPECT_EQ(plant.decals[0].mesh, kPlanarDecal);
+  const Scene scene = load_scene("wall");
+  EXPECT_EQ(plant.decals[0].origin, scene.bounds().min);
+
+  spec.params = {"fault=bad_decal"};
+  try {
+    run_trial_record(spec);
+    ADD_FAILURE() << "a decal on a mesh the scene lacks was taken";
+  } catch (const PluginError& e) {
+    EXPECT_NE(std::string(e.what()).find("plugin " + fs::canonical(fixture("line_v3")).string() +
+                                         ") returned a malformed plant: decal 0 follows mesh 99, but the scene has"),
+              std::string::npos)
+        << e.what();
   }
 }
 
@@ -481,7 +566,7 @@ TEST(PythonPlugin, TheNumpyExampleGrowsLikeAnyPlugin) {
   EXPECT_GT(one.nodes.size(), 100u);
   EXPECT_EQ(one.validate(), "");
   EXPECT_EQ(r1.context->plugins.at(0).path, fs::canonical(script).string());
-  EXPECT_EQ(r1.context->plugins.at(0).abi_version, 2u);
+  EXPECT_EQ(r1.context->plugins.at(0).abi_version, GROWBENCH_PLUGIN_ABI_VERSION);
   EXPECT_EQ(one.organ_shapes, std::vector<std::string>{"blossom"});
   ASSERT_FALSE(one.organs.empty());
   EXPECT_EQ(one.organs[0].kind, OrganKind::Flower);
@@ -491,6 +576,66 @@ TEST(PythonPlugin, TheNumpyExampleGrowsLikeAnyPlugin) {
   const Scene boulder = load_scene("boulder");
   SceneQuery q(boulder);
   for (const auto& n : one.nodes) ASSERT_FALSE(q.inside(n.position));
+}
+
+// Python reaches version 3 too: the uv-cube's texture coordinates where the line down -Z through its middle
+// meets the front face (as the C plugin's probe: u 0.5, v 0.375, u along +X), node groups and a decal.
+TEST(PythonPlugin, ReadsTextureCoordinatesAndGivesGroupsAndADecal) {
+  const fs::path dir = test::temp_dir("python_v3");
+  const std::string script = test::write_text(dir / "uv.py", R"(import numpy as np
+import growbench
+class Uv:
+    name = 'py_uv'
+    def start(self, scene, host, params, seed):
+        self.cube = next(m for m in range(len(scene.meshes)) if host.mesh_uvs(m) is not None)
+        uvs, tris = host.mesh_uvs(self.cube)
+        v = scene.meshes[self.cube].vertices
+        lo, hi = v.min(axis=0), v.max(axis=0)
+        q = np.array([[(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2] + 1]])
+        p, n, d, found, mesh, tri = host.closest_points(q, triangles=True)
+        ok, uv, normal, du, dv = host.surface_frames(p, mesh, tri)
+        self.figures = {'uv_count': len(uvs), 'triangles': len(tris), 'u': float(uv[0, 0]), 'v': float(uv[0, 1]),
+                        'found': float(ok[0]), 'du_x': float(du[0, 0] / np.linalg.norm(du[0]))}
+        self.seed = scene.seed_positions[0]
+    def step(self):
+        return False
+    def plant(self):
+        image = np.zeros((2, 3, 4), dtype=np.uint8)
+        image[..., 0] = [[10, 20, 30], [40, 50, 60]]
+        image[..., 3] = 255
+        return {'positions': [self.seed, self.seed + [0, 0.1, 0]], 'parent': [-1, 0],
+                'groups': [-1, 2], 'group_prefix': 'py',
+                'decals': [{'mesh': self.cube, 'image': image}]}
+    def stats(self):
+        return self.figures
+PLUGIN = Uv
+)");
+  TrialSpec spec;
+  spec.algorithm = "py_uv";
+  spec.scene = "mesh:uv-cube";
+  spec.plugins = {script};
+  spec.metrics = false;
+  spec.out_dir = (dir / "out").string();
+  fs::create_directories(spec.out_dir);
+  Plant plant;
+  const TrialRecord r = run_trial_record(spec, {}, &plant);
+  const auto& st = r.results.algorithm_stats;
+  EXPECT_EQ(st.at("uv_count"), 14.0);
+  EXPECT_EQ(st.at("triangles"), 12.0);
+  EXPECT_EQ(st.at("found"), 1.0);
+  EXPECT_NEAR(st.at("u"), 0.5, 1e-5);
+  EXPECT_NEAR(st.at("v"), 0.375, 1e-5);
+  EXPECT_NEAR(st.at("du_x"), 1.0, 1e-5);
+  EXPECT_EQ(plant.node_groups, (std::vector<std::int32_t>{-1, 2}));
+  EXPECT_EQ(plant.group_prefix, "py");
+  ASSERT_EQ(plant.decals.size(), 1u);
+  int w = 0, h = 0, n = 0;
+  const std::string png = (dir / "out" / "decal0.png").string();
+  std::unique_ptr<unsigned char, void (*)(void*)> px(stbi_load(png.c_str(), &w, &h, &n, 4), stbi_image_free);
+  ASSERT_TRUE(px) << png;
+  EXPECT_EQ(w, 3);
+  EXPECT_EQ(h, 2);
+  EXPECT_EQ(px.get()[4 * 4], 50);  // row 1, column 1
 }
 
 // A script's own errors are named with the file: Python's exception and its line, with the trial's status

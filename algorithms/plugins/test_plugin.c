@@ -6,12 +6,15 @@
  *    tip. Its `fault` parameter makes it crash, hang, exhaust memory or report errors, for the tests of
  *    how a suite records a misbehaving plugin (an exit() it never reports, a message of a megabyte, a flood of stderr,
  * a full disk), give NaN to the queries (nan_query), hand over an invalid plant (bad_parent, nan_node) or
- * one that differs from process to process (by_process).
+ * one that differs from process to process (by_process), or (line_v3) a decal on a mesh the scene lacks (bad_decal).
  * 1 no entry point; 2 another ABI version; 3 a built-in's name; 4 a malformed parameter table;
  * 5 an entry() that crashes; 6 an entry() that calls exit(0); 7 an entry() that closes every descriptor and
  * waits forever. All of these declare ABI version 1 and check that they are given version 1's host table.
  * 8 "line_v2": the line in ABI version 2, with blossoms and tinted leaves (organ shapes and tints) and per-node
- * `height` and `Cd` attributes computed with the host's parallel_for. */
+ * `height` and `Cd` attributes computed with the host's parallel_for; it checks it is given version 2's host table.
+ * 9 "line_v3": line_v2 in ABI version 3, adding a node group per stalk, a decal over the first mesh with texture
+ * coordinates (planar where none has them), and the surface frame where the line from above that mesh's middle
+ * meets the mesh, given as stats for the tests to compare with the mesh's file. */
 #define _POSIX_C_SOURCE 200809L /* close() and pause() under C99 without extensions */
 #include <math.h>
 #include <stddef.h>
@@ -27,9 +30,9 @@
 #define TEST_PLUGIN_VARIANT 0
 #endif
 
-static const char* const kFaults[] = {"none",      "crash",      "hang",         "oom",       "fail",
-                                      "input",     "exit3",      "long_message", "flood",     "disk_full",
-                                      "nan_query", "bad_parent", "nan_node",     "by_process"};
+static const char* const kFaults[] = {"none",      "crash",      "hang",         "oom",        "fail",
+                                      "input",     "exit3",      "long_message", "flood",      "disk_full",
+                                      "nan_query", "bad_parent", "nan_node",     "by_process", "bad_decal"};
 enum { kFaultCount = sizeof kFaults / sizeof kFaults[0] };
 
 static const growbench_param kParams[] = {
@@ -70,9 +73,15 @@ typedef struct state {
   float* height;
   float* color;
   growbench_attribute attributes[2];
+  /* line_v3: per node a group; one decal; the probe of the surface frames (stats) */
+  int32_t* groups;
+  growbench_decal decal;
+  uint8_t pixels[4 * 2 * 4];
+  growbench_stat stats[10];
+  uint32_t stat_count;
 } state;
 
-#if TEST_PLUGIN_VARIANT == 8
+#if TEST_PLUGIN_VARIANT >= 8
 /* line_v2 colours each node by its height, one chunk of nodes at a time on the host's threads. */
 static void style_nodes(void* user, uint64_t begin, uint64_t end) {
   state* s = (state*)user;
@@ -84,6 +93,58 @@ static void style_nodes(void* user, uint64_t begin, uint64_t end) {
     s->color[3 * k + 1] = h > 1.0f ? 1.0f : (h < 0.0f ? 0.0f : h);
     s->color[3 * k + 2] = 0.1f;
   }
+}
+#endif
+
+#if TEST_PLUGIN_VARIANT == 9
+static void add_stat(state* s, const char* name, double value) {
+  s->stats[s->stat_count].name = name;
+  s->stats[s->stat_count++].value = value;
+}
+
+/* The first mesh with texture coordinates, and the surface frame where the line down the +Z axis through the
+ * middle of its bounds meets it: stats uv_mesh (-1: none), uv_count, probe_u, probe_v, the unit dp/du and dp/dv
+ * and their lengths. A point that is not finite must find no frame. */
+static int probe_surface(state* s) {
+  const growbench_host* h = s->host;
+  const float* uvs = NULL;
+  const uint32_t* uv_triangles = NULL;
+  uint64_t uv_count = 0, k;
+  uint32_t m;
+  growbench_vec3 lo = {INFINITY, INFINITY, INFINITY}, hi = {-INFINITY, -INFINITY, -INFINITY}, q;
+  growbench_closest_hit hit;
+  growbench_surface_point at[2];
+  growbench_surface_frame frame[2];
+  float du, dv;
+  for (m = 0; m < s->scene->mesh_count; ++m)
+    if (h->mesh_uvs(h->context, m, &uvs, &uv_count, &uv_triangles)) break;
+  add_stat(s, "uv_mesh", m < s->scene->mesh_count ? (double)m : -1.0);
+  add_stat(s, "uv_count", (double)uv_count);
+  if (m == s->scene->mesh_count) return uvs == NULL && uv_triangles == NULL;
+  for (k = 0; k < s->scene->meshes[m].vertex_count; ++k) {
+    const growbench_vec3 v = s->scene->meshes[m].vertices[k];
+    lo.x = fminf(lo.x, v.x), lo.y = fminf(lo.y, v.y), lo.z = fminf(lo.z, v.z);
+    hi.x = fmaxf(hi.x, v.x), hi.y = fmaxf(hi.y, v.y), hi.z = fmaxf(hi.z, v.z);
+  }
+  q.x = 0.5f * (lo.x + hi.x), q.y = 0.5f * (lo.y + hi.y), q.z = hi.z + 1.0f;
+  h->closest_points(h->context, &q, 1, INFINITY, 0, &hit);
+  at[0].point = hit.point, at[0].mesh = hit.mesh, at[0].triangle = hit.triangle;
+  at[1] = at[0];
+  at[1].point.x = NAN;
+  h->surface_frames(h->context, at, 2, frame);
+  if (!hit.found || hit.mesh != m || !frame[0].found || frame[1].found) return 0;
+  du = sqrtf(frame[0].dp_du.x * frame[0].dp_du.x + frame[0].dp_du.y * frame[0].dp_du.y +
+             frame[0].dp_du.z * frame[0].dp_du.z);
+  dv = sqrtf(frame[0].dp_dv.x * frame[0].dp_dv.x + frame[0].dp_dv.y * frame[0].dp_dv.y +
+             frame[0].dp_dv.z * frame[0].dp_dv.z);
+  add_stat(s, "probe_u", frame[0].u);
+  add_stat(s, "probe_v", frame[0].v);
+  add_stat(s, "probe_du_x", frame[0].dp_du.x / du);
+  add_stat(s, "probe_du_length", du);
+  add_stat(s, "probe_dv_y", frame[0].dp_dv.y / dv);
+  add_stat(s, "probe_dv_length", dv);
+  add_stat(s, "probe_normal_z", frame[0].normal.z);
+  return 1;
 }
 #endif
 
@@ -104,6 +165,21 @@ static int32_t start(growbench_instance* instance, const growbench_scene* scene,
   /* A version-1 plugin must be given the host table a version-1 host gave. */
   if (s->host->abi_version != 1 || s->host->struct_size != offsetof(growbench_host, parallel_for)) {
     s->host->fail(s->host->context, "a version-1 plugin was given a newer host table");
+    return GROWBENCH_ERROR;
+  }
+#elif TEST_PLUGIN_VARIANT == 8
+  if (s->host->abi_version != 2 || s->host->struct_size != offsetof(growbench_host, mesh_uvs)) {
+    s->host->fail(s->host->context, "a version-2 plugin was given another host table");
+    return GROWBENCH_ERROR;
+  }
+#elif TEST_PLUGIN_VARIANT == 9
+  if (s->host->abi_version != 3 || s->host->struct_size != sizeof(growbench_host)) {
+    s->host->fail(s->host->context, "a version-3 plugin was given another host table");
+    return GROWBENCH_ERROR;
+  }
+  add_stat(s, "steps", 0.0);
+  if (!probe_surface(s)) {
+    s->host->fail(s->host->context, "the surface frames answered wrongly");
     return GROWBENCH_ERROR;
   }
 #endif
@@ -276,7 +352,7 @@ static int32_t finish(growbench_instance* instance) {
       o->node = (int32_t)k;
     }
   }
-#if TEST_PLUGIN_VARIANT == 8
+#if TEST_PLUGIN_VARIANT >= 8
   s->organ_shape = (uint16_t*)calloc(s->organ_count + 1, sizeof(uint16_t));
   s->organ_tint = (growbench_vec3*)calloc(s->organ_count + 1, sizeof(growbench_vec3));
   s->height = (float*)calloc(s->node_count + 1, sizeof(float));
@@ -299,6 +375,27 @@ static int32_t finish(growbench_instance* instance) {
   s->attributes[1].components = 3;
   s->attributes[1].values = s->color;
 #endif
+#if TEST_PLUGIN_VARIANT == 9
+  s->groups = (int32_t*)calloc(s->node_count + 1, sizeof(int32_t));
+  if (!s->groups) {
+    s->host->fail(s->host->context, "out of memory");
+    return GROWBENCH_OUT_OF_MEMORY;
+  }
+  for (k = 0; k < s->node_count; ++k) s->groups[k] = k == 0 ? -1 : (int32_t)s->nodes[k].shoot;
+  for (k = 0; k < 8; ++k) { /* a 4 x 2 image: red by column, green by row */
+    s->pixels[4 * k] = (uint8_t)(60 * (k % 4));
+    s->pixels[4 * k + 1] = (uint8_t)(120 * (k / 4));
+    s->pixels[4 * k + 2] = 200;
+    s->pixels[4 * k + 3] = 255;
+  }
+  s->decal.mesh = s->fault == 14 ? 99 : (int32_t)s->stats[1].value; /* fault=bad_decal: a mesh the scene lacks */
+  s->decal.origin = s->scene->bounds_min;
+  s->decal.u_axis.x = s->scene->bounds_max.x - s->scene->bounds_min.x;
+  s->decal.v_axis.y = s->scene->bounds_max.y - s->scene->bounds_min.y;
+  s->decal.width = 4;
+  s->decal.height = 2;
+  s->decal.rgba = s->pixels;
+#endif
   return GROWBENCH_OK;
 }
 
@@ -320,11 +417,25 @@ static int32_t plant(growbench_instance* instance, growbench_plant_view* out) {
     out->node_attributes = s->attributes;
     out->node_attribute_count = 2;
   }
+#if TEST_PLUGIN_VARIANT == 9
+  if (s->groups) {
+    out->node_groups = s->groups;
+    out->group_prefix = "stalk";
+    out->decals = &s->decal;
+    out->decal_count = 1;
+  }
+#endif
   return GROWBENCH_OK;
 }
 
 static uint32_t stats(growbench_instance* instance, const growbench_stat** out) {
   static growbench_stat one[1] = {{"steps", 0.0}};
+#if TEST_PLUGIN_VARIANT == 9
+  state* s = (state*)instance;
+  s->stats[0].value = (double)s->steps;
+  *out = s->stats;
+  return s->stat_count;
+#endif
   one[0].value = (double)((state*)instance)->steps;
   *out = one;
   return 1;
@@ -339,6 +450,7 @@ static void destroy(growbench_instance* instance) {
   free(s->organ_tint);
   free(s->height);
   free(s->color);
+  free(s->groups);
   free(s);
 }
 
@@ -346,6 +458,8 @@ static const growbench_plugin kPlugin = {
 #if TEST_PLUGIN_VARIANT == 2
     99u,
 #elif TEST_PLUGIN_VARIANT == 8
+    2u,
+#elif TEST_PLUGIN_VARIANT == 9
     GROWBENCH_PLUGIN_ABI_VERSION,
 #else
     1u, /* the tests' version-1 plugin: it fills only version 1's members */
@@ -355,6 +469,8 @@ static const growbench_plugin kPlugin = {
     "spacecol",
 #elif TEST_PLUGIN_VARIANT == 8
     "line_v2",
+#elif TEST_PLUGIN_VARIANT == 9
+    "line_v3",
 #else
     "line",
 #endif

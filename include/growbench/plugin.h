@@ -1,4 +1,4 @@
-/* growbench plugin ABI, version 2: the boundary between the growbench harness (the host) and a growth
+/* growbench plugin ABI, version 3: the boundary between the growbench harness (the host) and a growth
  * algorithm built as a shared library (the plugin).
  *
  * C99, and nothing but plain data and function pointers cross it, so a plugin may be written in C, C++
@@ -29,9 +29,10 @@
 extern "C" {
 #endif
 
-#define GROWBENCH_PLUGIN_ABI_VERSION 2u
-/* The oldest version a host of this version still loads. A version-1 plugin fills only the members of
- * growbench_plant_view that version 1 had; the host reads nothing more from it. */
+#define GROWBENCH_PLUGIN_ABI_VERSION 3u
+/* The oldest version a host of this version still loads. A plugin of an older version fills only the
+ * members of growbench_plant_view its version had, and the host reads nothing more from it; it is given
+ * the host table of its version (abi_version and struct_size say which). */
 #define GROWBENCH_PLUGIN_ABI_OLDEST 1u
 
 #if defined(_WIN32)
@@ -191,6 +192,21 @@ typedef struct growbench_surface_sample {
   uint32_t mesh, triangle;
 } growbench_surface_sample;
 
+/* Version 3: a point on a scene triangle, as closest_points, rays and sample_surface give them. */
+typedef struct growbench_surface_point {
+  growbench_vec3 point;
+  uint32_t mesh, triangle;
+} growbench_surface_point;
+
+/* Version 3: the texture coordinates and surface frame at a growbench_surface_point. */
+typedef struct growbench_surface_frame {
+  int32_t found;               /* 0 when the mesh has no texture coordinates, an index is out of range or the
+                                  point is not finite; nothing else is written then */
+  float u, v;                  /* the corners' coordinates interpolated (barycentric); v points up the image */
+  growbench_vec3 normal;       /* unit face normal as wound */
+  growbench_vec3 dp_du, dp_dv; /* how far the point moves per unit of u and of v along the triangle */
+} growbench_surface_frame;
+
 typedef enum growbench_log_level { GROWBENCH_LOG_INFO = 0, GROWBENCH_LOG_WARNING = 1 } growbench_log_level;
 
 /* The envelope's index for inside_shape(); zones are 0 .. zone_count - 1. */
@@ -248,6 +264,17 @@ typedef struct growbench_host {
    * throw or longjmp out; it may call the queries above. */
   void (*parallel_for)(void* context, uint64_t begin, uint64_t end, uint64_t grain,
                        void (*body)(void* user, uint64_t chunk_begin, uint64_t chunk_end), void* user);
+
+  /* Version 3. The texture coordinates of scene mesh `mesh` as its file gives them: corner k of triangle
+   * t has (u, v) = (uvs[2 * i], uvs[2 * i + 1]) with i = uv_triangles[3 * t + k]; v points up the image
+   * (the top row of an image is v = 1). Coordinates outside [0, 1] are kept as given. Returns 1, or 0 with
+   * the arrays NULL and *uv_count 0 when the mesh has none or `mesh` is out of range. The arrays are the
+   * host's and live until destroy(). */
+  int32_t (*mesh_uvs)(void* context, uint32_t mesh, const float** uvs, uint64_t* uv_count,
+                      const uint32_t** uv_triangles);
+  /* The texture coordinates, face normal and tangents at each point (see growbench_surface_frame). */
+  void (*surface_frames)(void* context, const growbench_surface_point* points, uint64_t n,
+                         growbench_surface_frame* out);
 } growbench_host;
 
 /* ------------------------------------------------------------------ the plant */
@@ -291,6 +318,20 @@ typedef struct growbench_attribute {
   const float* values; /* node_count * components, node by node; finite */
 } growbench_attribute;
 
+/* Version 3: an image laid over the scene's surfaces, as the built-in vines lays its texture. Renders draw
+ * it over the surfaces' own material, and it stands for the plant there: a plant with decals is drawn by
+ * them, not by its branches. The host writes it as a PNG beside the plant's meshes. */
+#define GROWBENCH_PLANAR_DECAL (-1)
+typedef struct growbench_decal {
+  /* >= 0: the image follows that scene mesh's texture coordinates (the mesh must have them).
+   * GROWBENCH_PLANAR_DECAL: image point (u, v) sits at origin + u * u_axis + v * v_axis and is projected
+   * along u_axis x v_axis onto the climbable meshes. */
+  int32_t mesh;
+  growbench_vec3 origin, u_axis, v_axis;
+  uint32_t width, height; /* 1 to 8192 each */
+  const uint8_t* rgba;    /* width * height pixels of 4 bytes (sRGB, straight alpha), the top row first */
+} growbench_decal;
+
 /* The organ_shape of an organ that takes its kind's shape (leaf, blossom, bud). */
 #define GROWBENCH_KIND_SHAPE 0xFFFFu
 
@@ -314,6 +355,15 @@ typedef struct growbench_plant_view {
   /* Named per-node values. */
   const growbench_attribute* node_attributes;
   uint32_t node_attribute_count;
+
+  /* Version 3; each may be NULL (count 0). Per node (node_count entries): its group, >= 0, or -1 for none,
+   * as the L-system's g gives them. The branches of group g are their own part of the meshes, named
+   * group_prefix followed by g (letters, digits and '_'; NULL or "" for "group"): the OBJ's g/usemtl pair
+   * and the glTF's node that a material is given to in a modelling tool. */
+  const int32_t* node_groups;
+  const char* group_prefix;
+  const growbench_decal* decals;
+  uint32_t decal_count;
 } growbench_plant_view;
 
 typedef struct growbench_stat {

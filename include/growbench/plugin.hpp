@@ -309,6 +309,22 @@ class Host {
     if (call.error) std::rethrow_exception(call.error);
   }
 
+  // A scene mesh's texture coordinates (see growbench_host::mesh_uvs); empty (count 0) when it has none.
+  struct MeshUvs {
+    const float* uvs = nullptr;  // 2 per coordinate: u, v
+    std::uint64_t count = 0;
+    const std::uint32_t* triangles = nullptr;  // 3 coordinate indices per triangle of the mesh
+  };
+  [[nodiscard]] MeshUvs mesh_uvs(std::uint32_t mesh) const {
+    MeshUvs m;
+    if (h_->mesh_uvs(h_->context, mesh, &m.uvs, &m.count, &m.triangles) == 0) return {};
+    return m;
+  }
+  // Texture coordinates, face normal and tangents at points on scene triangles.
+  void surface_frames(const growbench_surface_point* p, std::size_t n, growbench_surface_frame* out) const {
+    h_->surface_frames(h_->context, p, n, out);
+  }
+
  private:
   const growbench_host* h_;
 };
@@ -330,6 +346,15 @@ struct Attribute {
   std::vector<float> values;  // nodes.size() * components, node by node
 };
 
+// An image laid over the scene's surfaces (see growbench_decal): over a mesh's texture coordinates, or
+// planar (mesh GROWBENCH_PLANAR_DECAL) at origin + u * u_axis + v * v_axis.
+struct Decal {
+  std::int32_t mesh = GROWBENCH_PLANAR_DECAL;
+  Vec3 origin{0.0f, 0.0f, 0.0f}, u_axis{1.0f, 0.0f, 0.0f}, v_axis{0.0f, 1.0f, 0.0f};
+  std::uint32_t width = 0, height = 0;
+  std::vector<std::uint8_t> rgba;  // width * height * 4, sRGB with straight alpha, the top row (v = 1) first
+};
+
 // The plant as the plugin builds it; view() hands it to the host without a copy.
 struct Plant {
   std::vector<growbench_node> nodes;
@@ -343,6 +368,10 @@ struct Plant {
   std::vector<std::uint16_t> organ_shape;
   std::vector<Vec3> organ_tint;
   std::deque<Attribute> attributes;  // a deque: attribute() never moves one already made
+  // Per node, or empty: its group (-1: none); group g's branches are the mesh part group_prefix + g.
+  std::vector<std::int32_t> node_groups;
+  std::string group_prefix;
+  std::vector<Decal> decals;
 
   // Appends an organ and, when given, its shape (an index into organ_shapes) and tint.
   void add_organ(const growbench_organ& organ, std::uint16_t shape = GROWBENCH_KIND_SHAPE,
@@ -403,6 +432,21 @@ struct Plant {
     }
     v.node_attributes = attribute_views_.data();
     v.node_attribute_count = static_cast<std::uint32_t>(attribute_views_.size());
+    if (!node_groups.empty()) {
+      padded_groups_ = node_groups;
+      padded_groups_.resize(nodes.size(), -1);
+      v.node_groups = padded_groups_.data();
+    }
+    v.group_prefix = group_prefix.c_str();
+    decal_views_.clear();
+    for (const Decal& d : decals) {
+      if (d.rgba.size() != std::size_t{d.width} * d.height * 4)
+        throw std::length_error("decal of " + std::to_string(d.width) + " x " + std::to_string(d.height) +
+                                " pixels holds " + std::to_string(d.rgba.size()) + " bytes, not 4 per pixel");
+      decal_views_.push_back({d.mesh, d.origin, d.u_axis, d.v_axis, d.width, d.height, d.rgba.data()});
+    }
+    v.decals = decal_views_.data();
+    v.decal_count = static_cast<std::uint32_t>(decal_views_.size());
     return v;
   }
 
@@ -421,6 +465,8 @@ struct Plant {
   mutable std::vector<std::uint16_t> padded_shape_;
   mutable std::vector<Vec3> padded_tint_;
   mutable std::vector<std::vector<float>> padded_values_;
+  mutable std::vector<std::int32_t> padded_groups_;
+  mutable std::vector<growbench_decal> decal_views_;
 };
 
 // ------------------------------------------------------------------ the algorithm

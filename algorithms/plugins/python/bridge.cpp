@@ -1,4 +1,4 @@
-// Algorithms written in Python: a growbench plugin table (plugin.h, ABI version 2) made from a Python class,
+// Algorithms written in Python: a growbench plugin table (plugin.h, this version of its ABI) made from a Python class,
 // with the host's queries offered to it as batched calls on numpy arrays. The loader dlopens this module
 // when a plugin's path ends in .py (algorithms/plugins/loader.cpp) and asks growbench_python_plugin() for
 // the script's table. The interpreter is Debian's CPython, embedded once per process and never finalized;
@@ -28,6 +28,7 @@ namespace {
 
 using F32 = py::array_t<float, py::array::c_style | py::array::forcecast>;
 using U64 = py::array_t<std::uint64_t, py::array::c_style | py::array::forcecast>;
+using U32 = py::array_t<std::uint32_t, py::array::c_style | py::array::forcecast>;
 
 // ------------------------------------------------------------------ the host, as Python sees it
 
@@ -52,7 +53,7 @@ py::array_t<bool> new_flags(const std::vector<std::uint8_t>& v) {
 
 class Host {
  public:
-  explicit Host(const growbench_host* h) : h_(h) {}
+  Host(const growbench_host* h, const growbench_scene* scene) : h_(h), scene_(scene) {}
 
   [[nodiscard]] unsigned threads() const { return h_->threads; }
   [[nodiscard]] bool cancelled() const { return h_->cancelled(h_->context) != 0; }
@@ -69,8 +70,10 @@ class Host {
     return out;
   }
 
-  // (point (N, 3), normal (N, 3), distance (N,), found (N,) bool).
-  [[nodiscard]] py::tuple closest_points(const py::handle& p, float max_distance, bool climbable_only) const {
+  // (point (N, 3), normal (N, 3), distance (N,), found (N,) bool), and with `triangles` also (mesh (N,),
+  // triangle (N,)), what surface_frames() takes.
+  [[nodiscard]] py::tuple closest_points(const py::handle& p, float max_distance, bool climbable_only,
+                                         bool triangles) const {
     const auto [pts, n] = points_of(p, "closest_points");
     std::vector<growbench_closest_hit> hits(n);
     h_->closest_points(h_->context, vecs(pts), n, max_distance, climbable_only ? 1 : 0, hits.data());
@@ -82,7 +85,13 @@ class Host {
       distance.mutable_data()[i] = hits[i].distance;
       found[i] = hits[i].found != 0;
     }
-    return py::make_tuple(point, normal, distance, new_flags(found));
+    if (!triangles) return py::make_tuple(point, normal, distance, new_flags(found));
+    U32 mesh(static_cast<py::ssize_t>(n)), tri(static_cast<py::ssize_t>(n));
+    for (std::size_t i = 0; i < n; ++i) {
+      mesh.mutable_data()[i] = hits[i].mesh;
+      tri.mutable_data()[i] = hits[i].triangle;
+    }
+    return py::make_tuple(point, normal, distance, new_flags(found), mesh, tri);
   }
 
   [[nodiscard]] std::vector<growbench_ray> rays_of(const py::handle& o, const py::handle& d, float tmin,
@@ -136,6 +145,43 @@ class Host {
     h_->inside_shape(h_->context, shape, vecs(pts), n, out.data());
     return new_flags(out);
   }
+  // (uvs (K, 2), triangles (T, 3)) of scene mesh `mesh`, or None when it has no texture coordinates.
+  [[nodiscard]] py::object mesh_uvs(std::uint32_t mesh) const {
+    const float* uvs = nullptr;
+    const std::uint32_t* tris = nullptr;
+    std::uint64_t k = 0;
+    if (h_->mesh_uvs(h_->context, mesh, &uvs, &k, &tris) == 0) return py::none();
+    const auto t = static_cast<py::ssize_t>(scene_->meshes[mesh].triangle_count);
+    F32 u({static_cast<py::ssize_t>(k), py::ssize_t{2}});
+    std::memcpy(u.mutable_data(), uvs, k * 2 * sizeof(float));
+    U32 tri({t, py::ssize_t{3}});
+    std::memcpy(tri.mutable_data(), tris, static_cast<std::size_t>(t) * 3 * sizeof(std::uint32_t));
+    return py::make_tuple(u, tri);
+  }
+  // (found (N,) bool, uv (N, 2), normal (N, 3), dp_du (N, 3), dp_dv (N, 3)) at points on scene triangles.
+  [[nodiscard]] py::tuple surface_frames(const py::handle& p, const py::handle& meshes,
+                                         const py::handle& triangles) const {
+    const auto [pts, n] = points_of(p, "surface_frames");
+    const U32 m = U32::ensure(meshes), t = U32::ensure(triangles);
+    if (!m || !t || static_cast<std::size_t>(m.size()) != n || static_cast<std::size_t>(t.size()) != n)
+      throw py::value_error("surface_frames: expected N points, N mesh indices and N triangle indices");
+    std::vector<growbench_surface_point> at(n);
+    for (std::size_t i = 0; i < n; ++i) at[i] = {vecs(pts)[i], m.data()[i], t.data()[i]};
+    std::vector<growbench_surface_frame> f(n);
+    h_->surface_frames(h_->context, at.data(), n, f.data());
+    F32 uv({static_cast<py::ssize_t>(n), py::ssize_t{2}}), normal = new_points(n), du = new_points(n),
+                                                           dv = new_points(n);
+    std::vector<std::uint8_t> found(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      found[i] = f[i].found != 0;
+      uv.mutable_data()[2 * i] = f[i].u;
+      uv.mutable_data()[2 * i + 1] = f[i].v;
+      std::memcpy(normal.mutable_data() + 3 * i, &f[i].normal, sizeof(growbench_vec3));
+      std::memcpy(du.mutable_data() + 3 * i, &f[i].dp_du, sizeof(growbench_vec3));
+      std::memcpy(dv.mutable_data() + 3 * i, &f[i].dp_dv, sizeof(growbench_vec3));
+    }
+    return py::make_tuple(new_flags(found), uv, normal, du, dv);
+  }
   [[nodiscard]] py::array_t<bool> light_visible(const py::handle& p, float bias) const {
     const auto [pts, n] = points_of(p, "light_visible");
     std::vector<std::uint8_t> out(n);
@@ -156,6 +202,7 @@ class Host {
 
  private:
   const growbench_host* h_;
+  const growbench_scene* scene_;  // lives as long as the instance
 };
 
 // A parameter row as the class's `params` list gives it: growbench.real("step", 0.01, min=..., ...).
@@ -210,6 +257,7 @@ PYBIND11_EMBEDDED_MODULE(growbench, m) {
       py::arg("name"), py::arg("default"), py::arg("choices"), py::arg("doc") = "");
   m.attr("ENVELOPE") = GROWBENCH_ENVELOPE;
   m.attr("KIND_SHAPE") = GROWBENCH_KIND_SHAPE;
+  m.attr("PLANAR_DECAL") = GROWBENCH_PLANAR_DECAL;
   m.attr("LEAF") = static_cast<int>(GROWBENCH_ORGAN_LEAF);
   m.attr("YOUNG_LEAF") = static_cast<int>(GROWBENCH_ORGAN_YOUNG_LEAF);
   m.attr("FLOWER") = static_cast<int>(GROWBENCH_ORGAN_FLOWER);
@@ -221,7 +269,9 @@ PYBIND11_EMBEDDED_MODULE(growbench, m) {
       .def("warn", &Host::warn)
       .def("uniform", &Host::uniform, py::arg("stream"), py::arg("counters"))
       .def("closest_points", &Host::closest_points, py::arg("points"), py::arg("max_distance") = HUGE_VALF,
-           py::arg("climbable_only") = false)
+           py::arg("climbable_only") = false, py::arg("triangles") = false)
+      .def("mesh_uvs", &Host::mesh_uvs, py::arg("mesh"))
+      .def("surface_frames", &Host::surface_frames, py::arg("points"), py::arg("meshes"), py::arg("triangles"))
       .def("rays", &Host::rays, py::arg("origins"), py::arg("directions"), py::arg("tmin") = 0.0f,
            py::arg("tmax") = HUGE_VALF)
       .def("occluded", &Host::occluded, py::arg("origins"), py::arg("directions"), py::arg("tmin") = 0.0f,
@@ -263,6 +313,10 @@ struct Instance {
   std::vector<std::string> attribute_names;
   std::vector<std::vector<float>> attribute_values;
   std::vector<std::uint32_t> attribute_components;
+  std::vector<std::int32_t> groups;
+  std::string group_prefix;
+  std::vector<std::vector<std::uint8_t>> decal_pixels;
+  std::vector<growbench_decal> decals;
   bool stale = true;  // the Python plant changed since it was last taken (start, step and finish change it)
   std::vector<growbench_attribute> attributes;
   std::vector<std::string> stat_names;
@@ -319,7 +373,19 @@ py::object scene_object(const growbench_scene& s) {
   d["light_direction"] = v3(s.light.direction);
   d["light_position"] = v3(s.light.position);
   d["zone_count"] = s.zone_count;
-  return py::module_::import("types").attr("SimpleNamespace")(**d);
+  const py::object ns = py::module_::import("types").attr("SimpleNamespace");
+  py::list meshes;
+  for (std::uint32_t k = 0; k < s.mesh_count; ++k) {
+    const growbench_mesh& m = s.meshes[k];
+    F32 v = new_points(m.vertex_count);
+    std::memcpy(v.mutable_data(), m.vertices, m.vertex_count * sizeof(growbench_vec3));
+    U32 t({static_cast<py::ssize_t>(m.triangle_count), py::ssize_t{3}});
+    std::memcpy(t.mutable_data(), m.triangles, m.triangle_count * 3 * sizeof(std::uint32_t));
+    meshes.append(ns(py::arg("name") = m.name ? m.name : "", py::arg("vertices") = v, py::arg("triangles") = t,
+                     py::arg("climbable") = m.climbable != 0, py::arg("solid") = m.solid != 0));
+  }
+  d["meshes"] = meshes;
+  return ns(**d);
 }
 
 py::dict params_object(const Script& sc, const growbench_value* values) {
@@ -440,6 +506,40 @@ void take_attributes(Instance& s, const py::dict& d) {
   }
 }
 
+growbench_vec3 vec3_of(const py::dict& d, const char* key, growbench_vec3 fallback) {
+  if (!d.contains(key)) return fallback;
+  const auto v = d[key].cast<std::array<float, 3>>();
+  return {v[0], v[1], v[2]};
+}
+
+// plant['groups'] (N ints, -1 for none) with plant['group_prefix'], and plant['decals']: a list of dicts with
+// 'image' (H, W, 4) uint8, the top row first, and 'mesh' (an index, or growbench.PLANAR_DECAL with 'origin',
+// 'u_axis' and 'v_axis').
+void take_groups_and_decals(Instance& s, const py::dict& d) {
+  s.groups = column<std::int32_t>(d, "groups", s.nodes.size());
+  s.group_prefix = d.contains("group_prefix") ? text_of(d["group_prefix"]) : "";
+  s.decals.clear();
+  s.decal_pixels.clear();
+  if (!d.contains("decals")) return;
+  for (const auto& item : d["decals"].cast<py::list>()) {
+    const auto k = std::to_string(s.decals.size());
+    const auto e = item.cast<py::dict>();
+    using U8 = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>;
+    const U8 image = e.contains("image") ? U8::ensure(e["image"]) : U8();
+    if (!image || image.ndim() != 3 || image.shape(2) != 4)
+      throw py::value_error("plant['decals'][" + k + "]['image']: expected an (H, W, 4) array of uint8");
+    growbench_decal g{};
+    g.mesh = e.contains("mesh") ? e["mesh"].cast<std::int32_t>() : GROWBENCH_PLANAR_DECAL;
+    g.origin = vec3_of(e, "origin", {0.0f, 0.0f, 0.0f});
+    g.u_axis = vec3_of(e, "u_axis", {1.0f, 0.0f, 0.0f});
+    g.v_axis = vec3_of(e, "v_axis", {0.0f, 1.0f, 0.0f});
+    g.height = static_cast<std::uint32_t>(image.shape(0));
+    g.width = static_cast<std::uint32_t>(image.shape(1));
+    s.decal_pixels.emplace_back(image.data(), image.data() + image.size());
+    s.decals.push_back(g);
+  }
+}
+
 void fill_view(Instance& s, growbench_plant_view* out) {
   std::memset(out, 0, sizeof(*out));
   out->nodes = s.nodes.data();
@@ -457,6 +557,11 @@ void fill_view(Instance& s, growbench_plant_view* out) {
     s.attributes.push_back({s.attribute_names[k].c_str(), s.attribute_components[k], s.attribute_values[k].data()});
   out->node_attributes = s.attributes.data();
   out->node_attribute_count = static_cast<uint32_t>(s.attributes.size());
+  out->node_groups = s.groups.empty() ? nullptr : s.groups.data();
+  out->group_prefix = s.group_prefix.c_str();
+  for (std::size_t k = 0; k < s.decals.size(); ++k) s.decals[k].rgba = s.decal_pixels[k].data();
+  out->decals = s.decals.data();
+  out->decal_count = static_cast<uint32_t>(s.decals.size());
 }
 
 // The table's functions for the script in slot N: create() is given only the host, so each script's table
@@ -485,7 +590,7 @@ int32_t start(growbench_instance* i, const growbench_scene* scene, const growben
   Instance& s = self(i);
   return guarded(s.host, [&] {
     s.stale = true;
-    s.self.attr("start")(scene_object(*scene), Host(s.host), params_object(*s.script, values), seed);
+    s.self.attr("start")(scene_object(*scene), Host(s.host, scene), params_object(*s.script, values), seed);
     return int32_t{GROWBENCH_OK};
   });
 }
@@ -517,6 +622,7 @@ void take_plant(Instance& s) {
   take_nodes(s, d);
   take_organs(s, d);
   take_attributes(s, d);
+  take_groups_and_decals(s, d);
   s.stale = false;
 }
 
