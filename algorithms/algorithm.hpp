@@ -79,6 +79,11 @@ class GrowthAlgorithm {
   [[nodiscard]] virtual std::size_t organ_count() const { return plant().organs.size(); }
   // Called once after the last step, before meshing (e.g. to assign pipe-model radii or place leaves).
   virtual void finish() {}
+  // The parameters it grows with, when files it reads set some (an L-system's grammar file sets its premise
+  // and angle): what the record keeps as its effective parameters. Empty: those it was given. After start().
+  [[nodiscard]] virtual std::optional<Params> effective_params() const { return std::nullopt; }
+  // The files its parameters named and it read, as (parameter, path): the record keeps their content hashes.
+  [[nodiscard]] virtual std::vector<std::pair<std::string, std::string>> input_files() const { return {}; }
   // Algorithm-specific figures for the trial record (e.g. attraction points left).
   [[nodiscard]] virtual std::vector<std::pair<std::string, double>> stats() const { return {}; }
   // Its word on the plant as grown (OwnVerdict above); called after finish().

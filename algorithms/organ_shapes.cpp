@@ -222,14 +222,9 @@ OrganShape load_organ_obj(const std::string& path) {
   return s;
 }
 
-namespace {
-
-// A shape's name that means a file: a path, or anything ending in .obj.
 bool names_a_file(const std::string& name) {
   return name.find('/') != std::string::npos || name.ends_with(".obj") || name.ends_with(".OBJ");
 }
-
-}  // namespace
 
 OrganShape organ_shape_named(const std::string& name, std::string_view source) {
   return names_a_file(name) ? load_organ_obj(name) : builtin_organ_shape(name, source);

@@ -37,6 +37,8 @@ OrganShape builtin_organ_shape(std::string_view name, std::string_view source = 
 // An OBJ authored in the organ's frame: moved so its lowest z is 0 and scaled so its length along z is 1.
 // InputError naming the file when it cannot be read, has no faces, or has no length along z.
 OrganShape load_organ_obj(const std::string& path);
+// Whether a shape's name means an OBJ file (it ends in .obj, or contains a '/') rather than a built-in.
+bool names_a_file(const std::string& name);
 // A built-in's name or an OBJ file's path (anything ending in .obj, or containing a '/').
 OrganShape organ_shape_named(const std::string& name_or_path, std::string_view source = "organ shape");
 

@@ -86,7 +86,39 @@ std::vector<std::size_t> symbol_counts(const LString& s) {
   return counts;
 }
 
+// `%` cuts off the rest of its branch (the reference's "Cut off remainder of branch"): the modules after it, up
+// to its branch's ']' or the string's end, leave the string, so they neither grow nor hold memory. The `%`
+// stays, so that the printed string shows where a branch was cut.
+void cut_branches(LString& s) {
+  const std::size_t n = s.size();
+  std::uint16_t* sym = s.symbols.data();
+  float* par = s.params.data();
+  std::uint16_t* age = s.ages.size() == n ? s.ages.data() : nullptr;
+  std::size_t w = 0, pr = 0, pw = 0;
+  for (std::size_t r = 0; r < n;) {
+    const std::uint16_t word = sym[r++];
+    if (age) age[w] = age[r - 1];
+    sym[w++] = word;
+    for (int a = 0; a < count_of(word); ++a) par[pw++] = par[pr++];
+    if (symbol_of(word) != '%') continue;
+    for (int depth = 0; r < n; ++r) {
+      const char c = symbol_of(sym[r]);
+      if (c == ']' && depth == 0) break;
+      depth += c == '[' ? 1 : c == ']' ? -1 : 0;
+      pr += static_cast<std::size_t>(count_of(sym[r]));
+    }
+  }
+  s.symbols.resize_discard(w);
+  s.params.resize_discard(pw);
+  if (age) s.ages.resize_discard(w);
+}
+
 Deriver::Deriver(const Grammar& grammar, DeriveSettings settings) : g_(grammar), s_(std::move(settings)) {
+  auto cuts = [](const auto& modules) {
+    return std::any_of(modules.begin(), modules.end(), [](const auto& m) { return m.symbol == '%'; });
+  };
+  has_cut_ = cuts(g_.premise) ||
+             std::any_of(g_.rules.begin(), g_.rules.end(), [&](const Rule& r) { return cuts(r.successor); });
   for (int c = 0; c < 128; ++c) {
     const auto& list = g_.rules_for[c];
     if (list.empty()) continue;
@@ -125,6 +157,7 @@ void Deriver::premise(LString& out) const {
     out.ages.resize_discard(syms.size());
     std::fill_n(out.ages.data(), syms.size(), std::uint16_t{0});
   }
+  if (has_cut_) cut_branches(out);
 }
 
 // Matches the rule's contexts around module m (parameters at offset poff) and binds every formal.
@@ -519,6 +552,7 @@ void Deriver::rewrite(const LString& in, LString& out, int generation, const std
       poff += static_cast<std::size_t>(k);
     }
   });
+  if (has_cut_) cut_branches(out);
 }
 
 }  // namespace growbench::lsys

@@ -76,6 +76,7 @@ class Deriver {
   // 0 copy; 1 one static rule without conditions; 2 general; 3 one rule without conditions whose pattern
   // names its parameters: it applies exactly to the modules with that many, so nothing is chosen.
   std::uint8_t kind_[128] = {};
+  bool has_cut_ = false;      // the premise or a successor holds '%' (cut_branches runs after each rewrite)
   bool any_general_ = false;  // some symbol is kind 2: rule choices are stored per module
   std::uint32_t static_symbols_[128] = {}, static_params_[128] = {};  // output size of a kind-1 or 3 symbol
   std::uint8_t formals_[128] = {};                                    // parameters a kind-3 symbol needs

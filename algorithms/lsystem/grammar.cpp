@@ -434,10 +434,18 @@ GrammarFile read_grammar_file(const std::string& path, const std::vector<std::st
         const std::string key(l.substr(a, b - a));
         if (std::find(known_settings.begin(), known_settings.end(), key) == known_settings.end()) {
           const std::string near = closest_match(key, known_settings);
-          throw InputError(fmt::format("{}:{}:{}: unknown setting '{}'{}; expected one of {}", path, k + 1, a + 1, key,
-                                       near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near),
+          // `AB = F` reads as a setting; if it was meant as a rule, say what a rule's predecessor is.
+          const std::string as_rule =
+              l[c] == '=' ? "; if this is a rule, its predecessor is one symbol (write 'A < B = ...' for a context)"
+                          : "";
+          throw InputError(fmt::format("{}:{}:{}: unknown setting '{}'{}{}; expected one of {}", path, k + 1, a + 1,
+                                       key, near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near), as_rule,
                                        fmt::join(known_settings, ", ")));
         }
+        for (const GrammarFile::Setting& earlier : f.settings)
+          if (earlier.key == key)
+            throw InputError(fmt::format("{}:{}:{}: '{}' is set twice (first at line {}); expected each setting once",
+                                         path, k + 1, a + 1, key, earlier.line));
         const Span value = LineParser::trim({l.substr(c + 1), c + 2});
         f.settings.push_back({key, std::string(value.text), k + 1, value.column});
       }

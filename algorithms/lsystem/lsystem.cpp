@@ -103,10 +103,19 @@ const AlgorithmInfo kInfo = {
                 .doc("what in(x,y,z) tests: the scene envelope, the scene's solids, or auto (envelope if any, else "
                      "solids)"),
             param::text("pic_image").doc("image read by pic(u, v, plane) (PNG, JPEG, ...)"),
+            param::boolean("apply_color", false)
+                .doc("colour every node (Cd) from color_image at the turtle's (u, v), which ' and # move "
+                     "(Houdini's Apply Color)"),
+            param::text("color_image").doc("the image apply_color reads (Houdini's Image File; PNG, JPEG, ...)"),
             param::text("organ_j").doc("J's geometry: a built-in shape (leaf, blossom, half_bloom, bud; `growbench "
                                        "list organs`) or an OBJ file; empty: its kind's shape, or --leaf-obj"),
             param::text("organ_k").doc("K's geometry, as organ_j"),
             param::text("organ_m").doc("M's geometry, as organ_j"),
+            param::text("leaf_param_a")
+                .doc("the setting of J/K/M's built-in shape that their stamp a sets (J(s,x,a,b,c); e.g. petals, "
+                     "width): Houdini's Leaf Param A"),
+            param::text("leaf_param_b").doc("the shape setting stamp b sets, as leaf_param_a"),
+            param::text("leaf_param_c").doc("the shape setting stamp c sets, as leaf_param_a"),
             param::choice("kind_j", "leaf", {"leaf", "young_leaf", "flower", "bud"})
                 .doc("what J places, for the metrics, mesh groups and materials"),
             param::choice("kind_k", "flower", {"leaf", "young_leaf", "flower", "bud"}).doc("what K places"),
@@ -133,11 +142,6 @@ const std::vector<std::string>& setting_names() {
   return names;
 }
 
-struct Image {
-  int w = 0, h = 0;
-  std::vector<std::uint8_t> rgb;  // row 0 at the top; a quarter of floats' memory, the same values on lookup
-};
-
 class Host final : public lsys::ExprHost {
  public:
   double in(double x, double y, double z) const override {
@@ -148,9 +152,7 @@ class Host final : public lsys::ExprHost {
   }
   double pic(double u, double v, double plane) const override {
     if (image_.w == 0) throw InputError("pic() needs an image: set pic_image=FILE");
-    const int x = std::clamp(static_cast<int>(std::floor(u * image_.w)), 0, image_.w - 1);
-    const int y = std::clamp(static_cast<int>(std::floor((1.0 - v) * image_.h)), 0, image_.h - 1);
-    const std::uint8_t* at = &image_.rgb[(static_cast<std::size_t>(y) * image_.w + x) * 3];
+    const std::uint8_t* at = image_.at(u, v);
     const float px[3] = {at[0] / 255.0f, at[1] / 255.0f, at[2] / 255.0f};
     const int pl = static_cast<int>(plane);
     if (pl >= 1 && pl <= 3) return px[pl - 1];
@@ -159,7 +161,8 @@ class Host final : public lsys::ExprHost {
   double rand(double s) const override {
     std::uint64_t bits;
     std::memcpy(&bits, &s, sizeof bits);
-    return static_cast<double>(random_bits(seed_, 0x7261'6e64, bits) >> 11) * 0x1.0p-53;
+    // Each plant has its stream (plant 0's values are those of a one-plant scene).
+    return static_cast<double>(random_bits(seed_, 0x7261'6e64 + (stream_ << 32), bits) >> 11) * 0x1.0p-53;
   }
   double chan(double index) const override {
     const auto k = static_cast<long>(std::floor(index));
@@ -170,8 +173,9 @@ class Host final : public lsys::ExprHost {
 
   const SceneQuery* query_ = nullptr;
   int mode_ = 0;  // 0 none, 1 envelope, 2 solids
-  Image image_;
+  lsys::Image image_;
   std::uint64_t seed_ = 0;
+  std::uint64_t stream_ = 0;  // the plant being rewritten: plants are rewritten one after another
   std::vector<double> channels_;
 };
 
@@ -206,7 +210,25 @@ struct Setup {
   int rewrites = 0;                       // whole generations, plus one for a fractional part
   double fraction = 0.0;                  // the fractional part (0: none); the last rewrite is drawn scaled by it
   std::vector<std::string> organ_shapes;  // Plant::organ_shapes: J/K/M's shapes by name
+  std::vector<std::pair<std::string, std::string>> inputs;  // (parameter, path) of each file read
+  lsys::Image color_image;                                  // apply_color's
+  lsys::OrganStamps stamps;                                 // leaf_param_a/b/c and J/K/M's shapes
 };
+
+// An image a parameter names, with the parameter in every error.
+lsys::Image load_image(const char* param, const std::string& file) {
+  int w = 0, h = 0, ch = 0;
+  if (stbi_info(file.c_str(), &w, &h, &ch) == 0)
+    throw InputError(fmt::format("{} '{}': cannot read the image ({})", param, file, stbi_failure_reason()));
+  if (w > kMaxImageSide || h > kMaxImageSide)
+    throw InputError(fmt::format("{} '{}': the image is {} x {} pixels; expected at most {} on each side", param, file,
+                                 w, h, kMaxImageSide));
+  unsigned char* px = stbi_load(file.c_str(), &w, &h, &ch, 3);
+  if (!px) throw InputError(fmt::format("{} '{}': cannot read the image ({})", param, file, stbi_failure_reason()));
+  lsys::Image image{w, h, std::vector<std::uint8_t>(px, px + static_cast<std::size_t>(w) * h * 3)};
+  stbi_image_free(px);
+  return image;
+}
 
 // An organ OBJ named by a grammar file is found beside the file, as its author wrote it.
 std::string organ_relative_to(const std::string& key, const std::string& value, const std::string& grammar) {
@@ -228,6 +250,11 @@ void organ_setup(const Params& p, Setup& s) {
                                                     : OrganKind::Bud;
     const std::string key = fmt::format("organ_{}", kSymbols[i]);
     const std::string& name = p.text(key);
+    s.stamps.params[i] = p.text(fmt::format("leaf_param_{}", "abc"[i]));
+    s.stamps.base[i] = !name.empty()                                 ? name
+                       : s.turtle.organ_kind[i] == OrganKind::Flower ? "blossom"
+                       : s.turtle.organ_kind[i] == OrganKind::Bud    ? "bud"
+                                                                     : "leaf";
     s.turtle.organ_shape[i] = kKindShape;
     if (name.empty()) continue;
     (void)organ_shape_named(name, fmt::format("parameter {}", key));
@@ -245,6 +272,7 @@ Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* quer
   std::optional<lsys::GrammarFile> file;
   if (!p.text("grammar").empty()) {
     file = lsys::read_grammar_file(resolve_grammar_path(p.text("grammar")), setting_names());
+    s.inputs.emplace_back("grammar", file->path);
     for (const auto& st : file->settings) {
       if (p.was_set(st.key)) continue;
       try {
@@ -258,6 +286,7 @@ Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* quer
   std::vector<lsys::GrammarText> rules;
   if (!p.text("rules_file").empty()) {
     rules.push_back(lsys::read_rules_file(p.text("rules_file")));
+    s.inputs.emplace_back("rules_file", p.text("rules_file"));
   } else if (p.was_set("rules") || !file) {
     rules.push_back({"parameter 'rules'", p.text("rules"), 1});
   } else {
@@ -301,19 +330,17 @@ Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* quer
     if (s.host->mode_ == 2 && !query->has_sdf()) s.host->mode_ = 0;
   }
   if (!p.text("pic_image").empty()) {
-    const std::string file = p.text("pic_image");
-    int w = 0, h = 0, ch = 0;
-    if (stbi_info(file.c_str(), &w, &h, &ch) == 0)
-      throw InputError(fmt::format("pic_image '{}': cannot read the image ({})", file, stbi_failure_reason()));
-    if (w > kMaxImageSide || h > kMaxImageSide)
-      throw InputError(fmt::format("pic_image '{}': the image is {} x {} pixels; expected at most {} on each side",
-                                   file, w, h, kMaxImageSide));
-    unsigned char* px = stbi_load(file.c_str(), &w, &h, &ch, 3);
-    if (!px) throw InputError(fmt::format("pic_image '{}': cannot read the image ({})", file, stbi_failure_reason()));
-    s.host->image_.w = w;
-    s.host->image_.h = h;
-    s.host->image_.rgb.assign(px, px + static_cast<std::size_t>(w) * h * 3);
-    stbi_image_free(px);
+    s.host->image_ = load_image("pic_image", p.text("pic_image"));
+    s.inputs.emplace_back("pic_image", p.text("pic_image"));
+  }
+  if (p.boolean("apply_color")) {
+    if (p.text("color_image").empty())
+      throw InputError("apply_color: needs an image to read the colours from: set color_image=FILE");
+    if (std::find(s.grammar.strings.begin(), s.grammar.strings.end(), "Cd") != s.grammar.strings.end())
+      throw InputError(
+          "apply_color: the grammar colours the branches itself with a(\"Cd\", ...); use one or the other");
+    s.color_image = load_image("color_image", p.text("color_image"));
+    s.inputs.emplace_back("color_image", p.text("color_image"));
   }
 
   // Designated initializers: a member left out is a warning (-Wmissing-field-initializers), an error in CI.
@@ -379,6 +406,8 @@ Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* quer
       .birth_step = 0,
       .organ_kind = {},
       .organ_shape = {},
+      .color_image = nullptr,
+      .stamps = nullptr,
   };
   organ_setup(p, s);
   const double generations = p.real("generations");
@@ -434,7 +463,7 @@ class LSystem final : public GrowthAlgorithm {
     for (auto& pl : plants_) {
       if (!pl.started || pl.generation >= setup_.rewrites) continue;
       const auto t0 = std::chrono::steady_clock::now();
-      deriver_->set_stream(pl.stream);
+      use_stream(pl.stream);
       deriver_->rewrite(pl.cur, pl.next, pl.generation + 1, pl.states);
       rewrite_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       std::swap(pl.cur, pl.next);
@@ -454,6 +483,10 @@ class LSystem final : public GrowthAlgorithm {
   }
 
   const Plant& plant() const override { return plant_; }
+
+  // The grammar file's settings under the user's: what it grew with.
+  std::optional<Params> effective_params() const override { return setup_.params; }
+  std::vector<std::pair<std::string, std::string>> input_files() const override { return setup_.inputs; }
 
   // A grammar is a program in the input, whose arithmetic can divide by zero or overflow: the invalid plant
   // it draws is bad input, not a bug.
@@ -485,10 +518,15 @@ class LSystem final : public GrowthAlgorithm {
   }
 
  private:
+  void use_stream(std::uint64_t stream) {
+    deriver_->set_stream(stream);
+    setup_.host->stream_ = stream;
+  }
+
   void begin_due() {
     for (auto& pl : plants_) {
       if (pl.started || pl.start_step > step_) continue;
-      deriver_->set_stream(pl.stream);
+      use_stream(pl.stream);
       deriver_->premise(pl.cur);
       pl.started = true;
     }
@@ -507,6 +545,11 @@ class LSystem final : public GrowthAlgorithm {
       ts.origin = pl.origin;
       ts.heading = pl.heading;
       ts.stream = pl.stream;
+      ts.color_image = setup_.color_image.w > 0 ? &setup_.color_image : nullptr;
+      const auto& stamp_params = setup_.stamps.params;
+      ts.stamps = std::all_of(stamp_params.begin(), stamp_params.end(), [](const auto& x) { return x.empty(); })
+                      ? nullptr
+                      : &setup_.stamps;
       ts.birth_step = static_cast<std::uint32_t>(step_);
       ts.fraction = (setup_.fraction > 0.0 && pl.generation == setup_.rewrites) ? setup_.fraction : 1.0;
       const bool need_states = setup_.grammar.uses_turtle && pl.generation < setup_.rewrites;

@@ -165,7 +165,9 @@ void BM_LsysTurtle(benchmark::State& state) {
                              .avoid = nullptr,
                              .birth_step = 0,
                              .organ_kind = {OrganKind::Leaf, OrganKind::Flower, OrganKind::Bud},
-                             .organ_shape = {kKindShape, kKindShape, kKindShape}};
+                             .organ_shape = {kKindShape, kKindShape, kKindShape},
+                             .color_image = nullptr,
+                             .stamps = nullptr};
   std::size_t nodes = 0;
   Plant reused;
   for (auto _ : state) {

@@ -4,10 +4,13 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <string>
+#include <unordered_map>
 
 #include <fmt/format.h>
 #include <glm/gtc/quaternion.hpp>
 
+#include "algorithms/organ_shapes.hpp"
 #include "core/errors.hpp"
 #include "core/random.hpp"
 #include "scenes/scene_query.hpp"
@@ -145,6 +148,7 @@ class Interpreter {
           o.shape = s_.organ_shape[which];
           o.node = t.node;
           for (int q = 2; q < k && q < 5; ++q) o.stamp[static_cast<std::size_t>(q - 2)] = a[q];
+          if (k > 2 && s_.stamps) o.shape = stamped_shape(c, which, a, k);
           plant_.organs.push_back(o);
           break;
         }
@@ -155,7 +159,10 @@ class Interpreter {
           const double sin_between = glm::length(axis);
           if (sin_between > 1e-12 && g != 0.0) {
             const glm::dvec3 ax = axis / sin_between;
-            const double alpha = g * sin_between;
+            // ABOP's bend, g |H x down|, toward -Y and never past it: at most the angle left to straight down
+            // (for g < 0, up to straight up), so a large g hangs the heading rather than swinging it back up.
+            const double to_down = std::atan2(sin_between, glm::dot(t.H, down));
+            const double alpha = std::clamp(g * sin_between, to_down - std::numbers::pi, to_down);
             const double cs = std::cos(alpha), sn = std::sin(alpha);
             t.H = glm::normalize(rotate_about(t.H, ax, cs, sn));
             t.L = glm::normalize(rotate_about(t.L, ax, cs, sn));
@@ -203,18 +210,9 @@ class Interpreter {
           t.L = -t.L;
           t.U = -t.U;
           break;
-        case '~': {
-          const double lim = k > 0 ? a[0] : 180.0;
-          Rng rng(s_.seed, s_.stream * 0x100000001ull + 11, m);
-          double cs, sn;
-          sincos_deg(lim * rng.uniform(-1.0, 1.0), cs, sn);
-          rotate_pair(t.H, t.U, cs, sn);
-          sincos_deg(lim * rng.uniform(-1.0, 1.0), cs, sn);
-          rotate_pair(t.L, t.U, cs, sn);
-          sincos_deg(lim * rng.uniform(-1.0, 1.0), cs, sn);
-          rotate_pair(t.H, t.L, cs, sn);
+        case '~':
+          random_turn(t, k > 0 ? a[0] : 180.0, m);
           break;
-        }
         case '"':
           t.length *= k > 0 ? a[0] : s_.step_scale;
           break;
@@ -365,6 +363,11 @@ class Interpreter {
     // before that has no group and the empty snapshot)
     if (groups_used_) node_groups_.push_back(t.group);
     if (attrs_used_) node_attrs_.push_back(t.attrs);
+    if (s_.color_image) {  // Apply Color: the image's sRGB pixel at the turtle's (u, v), as linear Cd
+      const std::uint8_t* px = s_.color_image->at(t.u, t.v);
+      const glm::vec3 c = srgb_to_linear(glm::vec3(px[0], px[1], px[2]) / 255.0f);
+      node_colors_.insert(node_colors_.end(), {c.r, c.g, c.b});
+    }
     if (tube.sections != 0 || tube.divisions != 0) {
       if (!tubes_used_) node_tubes_.assign(plant_.nodes.size() - 1 - first_node_, TubeShape{});
       tubes_used_ = true;
@@ -373,6 +376,59 @@ class Interpreter {
     return static_cast<std::int32_t>(plant_.nodes.size() - 1);
   }
   void snap_start(State& t) { snap(t); }
+
+  // The shape J/K/M (symbol c, index which) takes with its stamps a, b, c (args 2..4) set as the Leaf Params
+  // name them: kept in Plant::organ_shapes, each distinct name checked once.
+  std::uint16_t stamped_shape(char c, std::size_t which, const float* a, int k) {
+    std::string settings;
+    for (int q = 2; q < k && q < 5; ++q) {
+      const std::string& setting = s_.stamps->params[static_cast<std::size_t>(q - 2)];
+      if (setting.empty()) continue;
+      settings += fmt::format("{}{}={}", settings.empty() ? "" : ",", setting, a[q]);
+    }
+    if (settings.empty()) return s_.organ_shape[which];
+    const std::string& base = s_.stamps->base[which];
+    if (names_a_file(base))
+      throw InputError(
+          fmt::format("{}'s stamps set '{}' of its shape, but its shape is the OBJ file '{}', which has no "
+                      "settings; leaf_param_a/b/c apply to the built-in shapes",
+                      c, settings, base));
+    const std::string name = base + (base.find(':') == std::string::npos ? ":" : ",") + settings;
+    if (const auto it = stamped_.find(name); it != stamped_.end()) return it->second;
+    auto& shapes = plant_.organ_shapes;
+    auto at = std::find(shapes.begin(), shapes.end(), name);
+    if (at == shapes.end()) {
+      (void)organ_shape_named(name, fmt::format("{}'s stamps (leaf_param_a/b/c)", c));
+      if (shapes.size() >= kKindShape) throw InputError(fmt::format("{}'s stamps make too many shapes", c));
+      at = shapes.insert(shapes.end(), name);
+    }
+    return stamped_.emplace(name, static_cast<std::uint16_t>(at - shapes.begin())).first->second;
+  }
+
+  // ~(a): a heading drawn uniformly from the cone of half-angle a about the current one (the whole sphere
+  // from 180), reached by the smallest rotation of the frame, then a roll of up to a about it. The heading
+  // moves at most a degrees, which three independent turns of up to a each would not keep.
+  void random_turn(State& t, double limit_deg, std::size_t m) {
+    Rng rng(s_.seed, s_.stream * 0x100000001ull + 11, m);
+    const double lim = std::clamp(limit_deg, 0.0, 180.0) * std::numbers::pi / 180.0;
+    const double cos_theta = 1.0 - rng.uniform() * (1.0 - std::cos(lim));  // uniform over the cap's area
+    const double sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
+    const double phi = rng.uniform(0.0, 2.0 * std::numbers::pi);
+    const glm::dvec3 h = cos_theta * t.H + sin_theta * (std::cos(phi) * t.L + std::sin(phi) * t.U);
+    const glm::dvec3 axis = glm::cross(t.H, h);
+    const double sn = glm::length(axis), cs = glm::dot(t.H, h);
+    if (sn > 1e-12) {
+      t.L = glm::normalize(rotate_about(t.L, axis / sn, cs, sn));
+      t.H = glm::normalize(h);
+      t.U = glm::cross(t.H, t.L);
+    } else if (cs < 0.0) {  // exactly opposite: a half turn about U
+      t.H = -t.H;
+      t.L = -t.L;
+    }
+    double rc, rs;
+    sincos_deg(limit_deg * rng.uniform(-1.0, 1.0), rc, rs);
+    rotate_pair(t.L, t.U, rc, rs);
+  }
 
   // Moves the module cursor (m, p) to the last module of the current branch, so that its ']' pops next;
   // the skipped modules see the turtle as it stands.
@@ -471,6 +527,15 @@ class Interpreter {
           attr.values.push_back(id < snap.size() && cpt < 3 ? snap[id][static_cast<std::size_t>(cpt)] : 0.0f);
       }
     }
+    if (s_.color_image) {
+      auto it = std::find_if(plant_.node_attributes.begin(), plant_.node_attributes.end(),
+                             [](const NodeAttribute& x) { return x.name == "Cd"; });
+      if (it == plant_.node_attributes.end()) {
+        plant_.node_attributes.push_back({"Cd", 3, std::vector<float>(first_node * 3, 0.0f)});
+        it = plant_.node_attributes.end() - 1;
+      }
+      it->values.insert(it->values.end(), node_colors_.begin(), node_colors_.end());
+    }
     // attributes other plants made before this one: pad with zeros for this plant's nodes
     for (auto& attr : plant_.node_attributes)
       attr.values.resize(plant_.nodes.size() * static_cast<std::size_t>(attr.components), 0.0f);
@@ -488,6 +553,8 @@ class Interpreter {
   std::vector<std::vector<std::array<float, 4>>> attr_snapshots_;
   std::vector<int> attr_components_;
   std::vector<TubeShape> node_tubes_;
+  std::vector<float> node_colors_;                          // Apply Color: 3 per node of this plant
+  std::unordered_map<std::string, std::uint16_t> stamped_;  // stamped shape names -> Plant::organ_shapes
   std::int32_t group_counter_ = 0;
   bool groups_used_ = false, attrs_used_ = false, tubes_used_ = false;
   std::size_t first_node_ = 0;  // this plant's first node in plant_

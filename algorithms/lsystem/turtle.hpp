@@ -15,7 +15,9 @@
 // a step that would end in a solid or cross one at its midpoint, and the step is not taken.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -36,6 +38,26 @@ enum class Convention { Houdini, Abop };
 
 // What the turtle draws with. The values come from the parameter table (make_setup in lsystem.cpp), the
 // per-plant ones from the plant being drawn: no member has a default of its own.
+// An 8-bit RGB image read by (u, v): pic() and Apply Color.
+struct Image {
+  int w = 0, h = 0;
+  std::vector<std::uint8_t> rgb;  // row 0 at the top; a quarter of floats' memory, the same values on lookup
+  // The pixel holding (u, v), v up the image; outside [0, 1]^2, the nearest edge pixel.
+  [[nodiscard]] const std::uint8_t* at(double u, double v) const {
+    const int x = std::clamp(static_cast<int>(std::floor(u * w)), 0, w - 1);
+    const int y = std::clamp(static_cast<int>(std::floor((1.0 - v) * h)), 0, h - 1);
+    return &rgb[(static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)) * 3];
+  }
+};
+
+// Houdini's Leaf Params A, B, C: the built-in shape setting each of J/K/M's stamps a, b, c sets, when the
+// module passes it ("" for none). J/K/M's shape (`base`, a built-in's name with its settings) then becomes
+// "base:setting=value,...", a shape of its own in Plant::organ_shapes.
+struct OrganStamps {
+  std::array<std::string, 3> params;
+  std::array<std::string, 3> base;  // for J, K and M
+};
+
 struct TurtleSettings {
   double step;             // default F length (m)
   double step_scale;       // " and _
@@ -58,6 +80,8 @@ struct TurtleSettings {
   std::uint32_t birth_step;
   std::array<OrganKind, 3> organ_kind;       // what J, K and M place
   std::array<std::uint16_t, 3> organ_shape;  // their shapes: Plant::organ_shapes indices, or kKindShape
+  const Image* color_image;                  // Apply Color: each node's Cd from it at the turtle's (u, v)
+  const OrganStamps* stamps;                 // Leaf Params A, B, C; null when none is set
 };
 
 struct TurtleResult {

@@ -232,10 +232,25 @@ class ShapeTests {
   Aabb tried_all_;
 };
 
-// The branch segments, for the test that an organ's box meets no segment's capsule but its stem's.
+// The branch segments, for the test that an organ's box meets no segment's capsule but its stem's. An
+// organ's stem is the chain of segments from the branch point its node hangs from: a flower on a short,
+// fine pedicel sits within the capsule of the pedicel's first segments, which hold it rather than cross it.
 class Branches {
  public:
-  explicit Branches(const std::vector<PlantNode>& nodes) : nodes_(nodes) {
+  explicit Branches(const std::vector<PlantNode>& nodes)
+      : nodes_(nodes), chain_(nodes.size()), depth_(nodes.size(), 0) {
+    std::vector<std::uint32_t> children(nodes.size(), 0);
+    for (const auto& n : nodes)
+      if (n.parent != kNoParent) ++children[static_cast<std::size_t>(n.parent)];
+    // Parents precede children: a root, or a node after a branch point, starts a chain; others continue their
+    // parent's.
+    for (std::size_t c = 0; c < nodes.size(); ++c) {
+      const std::int32_t p = nodes[c].parent;
+      const auto pp = static_cast<std::size_t>(p);
+      const bool starts = p == kNoParent || children[pp] > 1;
+      chain_[c] = starts ? static_cast<std::uint32_t>(c) : chain_[pp];
+      depth_[c] = p == kNoParent ? 0 : depth_[pp] + 1;
+    }
     for (std::size_t c = 0; c < nodes.size(); ++c) {
       if (nodes[c].parent == kNoParent) continue;
       const auto& p = nodes[static_cast<std::size_t>(nodes[c].parent)];
@@ -249,7 +264,15 @@ class Branches {
   Branches(const Branches&) = delete;  // the tree refers to cloud_
   Branches& operator=(const Branches&) = delete;
 
-  // Whether a segment other than those ending or starting at node `own` (the organ's stem) meets the box.
+  // Whether the segment ending at node c is on the stem of an organ at node `own`: on own's chain, at or
+  // above it, or the segment starting at own.
+  [[nodiscard]] bool on_stem(std::uint32_t c, std::int32_t own) const {
+    if (own == kNoParent) return false;
+    const auto o = static_cast<std::size_t>(own);
+    return nodes_[c].parent == own || (chain_[c] == chain_[o] && depth_[c] <= depth_[o]);
+  }
+
+  // Whether a segment other than those of its stem (on_stem) meets the box of an organ at node `own`.
   [[nodiscard]] bool block(const Probe& c, std::int32_t own) const {
     if (!tree_) return false;
     bool blocked = false;
@@ -257,7 +280,7 @@ class Branches {
                     [&](std::uint32_t s, float) {
                       const std::uint32_t ci = child_[s];
                       const auto& n = nodes_[ci];
-                      if (own != kNoParent && (static_cast<std::int32_t>(ci) == own || n.parent == own)) return true;
+                      if (on_stem(ci, own)) return true;
                       const auto& p = nodes_[static_cast<std::size_t>(n.parent)];
                       const double r = std::max({p.radius, n.radius, 1e-4f});
                       blocked = capsule_meets_box(glm::dvec3(p.position), glm::dvec3(n.position), r, c.box);
@@ -268,6 +291,8 @@ class Branches {
 
  private:
   const std::vector<PlantNode>& nodes_;
+  std::vector<std::uint32_t> chain_;  // per node: the first node of its unbranched chain
+  std::vector<std::uint32_t> depth_;  // per node: segments from its root
   std::vector<glm::vec3> mid_;        // each segment's midpoint
   std::vector<std::uint32_t> child_;  // each segment's child node
   double reach_ = 0.0;                // the farthest any segment's capsule reaches from its midpoint

@@ -358,6 +358,21 @@ struct Verdict {
   }
 };
 
+// A file the algorithm read its input from (GrowthAlgorithm::input_files), with its content's hash, so that a
+// result says which grammar or point cloud it grew from, not only where it lay.
+struct InputFile {
+  std::string param;  // the parameter that named it
+  std::string path;   // as the algorithm opened it
+  std::string hash;   // XXH3 (64 bits) of its content, 16 hex digits
+  friend bool operator==(const InputFile&, const InputFile&) = default;
+
+  static constexpr std::string_view kSchemaName = "input_file";
+  static constexpr auto fields() {
+    using F = InputFile;
+    return std::tuple{field("param", &F::param), field("path", &F::path), field("hash", &F::hash).refine(kHashSchema)};
+  }
+};
+
 // What a trial grew and what the plant measures: the same for every successful repetition of a cell, so a
 // suite keeps it once per cell. A trial's record and a cell's results both hold it, field for field.
 struct TrialResults {
@@ -370,6 +385,7 @@ struct TrialResults {
   std::string stopped_by = "finished";  // kStoppedBy
   Curve curve;
   nlohmann::json params = nlohmann::json::object();  // the algorithm's effective parameters by name
+  std::vector<InputFile> inputs;                     // the files it read them from, when any
   std::map<std::string, double> algorithm_stats;
   std::uint64_t threads = 0;              // the threads it ran with
   std::optional<OrganPassRecord> organs;  // only when the pass ran (an organ option was given)
@@ -387,6 +403,7 @@ struct TrialResults {
                       field("stopped_by", &T::stopped_by).one_of(kStoppedBy),
                       field("curve", &T::curve).with(kNoCsv),
                       field("params", &T::params).with(kNoCsv),
+                      field("inputs", &T::inputs).with(kNoCsv),
                       field("algorithm_stats", &T::algorithm_stats),
                       field("threads", &T::threads),
                       field("organs", &T::organs),

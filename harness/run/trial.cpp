@@ -563,6 +563,12 @@ void organ_pass(const TrialSpec& spec, const OrganOptions& options, const Params
   rec.results.organs = std::move(out);
 }
 
+// What the algorithm's own input files set, and their hashes (a grammar's premise, not the default's).
+void record_inputs(const GrowthAlgorithm& algo, TrialResults& r) {
+  if (const auto effective = algo.effective_params()) r.params = effective->to_json();
+  for (const auto& [param, path] : algo.input_files()) r.inputs.push_back({param, path, file_hash(path)});
+}
+
 }  // namespace
 
 TrialRecord run_trial_record(const TrialSpec& spec, const std::function<void(const Progress&)>& progress,
@@ -597,6 +603,7 @@ TrialRecord run_trial_record(const TrialSpec& spec, const std::function<void(con
   if (!spec.leaf_obj.empty()) rec.leaf_obj = spec.leaf_obj;
 
   grow(spec, params, st, timer, rec, progress);
+  record_inputs(*st.algo, rec.results);
   const Plant& plant = st.algo->plant();
   // An algorithm whose input can draw an invalid plant (an L-system's grammar is a program) refuses it in
   // finish(), as bad input; a plugin's invalid plant is the plugin's error; a built-in's is a bug.

@@ -2,7 +2,9 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <numbers>
 #include <optional>
+#include <set>
 
 #include <glm/gtc/quaternion.hpp>
 #include <gtest/gtest.h>
@@ -145,6 +147,29 @@ TEST(OrganPlacement, AFlowerThroughABranchFallsBackToABud) {
   EXPECT_EQ(place_organs(none, options({"placement=avoid", "fallback_flower=none"})).dropped, 1u);
 }
 
+// An organ's stem is the chain of segments from its branch point, not only the last one: a blossom on a
+// 0.01 pedicel after a 0.3 stem of thickness 0.03 (F(0.3)F(0.01)J) sits inside the stem's first capsule,
+// which holds it; it was dropped while only the last segment counted as its stem. A branch from the
+// branch point is not its stem, and still blocks it.
+TEST(OrganPlacement, AnOrgansStemIsItsChainFromTheBranchPoint) {
+  const glm::quat up = glm::angleAxis(-0.5f * std::numbers::pi_v<float>, glm::vec3(1, 0, 0));  // +Z to +Y
+  Plant p;
+  p.nodes.push_back({glm::vec3(0.0f), 0.015f, kNoParent, 0, 0, 0});
+  p.nodes.push_back({glm::vec3(0.0f, 0.3f, 0.0f), 0.015f, 0, 0, 0, 0});
+  p.nodes.push_back({glm::vec3(0.0f, 0.31f, 0.0f), 0.015f, 1, 0, 0, 0});
+  p.organs.push_back(organ_at({0.0f, 0.31f, 0.0f}, 0.03f, OrganKind::Flower, up));
+  p.organs[0].node = 2;
+  const PlacementCounts c = place_organs(p, options({"placement=avoid", "fallback_flower=none"}));
+  EXPECT_EQ(c.placed, 1u);
+  EXPECT_EQ(c.dropped, 0u);
+  // The same pedicel from a branch point, with a side branch leaving that point through the blossom.
+  Plant fork = p;
+  fork.organs[0].position = {0.0f, 0.33f, 0.0f};
+  fork.nodes[2].position = {0.0f, 0.33f, 0.0f};
+  fork.nodes.push_back({glm::vec3(0.0f, 0.36f, 0.0f), 0.015f, 1, 1, 1, 0});
+  EXPECT_EQ(place_organs(fork, options({"placement=avoid", "fallback_flower=none"})).dropped, 1u);
+}
+
 // A crowd of leaves and flowers at random, dense enough that most meet another.
 Plant crowd(std::size_t n, float box) {
   Plant p;
@@ -192,8 +217,8 @@ TEST(OrganPlacement, KeptOrgansNeverMeetAndTheResultIsTheSameForAnyThreadCount) 
 
 // The avoid placement by its definition, by brute force over every pair: each organ in order takes its
 // first candidate (as grown, then its fallback) whose box meets no branch segment's capsule but its
-// stem's, and whose triangles meet those of no organ kept before it. `blocked` counts the candidates a
-// branch turned away.
+// stem's (the chain from its branch point), and whose triangles meet those of no organ kept before it. `blocked` counts
+// the candidates a branch turned away.
 PlacementCounts reference_placement(Plant& p, const OrganOptions& opt, std::size_t& blocked) {
   auto named = [&](const std::string& f) {
     const auto it = std::find(p.organ_shapes.begin(), p.organ_shapes.end(), f);
@@ -216,11 +241,25 @@ PlacementCounts reference_placement(Plant& p, const OrganOptions& opt, std::size
     if (f.rfind("bud", 0) == 0) o.kind = OrganKind::Bud;
     return o;
   };
+  // The stem of an organ at node `own`: the segments from own up to the branch point (or root) it hangs from,
+  // each named by its child node, and those starting at own.
+  auto stem = [&](std::int32_t own) {
+    std::set<std::int32_t> s;
+    for (std::int32_t x = own; x != kNoParent && p.nodes[static_cast<std::size_t>(x)].parent != kNoParent;) {
+      s.insert(x);
+      const std::int32_t up = p.nodes[static_cast<std::size_t>(x)].parent;
+      const auto siblings =
+          std::count_if(p.nodes.begin(), p.nodes.end(), [&](const auto& n) { return n.parent == up; });
+      x = siblings > 1 ? kNoParent : up;
+    }
+    return s;
+  };
   auto branch_blocks = [&](const Organ& o) {
     const OrientedBox box = organ_box(o, shapes.of(o));
+    const std::set<std::int32_t> own = stem(o.node);
     for (std::size_t c = 0; c < p.nodes.size(); ++c) {
       const auto& n = p.nodes[c];
-      if (n.parent == kNoParent || static_cast<std::int32_t>(c) == o.node ||
+      if (n.parent == kNoParent || own.count(static_cast<std::int32_t>(c)) ||
           (o.node != kNoParent && n.parent == o.node))
         continue;
       const auto& q = p.nodes[static_cast<std::size_t>(n.parent)];
