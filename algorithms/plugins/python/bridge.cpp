@@ -9,9 +9,9 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
-#include <deque>
 #include <memory>
 #include <new>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -20,9 +20,10 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
-#include "growbench/plugin.h"
+#include "growbench/plugin.hpp"
 
 namespace py = pybind11;
+namespace sdk = growbench::sdk;
 
 namespace {
 
@@ -287,16 +288,12 @@ namespace {
 
 // ------------------------------------------------------------------ one script's table
 
-// What a plugin table made from a script owns: the class, and every string and row the table points into.
+// What a plugin table made from a script owns: the class, and the SDK's Info, which the table's name,
+// summary, version, parameter rows and test parameters point into (as a C++ plugin's do).
 struct Script {
   py::object cls;
-  std::deque<std::string> strings;  // a deque: growing it never moves a string the table points to
-  std::vector<growbench_param> rows;
-  std::deque<std::vector<const char*>> choices;
-  std::vector<const char*> test_params;
+  std::optional<sdk::Info> info;
   growbench_plugin table{};
-
-  const char* keep(std::string s) { return strings.emplace_back(std::move(s)).c_str(); }
 };
 
 // The instance behind a growbench_instance: the Python object, and the plant it last handed over.
@@ -390,8 +387,8 @@ py::object scene_object(const growbench_scene& s) {
 
 py::dict params_object(const Script& sc, const growbench_value* values) {
   py::dict p;
-  for (std::size_t k = 0; k < sc.rows.size(); ++k) {
-    const growbench_param& r = sc.rows[k];
+  for (std::size_t k = 0; k < sc.table.param_count; ++k) {
+    const growbench_param& r = sc.table.params[k];
     const growbench_value& v = values[k];
     switch (r.type) {
       case GROWBENCH_PARAM_INT:
@@ -682,8 +679,8 @@ constexpr std::array<growbench_instance* (*)(const growbench_host*), kSlots> cre
   return {&create<N>...};
 }
 
-// One row of the table from the class's `params` entry (a dict as growbench.real() makes).
-growbench_param param_row(Script& sc, const py::dict& d) {
+// The parameter type a row's 'type' names.
+growbench_param_type param_type(const std::string& type) {
   static const std::array<std::pair<const char*, growbench_param_type>, 6> kTypes = {
       {{"integer", GROWBENCH_PARAM_INT},
        {"real", GROWBENCH_PARAM_REAL},
@@ -691,29 +688,36 @@ growbench_param param_row(Script& sc, const py::dict& d) {
        {"text", GROWBENCH_PARAM_STRING},
        {"vector3", GROWBENCH_PARAM_VEC3},
        {"choice", GROWBENCH_PARAM_CHOICE}}};
-  growbench_param r{};
-  const std::string type = text_of(d["type"]);
-  r.type = -1;
   for (const auto& [name, t] : kTypes)
-    if (type == name) r.type = t;
-  if (r.type < 0) throw py::value_error("params: unknown type '" + type + "'; use growbench.real(), integer(), ...");
-  r.name = sc.keep(text_of(d["name"]));
+    if (type == name) return t;
+  throw py::value_error("params: unknown type '" + type + "'; use growbench.real(), integer(), ...");
+}
+
+// One row of the table from the class's `params` entry (a dict as growbench.real() makes), as the SDK's
+// Param. Its keys are read in the order type, name, default, min, max, unit, doc, choices: a row with
+// several faults is refused for the first of them. A vector3 row (growbench has no helper for one)
+// defaults to the origin, whatever its 'default'.
+sdk::Param param_of(const py::dict& d) {
+  const growbench_param_type type = param_type(text_of(d["type"]));
+  const std::string name = text_of(d["name"]);
   const py::object v = d["default"];
-  if (r.type == GROWBENCH_PARAM_INT) r.default_value.integer = v.cast<std::int64_t>();
-  if (r.type == GROWBENCH_PARAM_REAL) r.default_value.real = v.cast<double>();
-  if (r.type == GROWBENCH_PARAM_BOOL) r.default_value.boolean = v.cast<bool>() ? 1 : 0;
-  if (r.type == GROWBENCH_PARAM_STRING || r.type == GROWBENCH_PARAM_CHOICE) r.default_value.text = sc.keep(text_of(v));
-  r.min = d.contains("min") ? d["min"].cast<double>() : -HUGE_VAL;
-  r.max = d.contains("max") ? d["max"].cast<double>() : HUGE_VAL;
-  r.unit = sc.keep(d.contains("unit") ? text_of(d["unit"]) : "");
-  r.doc = sc.keep(d.contains("doc") ? text_of(d["doc"]) : "");
-  if (r.type == GROWBENCH_PARAM_CHOICE) {
-    auto& c = sc.choices.emplace_back();
-    for (const auto& x : d["choices"]) c.push_back(sc.keep(text_of(x)));
-    r.choices = c.data();
-    r.choice_count = static_cast<uint32_t>(c.size());
+  std::optional<sdk::Param> p;
+  if (type == GROWBENCH_PARAM_INT) p = sdk::integer(name, v.cast<std::int64_t>());
+  if (type == GROWBENCH_PARAM_REAL) p = sdk::real(name, v.cast<double>());
+  if (type == GROWBENCH_PARAM_BOOL) p = sdk::boolean(name, v.cast<bool>());
+  if (type == GROWBENCH_PARAM_VEC3) p = sdk::vector3(name, 0.0, 0.0, 0.0);
+  const std::string text = type == GROWBENCH_PARAM_STRING || type == GROWBENCH_PARAM_CHOICE ? text_of(v) : "";
+  if (type == GROWBENCH_PARAM_STRING) p = sdk::text(name, text);
+  const double min = d.contains("min") ? d["min"].cast<double>() : -HUGE_VAL;
+  const double max = d.contains("max") ? d["max"].cast<double>() : HUGE_VAL;
+  std::string unit = d.contains("unit") ? text_of(d["unit"]) : "";
+  std::string doc = d.contains("doc") ? text_of(d["doc"]) : "";
+  if (type == GROWBENCH_PARAM_CHOICE) {
+    std::vector<std::string> choices;
+    for (const auto& x : d["choices"]) choices.push_back(text_of(x));
+    p = sdk::choice(name, text, std::move(choices));
   }
-  return r;
+  return std::move(*p).range(min, max).unit(std::move(unit)).doc(std::move(doc));
 }
 
 // The script's class: the module's PLUGIN.
@@ -739,20 +743,20 @@ void fill_table(Script& sc, int slot) {
   for (const char* key : {"name", "start", "step", "plant"})
     if (!py::hasattr(c, key))
       throw py::value_error(std::string("PLUGIN has no '") + key + "'; see docs/plugins.md, 'Algorithms in Python'");
+  std::vector<sdk::Param> params;
   if (py::hasattr(c, "params"))
-    for (const auto& row : c.attr("params")) sc.rows.push_back(param_row(sc, row.cast<py::dict>()));
+    for (const auto& row : c.attr("params")) params.push_back(param_of(row.cast<py::dict>()));
+  std::vector<std::string> test_params;
   if (py::hasattr(c, "test_params"))
-    for (const auto& a : c.attr("test_params")) sc.test_params.push_back(sc.keep(text_of(a)));
+    for (const auto& a : c.attr("test_params")) test_params.push_back(text_of(a));
+  std::string name = text_of(c.attr("name"));
+  std::string summary = py::hasattr(c, "summary") ? text_of(c.attr("summary")) : "an algorithm written in Python";
+  std::string version = py::hasattr(c, "version") ? text_of(c.attr("version")) : "";
   growbench_plugin& t = sc.table;
   t.abi_version = GROWBENCH_PLUGIN_ABI_VERSION;
   t.struct_size = sizeof(growbench_plugin);
-  t.name = sc.keep(text_of(c.attr("name")));
-  t.summary = sc.keep(py::hasattr(c, "summary") ? text_of(c.attr("summary")) : "an algorithm written in Python");
-  t.version = sc.keep(py::hasattr(c, "version") ? text_of(c.attr("version")) : "");
-  t.params = sc.rows.data();
-  t.param_count = static_cast<uint32_t>(sc.rows.size());
-  t.test_params = sc.test_params.data();
-  t.test_param_count = static_cast<uint32_t>(sc.test_params.size());
+  sc.info.emplace(std::move(name), std::move(summary), std::move(version), std::move(params), std::move(test_params))
+      .fill(t);
   static constexpr auto kCreators = creators(std::make_integer_sequence<int, kSlots>{});
   t.create = kCreators[static_cast<std::size_t>(slot)];
   t.start = &start;
