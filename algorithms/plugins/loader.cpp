@@ -349,6 +349,12 @@ std::string canonical_path(const std::string& given) {
   return abs.empty() ? given : abs.string();
 }
 
+// Where the algorithm `info` read from table `t` came from, as records name it: load_plugin and
+// describe_plugin must say the same of one file.
+PluginOrigin origin_of(const std::string& path, const AlgorithmInfo& info, const growbench_plugin& t) {
+  return PluginOrigin{info.name, path, file_hash(path), t.abi_version, text_or_empty(t.version)};
+}
+
 }  // namespace
 
 const AlgorithmEntry& load_plugin(const std::string& given) {
@@ -359,8 +365,7 @@ const AlgorithmEntry& load_plugin(const std::string& given) {
   const growbench_plugin* t = open_plugin(path);
   AlgorithmInfo info = read_plugin_table(path, *t);
   check_name_free(path, info.name);
-  auto origin = std::make_shared<PluginOrigin>(
-      PluginOrigin{info.name, path, file_hash(path), t->abi_version, text_or_empty(t->version)});
+  auto origin = std::make_shared<PluginOrigin>(origin_of(path, info, *t));
   Loaded& l = loaded().emplace_back(Loaded{path, std::move(info), {}});
   const AlgorithmInfo* ip = &l.info;
   l.entry = AlgorithmEntry{[ip]() -> const AlgorithmInfo& { return *ip; },
@@ -419,7 +424,7 @@ PluginOrigin describe_plugin(const std::string& given) {
   probe_in_child(path);
   const growbench_plugin* t = open_plugin(path);
   const AlgorithmInfo info = read_plugin_table(path, *t);
-  return PluginOrigin{info.name, path, file_hash(path), t->abi_version, text_or_empty(t->version)};
+  return origin_of(path, info, *t);
 }
 
 std::vector<PluginOrigin> loaded_plugins() {
