@@ -13,7 +13,7 @@
 #include "core/outcome.hpp"
 #include "harness/run/process.hpp"
 #include "harness/run/trial.hpp"
-#include "scenes/scene_library.hpp"
+#include "scenes/scene.hpp"
 #include "scenes/scene_query.hpp"
 
 namespace growbench {
@@ -33,7 +33,8 @@ int grow_and_report(const TrialSpec& spec, bool look_inside, int fd) {
   json r;
   try {
     Plant plant;
-    const TrialRecord rec = run_trial_record(spec, {}, &plant);
+    Scene scene;
+    const TrialRecord rec = run_trial_record(spec, {}, &plant, &scene);
     r["hash"] = rec.results.geometry_hash;
     r["stopped_by"] = rec.results.stopped_by;
     r["nodes"] = plant.nodes.size();
@@ -41,7 +42,6 @@ int grow_and_report(const TrialSpec& spec, bool look_inside, int fd) {
     std::uint64_t roots = 0;
     for (const auto& n : plant.nodes) roots += n.parent == kNoParent ? 1 : 0;
     r["roots"] = roots;
-    const Scene scene = load_scene(spec.scene);
     r["seeds"] = scene.seeds.size();
     if (look_inside) {  // the metrics' exact test, node by node
       const SceneQuery q(scene);

@@ -572,7 +572,7 @@ void record_inputs(const GrowthAlgorithm& algo, TrialResults& r) {
 }  // namespace
 
 TrialRecord run_trial_record(const TrialSpec& spec, const std::function<void(const Progress&)>& progress,
-                             Plant* plant_out) {
+                             Plant* plant_out, Scene* scene_out) {
   load_plugins(spec.plugins);
   const AlgorithmEntry& entry = find_algorithm(spec.algorithm);
   const Params params = checked_params(spec, entry);
@@ -632,6 +632,9 @@ TrialRecord run_trial_record(const TrialSpec& spec, const std::function<void(con
     // Indented for people reading `growbench run` output; compact when a suite parent parses it.
     write_file_atomic(path, json_text(to_json(rec), spec.skip_teardown ? -1 : 2));
   }
+  // Copied, not moved: the algorithm, destroyed last, may still point into the trial's scene. After the
+  // peak RSS is read, so that the copy is not counted in the record.
+  if (scene_out) *scene_out = st.scene;
   // Deliberately never freed: the process exits next and the kernel reclaims it all at once. Held by a
   // static, so that a leak checker sees it still reachable at exit.
   if (spec.skip_teardown) {

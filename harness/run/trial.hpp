@@ -17,6 +17,8 @@
 
 namespace growbench {
 
+struct Scene;
+
 struct Progress {
   int step = 0;
   std::size_t nodes = 0;
@@ -25,9 +27,10 @@ struct Progress {
 
 // Runs a trial. Bad input throws InputError before any growth; everything else is recorded.
 // The returned record is also written to OUT/record.json when out_dir is set.
-// `plant_out`, when given, receives the grown plant (tests check invariants on it).
+// `plant_out`, when given, receives the grown plant (tests check invariants on it); `scene_out` the scene it
+// grew in, with the seeds it grew from, so that a caller judging the plant against it need not load it again.
 TrialRecord run_trial_record(const TrialSpec& spec, const std::function<void(const Progress&)>& progress = {},
-                             Plant* plant_out = nullptr);
+                             Plant* plant_out = nullptr, Scene* scene_out = nullptr);
 // The same record as JSON (to_json of the above).
 nlohmann::json run_trial(const TrialSpec& spec, const std::function<void(const Progress&)>& progress = {},
                          Plant* plant_out = nullptr);
