@@ -11,13 +11,21 @@ const std::vector<ParamSpec>& organ_param_specs() {
   static const std::vector<ParamSpec> specs = {
       param::choice("placement", "free", {"free", "avoid"})
           .doc("free: every organ where the algorithm put it; avoid: in the plant's order, an organ that would "
-               "intersect an organ already placed or a branch other than its own stem tries its fallback, else is "
-               "dropped"),
+               "intersect an organ already placed or a branch other than its own stem tries itself turned, then "
+               "smaller, then its fallback, else is dropped"),
       param::text("fallback_flower", "bud").doc("the shape a flower falls back to under avoid ('none': dropped)"),
       param::text("fallback_bud", "none").doc("the shape a bud falls back to under avoid ('none': dropped)"),
       param::real("fallback_leaf", 0.6)
           .range(0, 1)
           .doc("a leaf falls back to itself at this fraction of its size under avoid (0: dropped)"),
+      param::real("turn_deg", 30.0)
+          .range(0, 90)
+          .unit("deg")
+          .doc("under avoid, an organ that does not fit first tries itself turned by +-turn_deg about its two cross "
+               "axes at its attachment point (0: no turns)"),
+      param::real("shrink", 0.7)
+          .range(0.1, 1)
+          .doc("under avoid, it then tries itself at this fraction of its size, before its fallback (1: no shrink)"),
       param::real("scale_min", 1.0)
           .range(0.01, 100)
           .doc("each organ's size is scaled by a draw in [scale_min, "
@@ -51,9 +59,9 @@ OrganOptions read_organ_options(const std::vector<std::string>& assignments, Par
         fmt::format("organ options: scale_min {} is above scale_max {}", p.real("scale_min"), p.real("scale_max")));
   for (const char* key : {"fallback_flower", "fallback_bud"})
     if (p.text(key) != "none") (void)organ_shape_named(p.text(key), fmt::format("organ option {}", key));
-  OrganOptions o{p.text("placement"),    p.text("fallback_flower"),   p.text("fallback_bud"), p.real("fallback_leaf"),
-                 p.real("scale_min"),    p.real("scale_max"),         p.real("roll_deg"),     p.real("tilt_deg"),
-                 p.real("color_jitter"), p.boolean("alternate_bloom")};
+  OrganOptions o{p.text("placement"), p.text("fallback_flower"), p.text("fallback_bud"), p.real("fallback_leaf"),
+                 p.real("turn_deg"),  p.real("shrink"),          p.real("scale_min"),    p.real("scale_max"),
+                 p.real("roll_deg"),  p.real("tilt_deg"),        p.real("color_jitter"), p.boolean("alternate_bloom")};
   if (params_out) *params_out = std::move(p);
   return o;
 }

@@ -20,6 +20,8 @@ struct OrganOptions {
   std::string fallback_flower;  // the shape a flower that does not fit tries next ("none": dropped)
   std::string fallback_bud;
   double fallback_leaf;  // a leaf that does not fit tries this fraction of its size (0: dropped)
+  double turn_deg;       // before its fallback, an organ tries itself turned by +- this (0: not)
+  double shrink;         // and then itself at this fraction of its size (1: not)
   double scale_min, scale_max;
   double roll_deg, tilt_deg;  // random rotation about the stem (+Z) and about the normal (+Y), +-
   double color_jitter;

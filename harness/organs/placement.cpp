@@ -389,8 +389,47 @@ void vary_organs(Plant& plant, const OrganOptions& opt, std::uint64_t seed) {
 
 namespace {
 
-// What each organ took.
-enum Decision : std::uint8_t { kGrown = 0, kFallback = 1, kDropped = 2 };
+// What each organ took: its candidate's index (0: as grown), or kDropped.
+constexpr std::uint8_t kGrown = 0, kDropped = 0xFF;
+
+// An organ's candidates, in the order they are tried: as grown; turned about its attachment point by
+// +-turn_deg about its two cross axes (a blossom tipped off a neighbour, a leaf lifted off a branch); at
+// `shrink` of its size; its kind's fallback. The turns and the shrink keep the organ what it is, so they
+// come before the fallback, which changes it.
+class Candidates {
+ public:
+  Candidates(Plant& plant, const OrganOptions& opt) : fallbacks_(plant, opt) {
+    if (opt.turn_deg > 0.0) {
+      const auto a = static_cast<float>(glm::radians(opt.turn_deg));
+      for (const glm::vec3 axis : {glm::vec3(1, 0, 0), glm::vec3(0, 1, 0)})
+        for (const float sign : {1.0f, -1.0f}) own_.push_back({glm::angleAxis(sign * a, axis), 1.0f});
+    }
+    if (opt.shrink < 1.0) own_.push_back({glm::quat(1, 0, 0, 0), opt.shrink});
+  }
+
+  [[nodiscard]] std::uint8_t count(OrganKind kind) const {
+    return static_cast<std::uint8_t>(1 + own_.size() + (fallbacks_.exist(kind) ? 1 : 0));
+  }
+  // Candidate v (< count) of an organ as grown.
+  [[nodiscard]] Organ of(Organ o, std::uint8_t v) const {
+    if (v == kGrown) return o;
+    if (v <= own_.size()) {
+      const Own& c = own_[v - 1];
+      o.orientation = glm::normalize(o.orientation * c.turn);
+      o.size = static_cast<float>(o.size * c.scale);
+      return o;
+    }
+    return fallbacks_.of(o);
+  }
+
+ private:
+  struct Own {
+    glm::quat turn;
+    double scale;
+  };
+  const Fallbacks fallbacks_;
+  std::vector<Own> own_;
+};
 
 // Each organ's own box's centre, and how far its candidates' boxes reach from it.
 struct Reach {
@@ -466,7 +505,7 @@ class Neighbours {
 class Placement {
  public:
   Placement(Plant& p, const OrganOptions& o, const OrganShape* custom)
-      : plant_(p), fallbacks_(p, o), shapes_(p, custom), branches_(p.nodes), neighbours_(reach()) {}
+      : plant_(p), candidates_(p, o), shapes_(p, custom), branches_(p.nodes), neighbours_(reach()) {}
 
   PlacementCounts run() {
     const std::size_t n = plant_.organs.size();
@@ -478,11 +517,14 @@ class Placement {
     std::size_t kept = 0;
     for (std::size_t i = 0; i < n; ++i) {
       const std::uint32_t p = neighbours_.place(i);
+      auto& kind = counts.by_kind[static_cast<std::size_t>(plant_.organs[i].kind)];
       if (decision[p] == kDropped) {
         ++counts.dropped;
+        ++kind.dropped;
         continue;
       }
       ++(decision[p] == kGrown ? counts.placed : counts.fallen_back);
+      ++(decision[p] == kGrown ? kind.placed : kind.fallen_back);
       plant_.organs[kept++] = as(p, decision[p]);
     }
     plant_.organs.resize(kept);
@@ -490,10 +532,8 @@ class Placement {
   }
 
  private:
-  // The organ at place p as grown or as its fallback.
-  [[nodiscard]] Organ as(std::uint32_t p, std::uint8_t variant) const {
-    return variant == kGrown ? organs_[p] : fallbacks_.of(organs_[p]);
-  }
+  // The organ at place p as its candidate `variant`.
+  [[nodiscard]] Organ as(std::uint32_t p, std::uint8_t variant) const { return candidates_.of(organs_[p], variant); }
 
   [[nodiscard]] Probe probe(const Organ& o) const {
     Probe p{organ_box(o, shapes_.of(o)), 0.0, glm::dvec3(0.0)};
@@ -510,10 +550,11 @@ class Placement {
       const OrientedBox own = organ_box(o, shapes_.of(o));
       r.centres[i] = glm::vec3(own.centre);
       r.spread[i] = glm::length(own.half);
-      if (!fallbacks_.exist(o.kind)) return;
-      const Organ f = fallbacks_.of(o);
-      const OrientedBox b = organ_box(f, shapes_.of(f));
-      r.spread[i] = std::max(r.spread[i], glm::length(b.centre - own.centre) + glm::length(b.half));
+      for (std::uint8_t v = 1; v < candidates_.count(o.kind); ++v) {
+        const Organ f = candidates_.of(o, v);
+        const OrientedBox b = organ_box(f, shapes_.of(f));
+        r.spread[i] = std::max(r.spread[i], glm::length(b.centre - own.centre) + glm::length(b.half));
+      }
     });
     return r;
   }
@@ -552,7 +593,7 @@ class Placement {
   // What the organ at place p takes: its first candidate that no branch but its own stem blocks and
   // that meets no candidate its earlier neighbours took.
   std::uint8_t decide(std::uint32_t p, const std::vector<std::uint8_t>& decision, ShapeTests& tests) const {
-    const std::uint8_t variants = fallbacks_.exist(organs_[p].kind) ? 2 : 1;
+    const std::uint8_t variants = candidates_.count(organs_[p].kind);
     for (std::uint8_t v = 0; v < variants; ++v) {
       const Organ o = as(p, v);
       const Probe box = probe(o);
@@ -572,7 +613,7 @@ class Placement {
   }
 
   Plant& plant_;
-  const Fallbacks fallbacks_;
+  const Candidates candidates_;
   const OrganShapes shapes_;
   const Branches branches_;
   const Neighbours neighbours_;
@@ -582,7 +623,12 @@ class Placement {
 }  // namespace
 
 PlacementCounts place_organs(Plant& plant, const OrganOptions& opt, const OrganShape* custom_leaf) {
-  if (opt.placement != "avoid") return {plant.organs.size(), 0, 0};
+  if (opt.placement != "avoid") {
+    PlacementCounts c;
+    c.placed = plant.organs.size();
+    for (const Organ& o : plant.organs) ++c.by_kind[static_cast<std::size_t>(o.kind)].placed;
+    return c;
+  }
   return Placement(plant, opt, custom_leaf).run();
 }
 

@@ -1,6 +1,7 @@
 // The organ pass after growth (options.hpp): variation, then placement. Shared by every algorithm.
 #pragma once
 
+#include <array>
 #include <cstdint>
 
 #include "algorithms/plant.hpp"
@@ -11,8 +12,12 @@ namespace growbench {
 
 struct PlacementCounts {
   std::uint64_t placed = 0;       // as grown (after variation)
-  std::uint64_t fallen_back = 0;  // placed as their fallback
-  std::uint64_t dropped = 0;      // neither fitted
+  std::uint64_t fallen_back = 0;  // placed turned, smaller or as their fallback
+  std::uint64_t dropped = 0;      // no candidate fitted
+  struct Kind {
+    std::uint64_t placed = 0, fallen_back = 0, dropped = 0;
+  };
+  std::array<Kind, 4> by_kind{};  // by OrganKind (the kind as grown)
 };
 
 // Scales, turns and tints each organ by counter-based draws from `seed` and its index (the same plant
@@ -20,9 +25,11 @@ struct PlacementCounts {
 void vary_organs(Plant& plant, const OrganOptions& options, std::uint64_t seed);
 
 // With placement=avoid: visits the organs in the plant's order and keeps each whose oriented box meets
-// no branch segment's capsule other than its own stem (the segments ending or starting at its node) and
-// whose triangles meet those of no organ kept before it (geom::triangles_overlap, the leaf_overlap
-// metric's test, after the boxes); otherwise its fallback under the same test; otherwise it is dropped.
+// no branch segment's capsule other than its own stem (the chain of segments from the branch point its
+// node hangs from, and those starting at its node) and whose triangles meet those of no organ kept before
+// it (geom::triangles_overlap, the leaf_overlap metric's test, after the boxes); otherwise the first of
+// its candidates that passes the same test (turned by +-turn_deg, at `shrink` of its size, its fallback);
+// otherwise it is dropped.
 // A k-d tree finds each organ's earlier neighbours in parallel; each organ is then decided, in parallel
 // with others, once its earlier neighbours are, testing only against the candidates they took. The
 // result is the in-order visit's, the same for any thread count. With placement=free, only counts.

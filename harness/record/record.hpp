@@ -329,15 +329,30 @@ struct Media {
 };
 
 // The organ pass after growth (harness/organs/): its settings and what placement did.
+// What the organ pass did with the organs of one kind, or with all of them.
+struct OrganCounts {
+  std::uint64_t placed = 0, fallen_back = 0, dropped = 0;  // as grown; turned, smaller or as a fallback; left out
+  friend bool operator==(const OrganCounts&, const OrganCounts&) = default;
+
+  static constexpr std::string_view kSchemaName = "organ_counts";
+  static constexpr auto fields() {
+    using O = OrganCounts;
+    return std::tuple{field("placed", &O::placed), field("fallen_back", &O::fallen_back),
+                      field("dropped", &O::dropped)};
+  }
+};
+
 struct OrganPassRecord {
   nlohmann::json options = nlohmann::json::object();  // every organ option with its effective value
   std::uint64_t placed = 0, fallen_back = 0, dropped = 0;
+  std::map<std::string, OrganCounts> by_kind;  // by organ kind as grown (leaf, flower, ...): the kinds the plant has
 
   static constexpr std::string_view kSchemaName = "organ_pass";
   static constexpr auto fields() {
     using O = OrganPassRecord;
     return std::tuple{field("options", &O::options).with(kNoCsv), field("placed", &O::placed),
-                      field("fallen_back", &O::fallen_back), field("dropped", &O::dropped)};
+                      field("fallen_back", &O::fallen_back), field("dropped", &O::dropped),
+                      field("by_kind", &O::by_kind).with(kNoCsv)};
   }
 };
 

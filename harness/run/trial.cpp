@@ -559,6 +559,11 @@ void organ_pass(const TrialSpec& spec, const OrganOptions& options, const Params
     out.placed = c.placed;
     out.fallen_back = c.fallen_back;
     out.dropped = c.dropped;
+    for (std::size_t k = 0; k < c.by_kind.size(); ++k) {
+      const auto& n = c.by_kind[k];
+      if (n.placed + n.fallen_back + n.dropped > 0)
+        out.by_kind[to_string(static_cast<OrganKind>(k))] = {n.placed, n.fallen_back, n.dropped};
+    }
   });
   rec.results.organs = std::move(out);
 }

@@ -281,7 +281,8 @@ TEST(Record, SchemaFileIsGenerated) {
   // The writer and the schema agree field for field: every key a full record writes is a property.
   const json defs = results_schema()["$defs"];
   ResultsFile r = small_results();
-  r.trials[0].results.plant->organs = OrganPassRecord{json{{"placement", "avoid"}}, 3, 1, 2};
+  r.trials[0].results.plant->organs =
+      OrganPassRecord{json{{"placement", "avoid"}}, 3, 1, 2, {{"leaf", {2, 1, 0}}, {"flower", {1, 0, 2}}}};
   const json cell = to_json(r)["trials"][0];
   for (const auto& [k, v] : cell.items()) EXPECT_TRUE(defs["cell"]["properties"].contains(k)) << k;
   // What only ok cells carry is required of them, and of no other.
@@ -322,7 +323,7 @@ TEST(Record, ABaselineCellIsItsCellsFieldsOfTheSameKeys) {
 // left out).
 TEST(Record, TakingACellsResultsTakesEveryField) {
   CellResults from = small_results().trials[0].results;
-  from.plant->organs = OrganPassRecord{json{{"placement", "avoid"}}, 231, 4, 5};
+  from.plant->organs = OrganPassRecord{json{{"placement", "avoid"}}, 231, 4, 5, {{"leaf", {231, 4, 5}}}};
   from.instructions.emplace()[Phase::growth] = 12345;
   CellResults to;
   take_present(to, from);
