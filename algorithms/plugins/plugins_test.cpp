@@ -473,8 +473,11 @@ TEST(CPlugin, ASuiteTimeLimitCancelsACooperativePluginAndKeepsItsPlant) {
     EXPECT_EQ(c.status, "ok") << c.label;
     ASSERT_TRUE(c.results.plant.has_value()) << c.label;
     EXPECT_EQ(c.results.plant->stopped_by, "time_limit") << c.label;
-    // The first step waited for the cancellation and then grew: a seed node and one more per seed.
-    EXPECT_EQ(c.results.plant->counts.nodes, 2 * wall.seeds.size()) << c.label;
+    // The first step waited for the cancellation and then grew, a seed node and one more per seed, and no
+    // step followed it; where start() itself outlasted the limit (a loaded or instrumented machine), no step ran.
+    EXPECT_LE(c.results.plant->counts.nodes, 2 * wall.seeds.size()) << c.label;
+    EXPECT_GE(c.results.plant->counts.nodes, wall.seeds.size()) << c.label;
+    EXPECT_LE(c.results.plant->steps, 1) << c.label;
     ASSERT_TRUE(c.samples.at(0).phases.has_value()) << c.label;
     const double growth = (*c.samples.at(0).phases)[Phase::growth].value().wall_s;
     const double limit = c.label == "own" ? 0.2 : 0.4;
