@@ -47,6 +47,53 @@ glm::vec3 closest_point_on_triangle(const glm::vec3& p, const glm::vec3& a, cons
   return closest_feature(p, a, b, c).first;
 }
 
+float segment_distance(const glm::vec3& p1, const glm::vec3& q1, const glm::vec3& p2, const glm::vec3& q2) {
+  const glm::vec3 d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
+  const float a = glm::dot(d1, d1), e = glm::dot(d2, d2), f = glm::dot(d2, r);
+  float s = 0.0f, t = 0.0f;
+  constexpr float eps = 1e-12f;
+  if (a <= eps && e <= eps) return glm::length(r);
+  if (a <= eps) {
+    t = std::clamp(f / e, 0.0f, 1.0f);
+  } else {
+    const float c = glm::dot(d1, r);
+    if (e <= eps) {
+      s = std::clamp(-c / a, 0.0f, 1.0f);
+    } else {
+      const float b = glm::dot(d1, d2), denom = a * e - b * b;
+      s = denom > eps ? std::clamp((b * f - c * e) / denom, 0.0f, 1.0f) : 0.0f;
+      t = (b * s + f) / e;
+      if (t < 0.0f) {
+        t = 0.0f;
+        s = std::clamp(-c / a, 0.0f, 1.0f);
+      } else if (t > 1.0f) {
+        t = 1.0f;
+        s = std::clamp((b - c) / a, 0.0f, 1.0f);
+      }
+    }
+  }
+  return glm::length((p1 + d1 * s) - (p2 + d2 * t));
+}
+
+float segment_triangle_distance(const glm::vec3& p, const glm::vec3& q, const glm::vec3 (&t)[3]) {
+  // Where the segment crosses the triangle's plane, the crossing in the triangle (by the signs of the
+  // sub-triangles' normals against the plane's) is a meeting.
+  const glm::vec3 n = glm::cross(t[1] - t[0], t[2] - t[0]);
+  const float dp = glm::dot(n, p - t[0]), dq = glm::dot(n, q - t[0]);
+  if ((dp <= 0.0f && dq >= 0.0f) || (dp >= 0.0f && dq <= 0.0f)) {
+    if (dp != dq) {
+      const glm::vec3 x = p + (dp / (dp - dq)) * (q - p);
+      bool inside = glm::dot(n, n) > 0.0f;
+      for (int k = 0; k < 3 && inside; ++k) inside = glm::dot(n, glm::cross(t[(k + 1) % 3] - t[k], x - t[k])) >= 0.0f;
+      if (inside) return 0.0f;
+    }
+  }
+  float d = std::min(glm::length(p - closest_point_on_triangle(p, t[0], t[1], t[2])),
+                     glm::length(q - closest_point_on_triangle(q, t[0], t[1], t[2])));
+  for (int k = 0; k < 3; ++k) d = std::min(d, segment_distance(p, q, t[k], t[(k + 1) % 3]));
+  return d;
+}
+
 namespace {
 
 // The interval that triangle t covers on the line (point o, direction d) where its plane meets the

@@ -13,6 +13,14 @@ namespace growbench::geom {
 // Closest point on triangle (a, b, c) to p (Ericson, Real-Time Collision Detection, 5.1.5).
 glm::vec3 closest_point_on_triangle(const glm::vec3& p, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c);
 
+// Distance between segments [p0,p1] and [q0,q1] (Ericson 5.1.9).
+float segment_distance(const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& q0, const glm::vec3& q1);
+
+// Distance between segment [p,q] and triangle t: zero where the segment passes through the triangle;
+// otherwise the least of its ends' distances to the triangle and its distances to the triangle's edges,
+// where a segment and a triangle that do not meet come closest.
+float segment_triangle_distance(const glm::vec3& p, const glm::vec3& q, const glm::vec3 (&t)[3]);
+
 // The same in double precision, with the feature the point lies on: a vertex, the interior of an edge,
 // or the face. The feature picks the pseudonormal that decides the side of p (SceneQuery's exact inside
 // test); double precision keeps the point exact to far below a float's rounding even on long slivers,

@@ -22,7 +22,7 @@ const std::vector<ParamSpec>& organ_param_specs() {
           .range(0, 90)
           .unit("deg")
           .doc("under avoid, an organ that does not fit first tries itself turned by +-turn_deg about its two cross "
-               "axes at its attachment point (0: no turns)"),
+               "axes at its attachment point, then pointed along its stem and so turned (0: none of these)"),
       param::real("shrink", 0.7)
           .range(0.1, 1)
           .doc("under avoid, it then tries itself at this fraction of its size, before its fallback (1: no shrink)"),

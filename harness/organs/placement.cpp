@@ -8,6 +8,8 @@
 #include <span>
 
 #include <glm/gtc/quaternion.hpp>
+#define GLM_ENABLE_EXPERIMENTAL  // glm::rotation (the least rotation between two vectors)
+#include <glm/gtx/quaternion.hpp>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_for_each.h>
@@ -183,6 +185,19 @@ class ShapeTests {
     return false;
   }
 
+  // Whether the tried candidate's shape meets the capsule of radius r about the segment (p, q): one of
+  // its triangles comes closer than r to the segment.
+  bool meets_capsule(const glm::vec3& p, const glm::vec3& q, float r) {
+    place_tried();
+    Aabb capsule;
+    capsule.extend(glm::min(p, q) - r);
+    capsule.extend(glm::max(p, q) + r);
+    if (disjoint(capsule, tried_all_)) return false;
+    for (const Tri& t : tri_)
+      if (!disjoint(t.box, capsule) && geom::segment_triangle_distance(p, q, t.v) < r) return true;
+    return false;
+  }
+
  private:
   static constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
   struct Tri {
@@ -264,28 +279,59 @@ class Branches {
   Branches(const Branches&) = delete;  // the tree refers to cloud_
   Branches& operator=(const Branches&) = delete;
 
-  // Whether the segment ending at node c is on the stem of an organ at node `own`: on own's chain, at or
-  // above it, or the segment starting at own.
-  [[nodiscard]] bool on_stem(std::uint32_t c, std::int32_t own) const {
-    if (own == kNoParent) return false;
+  // The part of the segment ending at node c that may block an organ at node `own`, as the segment's
+  // parameters [t0, t1] (empty when t0 >= t1). None of its stem: own's chain, at or above it, and the segment
+  // starting at own. Of a segment of the joint own's chain leaves (ending or starting at its branch point),
+  // only what lies farther from the joint than own's node by more than the segment's radius: nearer, it is
+  // the collar the organ's stem leaves from, which holds the organ's base where its stem is shorter than
+  // the joint is thick.
+  [[nodiscard]] std::pair<float, float> blocking_part(std::uint32_t c, std::int32_t own) const {
+    if (own == kNoParent) return {0.0f, 1.0f};
     const auto o = static_cast<std::size_t>(own);
-    return nodes_[c].parent == own || (chain_[c] == chain_[o] && depth_[c] <= depth_[o]);
+    if (nodes_[c].parent == own || (chain_[c] == chain_[o] && depth_[c] <= depth_[o])) return {1.0f, 0.0f};
+    const std::int32_t joint = nodes_[chain_[o]].parent;
+    const bool starts = joint != kNoParent && nodes_[c].parent == joint;
+    if (!starts && (joint == kNoParent || static_cast<std::int32_t>(c) != joint)) return {0.0f, 1.0f};
+    const glm::vec3 j = nodes_[static_cast<std::size_t>(joint)].position;
+    const float len = glm::length(nodes_[c].position - nodes_[static_cast<std::size_t>(nodes_[c].parent)].position);
+    const float r = std::max({nodes_[c].radius, nodes_[static_cast<std::size_t>(nodes_[c].parent)].radius, 1e-4f});
+    const float collar = len > 0.0f ? (glm::length(nodes_[o].position - j) + r) / len : 1.0f;
+    return starts ? std::pair{collar, 1.0f} : std::pair{0.0f, 1.0f - collar};
   }
 
-  // Whether a segment other than those of its stem (on_stem) meets the box of an organ at node `own`.
-  [[nodiscard]] bool block(const Probe& c, std::int32_t own) const {
+  // The organ's orientation turned (by the least rotation) so that its axis, its local +Z, points from the
+  // joint its stem leaves (or its chain's root) to its node; unchanged for an organ on no node, or at its
+  // joint.
+  [[nodiscard]] glm::quat along_stem(const Organ& o) const {
+    if (o.node == kNoParent) return o.orientation;
+    const auto n = static_cast<std::size_t>(o.node);
+    const std::int32_t joint = nodes_[chain_[n]].parent;
+    const glm::vec3 from = nodes_[joint == kNoParent ? chain_[n] : static_cast<std::size_t>(joint)].position;
+    const glm::vec3 d = nodes_[n].position - from;
+    const float len = glm::length(d);
+    if (!(len > 1e-6f * std::max(1.0f, glm::length(from)))) return o.orientation;
+    const glm::vec3 axis = glm::normalize(o.orientation * glm::vec3(0, 0, 1));
+    return glm::rotation(axis, d / len) * o.orientation;
+  }
+
+  // Whether a segment's blocking part (blocking_part) meets the shape of the candidate `tests`
+  // tries, an organ at node `own`: its capsule meets the candidate's box, then its triangles.
+  [[nodiscard]] bool block(const Probe& c, std::int32_t own, ShapeTests& tests) const {
     if (!tree_) return false;
     bool blocked = false;
-    kd_visit_within(*tree_, glm::vec3(c.box.centre), static_cast<float>((c.reach + reach_) * (1.0 + 1e-6)),
-                    [&](std::uint32_t s, float) {
-                      const std::uint32_t ci = child_[s];
-                      const auto& n = nodes_[ci];
-                      if (on_stem(ci, own)) return true;
-                      const auto& p = nodes_[static_cast<std::size_t>(n.parent)];
-                      const double r = std::max({p.radius, n.radius, 1e-4f});
-                      blocked = capsule_meets_box(glm::dvec3(p.position), glm::dvec3(n.position), r, c.box);
-                      return !blocked;
-                    });
+    kd_visit_within(
+        *tree_, glm::vec3(c.box.centre), static_cast<float>((c.reach + reach_) * (1.0 + 1e-6)),
+        [&](std::uint32_t s, float) {
+          const std::uint32_t ci = child_[s];
+          const auto& n = nodes_[ci];
+          const auto [t0, t1] = blocking_part(ci, own);
+          if (!(t0 < t1)) return true;
+          const auto& p = nodes_[static_cast<std::size_t>(n.parent)];
+          const float r = std::max({p.radius, n.radius, 1e-4f});
+          const glm::vec3 a = glm::mix(p.position, n.position, t0), b = glm::mix(p.position, n.position, t1);
+          blocked = capsule_meets_box(glm::dvec3(a), glm::dvec3(b), r, c.box) && tests.meets_capsule(a, b, r);
+          return !blocked;
+        });
     return blocked;
   }
 
@@ -393,18 +439,24 @@ namespace {
 constexpr std::uint8_t kGrown = 0, kDropped = 0xFF;
 
 // An organ's candidates, in the order they are tried: as grown; turned about its attachment point by
-// +-turn_deg about its two cross axes (a blossom tipped off a neighbour, a leaf lifted off a branch); at
-// `shrink` of its size; its kind's fallback. The turns and the shrink keep the organ what it is, so they
-// come before the fallback, which changes it.
+// +-turn_deg about its two cross axes (a blossom tipped off a neighbour, a leaf lifted off a branch);
+// pointed along its stem, away from the joint it leaves (the organs of one cluster fanned out, as a
+// cluster's pedicels hold them, where gravity hung them together), then so and turned as before; at
+// `shrink` of its size; its kind's fallback. The turns and the shrink keep the organ what it is, so they come before
+// the fallback, which changes it.
 class Candidates {
  public:
-  Candidates(Plant& plant, const OrganOptions& opt) : fallbacks_(plant, opt) {
+  Candidates(Plant& plant, const OrganOptions& opt, const Branches& branches)
+      : fallbacks_(plant, opt), branches_(branches) {
     if (opt.turn_deg > 0.0) {
       const auto a = static_cast<float>(glm::radians(opt.turn_deg));
       for (const glm::vec3 axis : {glm::vec3(1, 0, 0), glm::vec3(0, 1, 0)})
-        for (const float sign : {1.0f, -1.0f}) own_.push_back({glm::angleAxis(sign * a, axis), 1.0f});
+        for (const float sign : {1.0f, -1.0f}) own_.push_back({glm::angleAxis(sign * a, axis), 1.0f, false});
+      own_.push_back({glm::quat(1, 0, 0, 0), 1.0f, true});
+      for (const glm::vec3 axis : {glm::vec3(1, 0, 0), glm::vec3(0, 1, 0)})
+        for (const float sign : {1.0f, -1.0f}) own_.push_back({glm::angleAxis(sign * a, axis), 1.0f, true});
     }
-    if (opt.shrink < 1.0) own_.push_back({glm::quat(1, 0, 0, 0), opt.shrink});
+    if (opt.shrink < 1.0) own_.push_back({glm::quat(1, 0, 0, 0), opt.shrink, false});
   }
 
   [[nodiscard]] std::uint8_t count(OrganKind kind) const {
@@ -415,6 +467,7 @@ class Candidates {
     if (v == kGrown) return o;
     if (v <= own_.size()) {
       const Own& c = own_[v - 1];
+      if (c.along) o.orientation = branches_.along_stem(o);
       o.orientation = glm::normalize(o.orientation * c.turn);
       o.size = static_cast<float>(o.size * c.scale);
       return o;
@@ -426,8 +479,10 @@ class Candidates {
   struct Own {
     glm::quat turn;
     double scale;
+    bool along;  // first pointed along its stem
   };
   const Fallbacks fallbacks_;
+  const Branches& branches_;
   std::vector<Own> own_;
 };
 
@@ -505,7 +560,7 @@ class Neighbours {
 class Placement {
  public:
   Placement(Plant& p, const OrganOptions& o, const OrganShape* custom)
-      : plant_(p), candidates_(p, o), shapes_(p, custom), branches_(p.nodes), neighbours_(reach()) {}
+      : plant_(p), branches_(p.nodes), candidates_(p, o, branches_), shapes_(p, custom), neighbours_(reach()) {}
 
   PlacementCounts run() {
     const std::size_t n = plant_.organs.size();
@@ -597,8 +652,8 @@ class Placement {
     for (std::uint8_t v = 0; v < variants; ++v) {
       const Organ o = as(p, v);
       const Probe box = probe(o);
-      if (branches_.block(box, o.node)) continue;
       tests.begin(o, shapes_.of(o));
+      if (branches_.block(box, o.node, tests)) continue;
       bool meets = false;
       for (const std::uint32_t q : neighbours_.of(p)) {
         if (decision[q] == kDropped) continue;
@@ -613,9 +668,9 @@ class Placement {
   }
 
   Plant& plant_;
+  const Branches branches_;
   const Candidates candidates_;
   const OrganShapes shapes_;
-  const Branches branches_;
   const Neighbours neighbours_;
   std::vector<Organ> organs_;  // by place in the neighbours' tree: organs near in space, near in memory
 };

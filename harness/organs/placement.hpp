@@ -24,12 +24,13 @@ struct PlacementCounts {
 // for any thread count), and alternates blooms when asked. Adds to plant.organ_shapes what it uses.
 void vary_organs(Plant& plant, const OrganOptions& options, std::uint64_t seed);
 
-// With placement=avoid: visits the organs in the plant's order and keeps each whose oriented box meets
-// no branch segment's capsule other than its own stem (the chain of segments from the branch point its
-// node hangs from, and those starting at its node) and whose triangles meet those of no organ kept before
-// it (geom::triangles_overlap, the leaf_overlap metric's test, after the boxes); otherwise the first of
-// its candidates that passes the same test (turned by +-turn_deg, at `shrink` of its size, its fallback);
-// otherwise it is dropped.
+// With placement=avoid: visits the organs in the plant's order and keeps each whose triangles come within
+// no branch segment's radius but its stem's (the chain of segments from the branch point its node hangs
+// from, those starting at its node, and the joint's collar: the part of the branch point's other segments
+// no farther from it than the organ's node and their radius) and meet those of no organ kept before it
+// (geom::triangles_overlap, the leaf_overlap metric's test, after oriented boxes); otherwise the first of
+// its candidates that passes the same test (turned by +-turn_deg, pointed along its stem and so turned,
+// at `shrink` of its size, its fallback); otherwise it is dropped.
 // A k-d tree finds each organ's earlier neighbours in parallel; each organ is then decided, in parallel
 // with others, once its earlier neighbours are, testing only against the candidates they took. The
 // result is the in-order visit's, the same for any thread count. With placement=free, only counts.

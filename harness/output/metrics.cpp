@@ -50,34 +50,6 @@ glm::vec3 leaf_normal(const Organ& leaf) {
   return glm::mat3_cast(leaf.orientation)[1];
 }
 
-float segment_distance(const glm::vec3& p1, const glm::vec3& q1, const glm::vec3& p2, const glm::vec3& q2) {
-  const glm::vec3 d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
-  const float a = glm::dot(d1, d1), e = glm::dot(d2, d2), f = glm::dot(d2, r);
-  float s = 0.0f, t = 0.0f;
-  constexpr float eps = 1e-12f;
-  if (a <= eps && e <= eps) return glm::length(r);
-  if (a <= eps) {
-    t = std::clamp(f / e, 0.0f, 1.0f);
-  } else {
-    const float c = glm::dot(d1, r);
-    if (e <= eps) {
-      s = std::clamp(-c / a, 0.0f, 1.0f);
-    } else {
-      const float b = glm::dot(d1, d2), denom = a * e - b * b;
-      s = denom > eps ? std::clamp((b * f - c * e) / denom, 0.0f, 1.0f) : 0.0f;
-      t = (b * s + f) / e;
-      if (t < 0.0f) {
-        t = 0.0f;
-        s = std::clamp(-c / a, 0.0f, 1.0f);
-      } else if (t > 1.0f) {
-        t = 1.0f;
-        s = std::clamp((b - c) / a, 0.0f, 1.0f);
-      }
-    }
-  }
-  return glm::length((p1 + d1 * s) - (p2 + d2 * t));
-}
-
 namespace {
 
 // One pass of compute_metrics, a method per metric family; what several families share (the segments,
@@ -299,8 +271,8 @@ class MetricsPass {
         if (!judged_from(k, l) || d2 > reach_sum * reach_sum) return true;
         const Ends& el = ends(l);
         // Always the lower node index first, so a pair's verdict does not depend on the side judging it.
-        const float d =
-            seg[k] < seg[l] ? segment_distance(ek.a, ek.b, el.a, el.b) : segment_distance(el.a, el.b, ek.a, ek.b);
+        const float d = seg[k] < seg[l] ? geom::segment_distance(ek.a, ek.b, el.a, el.b)
+                                        : geom::segment_distance(el.a, el.b, ek.a, ek.b);
         if (d < ek.radius + el.radius && !neighbours(seg[k], seg[l])) {
           involved[k].store(1, std::memory_order_relaxed);
           involved[l].store(1, std::memory_order_relaxed);

@@ -64,7 +64,4 @@ glm::vec3 leaf_centre(const Organ& leaf);
 glm::vec3 leaf_normal(const Organ& leaf);
 bool is_leaf(const Organ& organ);
 
-// Distance between segments [p0,p1] and [q0,q1] (Ericson 5.1.9).
-float segment_distance(const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& q0, const glm::vec3& q1);
-
 }  // namespace growbench

@@ -32,11 +32,26 @@ Plant chain(std::vector<glm::vec3> pts, float radius = 0.01f) {
 }
 
 TEST(Metrics, SegmentDistance) {
-  EXPECT_NEAR(segment_distance({0, 0, 0}, {1, 0, 0}, {0.5f, 1, -1}, {0.5f, 1, 1}), 1.0f,
+  EXPECT_NEAR(geom::segment_distance({0, 0, 0}, {1, 0, 0}, {0.5f, 1, -1}, {0.5f, 1, 1}), 1.0f,
               1e-6f);                                                                            // skew, crossing above
-  EXPECT_NEAR(segment_distance({0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0}), 1.0f, 1e-6f);        // collinear gap
-  EXPECT_NEAR(segment_distance({0, 0, 0}, {1, 0, 0}, {0, 0.5f, 0}, {1, 0.5f, 0}), 0.5f, 1e-6f);  // parallel
-  EXPECT_NEAR(segment_distance({0, 0, 0}, {0, 0, 0}, {1, 1, 0}, {1, 1, 0}), std::sqrt(2.0f), 1e-6f);
+  EXPECT_NEAR(geom::segment_distance({0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0}), 1.0f, 1e-6f);  // collinear gap
+  EXPECT_NEAR(geom::segment_distance({0, 0, 0}, {1, 0, 0}, {0, 0.5f, 0}, {1, 0.5f, 0}), 0.5f, 1e-6f);  // parallel
+  EXPECT_NEAR(geom::segment_distance({0, 0, 0}, {0, 0, 0}, {1, 1, 0}, {1, 1, 0}), std::sqrt(2.0f), 1e-6f);
+}
+
+// Known distances from segments to the triangle (0,0,0), (1,0,0), (0,1,0) in z = 0.
+TEST(Geometry, SegmentTriangleDistance) {
+  const glm::vec3 t[3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  EXPECT_FLOAT_EQ(geom::segment_triangle_distance({0.2f, 0.2f, -1}, {0.2f, 0.2f, 1}, t), 0.0f);  // through the face
+  EXPECT_NEAR(geom::segment_triangle_distance({0.2f, 0.2f, 0.5f}, {0.3f, 0.3f, 2}, t), 0.5f, 1e-6f);  // end above
+  // Across the plane beside the triangle, parallel to its hypotenuse at 0.5 / sqrt(2) beyond it.
+  EXPECT_NEAR(geom::segment_triangle_distance({1.5f, 0, -1}, {0, 1.5f, 1}, t), 0.5f / std::sqrt(2.0f), 1e-6f);
+  // Skew over the edge x = 0: the edge is closest, at height 0.3 and 0.2 outside.
+  EXPECT_NEAR(geom::segment_triangle_distance({-0.2f, -1, 0.3f}, {-0.2f, 2, 0.3f}, t), std::sqrt(0.13f), 1e-6f);
+  // In the triangle's plane, outside it: its nearer end to the vertex (1, 0, 0).
+  EXPECT_NEAR(geom::segment_triangle_distance({2, 0, 0}, {3, 0, 0}, t), 1.0f, 1e-6f);
+  // In its plane, crossing it: zero.
+  EXPECT_FLOAT_EQ(geom::segment_triangle_distance({-1, 0.25f, 0}, {2, 0.25f, 0}, t), 0.0f);
 }
 
 TEST(Metrics, CountsLengthOrderDepthBox) {
@@ -143,8 +158,8 @@ TEST(Metrics, SelfIntersectionAndLeafOverlapMatchAllPairs) {
       if (neighbours(k, l)) continue;
       const auto& a = n[static_cast<std::size_t>(k)];
       const auto& b = n[static_cast<std::size_t>(l)];
-      const float d = segment_distance(n[static_cast<std::size_t>(a.parent)].position, a.position,
-                                       n[static_cast<std::size_t>(b.parent)].position, b.position);
+      const float d = geom::segment_distance(n[static_cast<std::size_t>(a.parent)].position, a.position,
+                                             n[static_cast<std::size_t>(b.parent)].position, b.position);
       if (d < a.radius + b.radius) {
         ++pairs;
         involved[static_cast<std::size_t>(k)] = involved[static_cast<std::size_t>(l)] = 1;

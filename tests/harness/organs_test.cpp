@@ -4,9 +4,10 @@
 #include <memory>
 #include <numbers>
 #include <optional>
-#include <set>
 
 #include <glm/gtc/quaternion.hpp>
+#define GLM_ENABLE_EXPERIMENTAL  // glm::rotation
+#include <glm/gtx/quaternion.hpp>
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
@@ -174,13 +175,15 @@ TEST(OrganPlacement, AFlowerThroughABranchFallsBackToABud) {
   Plant none;
   none.nodes = p.nodes;
   none.organs.push_back(organ_at({0, 0, 0}, 1.0f, OrganKind::Flower));
-  EXPECT_EQ(place_organs(none, options({"placement=avoid", "fallback_flower=none"})).dropped, 1u);
+  EXPECT_EQ(place_organs(none, options({"placement=avoid", "fallback_flower=none", "turn_deg=0", "shrink=1"})).dropped,
+            1u);
 }
 
 // An organ's stem is the chain of segments from its branch point, not only the last one: a blossom on a
 // 0.01 pedicel after a 0.3 stem of thickness 0.03 (F(0.3)F(0.01)J) sits inside the stem's first capsule,
 // which holds it; it was dropped while only the last segment counted as its stem. A branch from the
-// branch point is not its stem, and still blocks it.
+// branch point is not its stem: beyond the collar (as far from the joint as the blossom's node), it
+// still blocks it.
 TEST(OrganPlacement, AnOrgansStemIsItsChainFromTheBranchPoint) {
   const glm::quat up = glm::angleAxis(-0.5f * std::numbers::pi_v<float>, glm::vec3(1, 0, 0));  // +Z to +Y
   Plant p;
@@ -245,10 +248,140 @@ TEST(OrganPlacement, KeptOrgansNeverMeetAndTheResultIsTheSameForAnyThreadCount) 
   EXPECT_GT(before, 50u);
 }
 
+// The distance from a segment to a triangle, by ternary search along the segment (the distance to a
+// convex set is convex along a line), apart from geom::segment_triangle_distance's closed form.
+double reference_segment_triangle(const glm::vec3& a, const glm::vec3& b, const glm::vec3 (&t)[3]) {
+  auto f = [&](double s) {
+    const glm::dvec3 x = glm::dvec3(a) + s * (glm::dvec3(b) - glm::dvec3(a));
+    return glm::length(
+        x - geom::closest_feature_on_triangle(x, glm::dvec3(t[0]), glm::dvec3(t[1]), glm::dvec3(t[2])).point);
+  };
+  double lo = 0.0, hi = 1.0;
+  for (int k = 0; k < 60; ++k) {
+    const double m1 = lo + (hi - lo) / 3.0, m2 = hi - (hi - lo) / 3.0;
+    if (f(m1) < f(m2))
+      hi = m2;
+    else
+      lo = m1;
+  }
+  return std::min({f(0.0), f(1.0), f(0.5 * (lo + hi))});
+}
+
+float point_to_segment(const glm::vec3& x, const glm::vec3& a, const glm::vec3& b) {
+  const glm::vec3 ab = b - a;
+  const float l2 = glm::dot(ab, ab);
+  const float t = l2 > 0.0f ? std::clamp(glm::dot(x - a, ab) / l2, 0.0f, 1.0f) : 0.0f;
+  return glm::length(x - (a + t * ab));
+}
+
+// The branches as the definition reads them, each walk done again for every question.
+struct ReferenceBranches {
+  const Plant& p;
+
+  [[nodiscard]] const PlantNode& node(std::int32_t i) const { return p.nodes[static_cast<std::size_t>(i)]; }
+  [[nodiscard]] long children(std::int32_t up) const {
+    return std::count_if(p.nodes.begin(), p.nodes.end(), [&](const auto& n) { return n.parent == up; });
+  }
+  // The joint the chain through node `own` leaves (its first branch point above), or kNoParent, and the
+  // chain's first node.
+  [[nodiscard]] std::pair<std::int32_t, std::int32_t> joint_of(std::int32_t own) const {
+    std::int32_t x = own;
+    while (node(x).parent != kNoParent && children(node(x).parent) == 1) x = node(x).parent;
+    return {node(x).parent, x};
+  }
+  // The part [t0, t1] of the segment ending at node c that may block an organ at node `own`: none of the
+  // segments from own up to its joint, or of those starting at own; of a segment ending or starting at the
+  // joint, what lies farther from the joint than own's node by more than the segment's radius.
+  [[nodiscard]] std::pair<float, float> blocking_part(std::int32_t c, std::int32_t own) const {
+    if (own == kNoParent) return {0.0f, 1.0f};
+    const std::int32_t joint = joint_of(own).first, up = node(c).parent;
+    for (std::int32_t x = own; x != joint; x = node(x).parent)
+      if (x == c) return {1.0f, 0.0f};
+    if (up == own) return {1.0f, 0.0f};
+    if (joint == kNoParent || (up != joint && c != joint)) return {0.0f, 1.0f};
+    const float len = glm::length(node(c).position - node(up).position);
+    const float r = std::max({node(up).radius, node(c).radius, 1e-4f});
+    const float collar = len > 0.0f ? (glm::length(node(own).position - node(joint).position) + r) / len : 1.0f;
+    return up == joint ? std::pair{collar, 1.0f} : std::pair{0.0f, 1.0f - collar};
+  }
+  // Whether a triangle of the organ comes within a segment's radius of its blocking part.
+  [[nodiscard]] bool block(const Organ& o, const OrganShape& shape) const {
+    for (std::int32_t c = 0; c < static_cast<std::int32_t>(p.nodes.size()); ++c) {
+      if (node(c).parent == kNoParent) continue;
+      const auto [t0, t1] = blocking_part(c, o.node);
+      if (!(t0 < t1)) continue;
+      const PlantNode &q = node(node(c).parent), &n = node(c);
+      const float r = std::max({q.radius, n.radius, 1e-4f});
+      const glm::vec3 a = glm::mix(q.position, n.position, t0), b = glm::mix(q.position, n.position, t1);
+      for (const auto& t : shape.mesh.triangles) {
+        const glm::vec3 v[3] = {organ_point(o, shape.mesh.vertices[t.x]), organ_point(o, shape.mesh.vertices[t.y]),
+                                organ_point(o, shape.mesh.vertices[t.z])};
+        // A triangle within r of the segment has a vertex within r and its longest edge of it.
+        const float edge = std::max({glm::length(v[1] - v[0]), glm::length(v[2] - v[1]), glm::length(v[0] - v[2])});
+        if (std::min({point_to_segment(v[0], a, b), point_to_segment(v[1], a, b), point_to_segment(v[2], a, b)}) >
+            r + edge + 1e-5f)
+          continue;
+        if (reference_segment_triangle(a, b, v) < r) return true;
+      }
+    }
+    return false;
+  }
+  // The organ pointed from its joint (or its chain's first node) to its node.
+  [[nodiscard]] Organ along_stem(Organ o) const {
+    if (o.node == kNoParent) return o;
+    const auto [joint, first] = joint_of(o.node);
+    const glm::vec3 d = node(o.node).position - node(joint == kNoParent ? first : joint).position;
+    if (glm::length(d) < 1e-6f) return o;
+    const glm::vec3 axis = glm::mat3_cast(o.orientation)[2];
+    o.orientation = glm::normalize(glm::rotation(glm::normalize(axis), glm::normalize(d)) * o.orientation);
+    return o;
+  }
+};
+
+bool reference_triangles_meet(const OrganShapes& shapes, const Organ& a, const Organ& b) {
+  const auto &ma = shapes.of(a).mesh, &mb = shapes.of(b).mesh;
+  for (const auto& t : ma.triangles)
+    for (const auto& u : mb.triangles) {
+      const glm::vec3 ta[3] = {organ_point(a, ma.vertices[t.x]), organ_point(a, ma.vertices[t.y]),
+                               organ_point(a, ma.vertices[t.z])};
+      const glm::vec3 tb[3] = {organ_point(b, mb.vertices[u.x]), organ_point(b, mb.vertices[u.y]),
+                               organ_point(b, mb.vertices[u.z])};
+      if (geom::triangles_overlap(ta, tb)) return true;
+    }
+  return false;
+}
+
+// An organ's candidates in the order the definition tries them: as grown; turned by +-turn_deg about its
+// X, then its Y axis; pointed along its stem, then so and turned; at `shrink` of its size; its fallback.
+std::vector<Organ> reference_candidates(const Organ& grown, const OrganOptions& opt, const ReferenceBranches& b,
+                                        const std::optional<Organ>& fallback) {
+  std::vector<Organ> out{grown};
+  auto turned = [&](const Organ& from) {
+    for (const glm::vec3 axis : {glm::vec3(1, 0, 0), glm::vec3(0, 1, 0)})
+      for (const double deg : {opt.turn_deg, -opt.turn_deg}) {
+        Organ t = from;
+        t.orientation = glm::normalize(from.orientation * glm::angleAxis(static_cast<float>(glm::radians(deg)), axis));
+        out.push_back(t);
+      }
+  };
+  if (opt.turn_deg != 0.0) {
+    turned(grown);
+    out.push_back(b.along_stem(grown));
+    turned(out.back());
+  }
+  if (opt.shrink < 1.0) {
+    Organ s = grown;
+    s.size = static_cast<float>(s.size * opt.shrink);
+    out.push_back(s);
+  }
+  if (fallback) out.push_back(*fallback);
+  return out;
+}
+
 // The avoid placement by its definition, by brute force over every pair: each organ in order takes its
-// first candidate (as grown, then its fallback) whose box meets no branch segment's capsule but its
-// stem's (the chain from its branch point), and whose triangles meet those of no organ kept before it. `blocked` counts
-// the candidates a branch turned away.
+// first candidate (reference_candidates) whose triangles come within no branch segment's radius (but its
+// stem's, the chain from its joint, and the joint's segments' collar) and meet those of no organ kept
+// before it. `blocked` counts the candidates a branch turned away.
 PlacementCounts reference_placement(Plant& p, const OrganOptions& opt, std::size_t& blocked) {
   auto named = [&](const std::string& f) {
     const auto it = std::find(p.organ_shapes.begin(), p.organ_shapes.end(), f);
@@ -271,73 +404,21 @@ PlacementCounts reference_placement(Plant& p, const OrganOptions& opt, std::size
     if (f.rfind("bud", 0) == 0) o.kind = OrganKind::Bud;
     return o;
   };
-  // The stem of an organ at node `own`: the segments from own up to the branch point (or root) it hangs from,
-  // each named by its child node, and those starting at own.
-  auto stem = [&](std::int32_t own) {
-    std::set<std::int32_t> s;
-    for (std::int32_t x = own; x != kNoParent && p.nodes[static_cast<std::size_t>(x)].parent != kNoParent;) {
-      s.insert(x);
-      const std::int32_t up = p.nodes[static_cast<std::size_t>(x)].parent;
-      const auto siblings =
-          std::count_if(p.nodes.begin(), p.nodes.end(), [&](const auto& n) { return n.parent == up; });
-      x = siblings > 1 ? kNoParent : up;
-    }
-    return s;
-  };
-  auto branch_blocks = [&](const Organ& o) {
-    const OrientedBox box = organ_box(o, shapes.of(o));
-    const std::set<std::int32_t> own = stem(o.node);
-    for (std::size_t c = 0; c < p.nodes.size(); ++c) {
-      const auto& n = p.nodes[c];
-      if (n.parent == kNoParent || own.count(static_cast<std::int32_t>(c)) ||
-          (o.node != kNoParent && n.parent == o.node))
-        continue;
-      const auto& q = p.nodes[static_cast<std::size_t>(n.parent)];
-      if (capsule_meets_box(glm::dvec3(q.position), glm::dvec3(n.position), std::max({q.radius, n.radius, 1e-4f}), box))
-        return true;
-    }
-    return false;
-  };
-  auto triangles_meet = [&](const Organ& a, const Organ& b) {
-    const auto &ma = shapes.of(a).mesh, &mb = shapes.of(b).mesh;
-    for (const auto& t : ma.triangles)
-      for (const auto& u : mb.triangles) {
-        const glm::vec3 ta[3] = {organ_point(a, ma.vertices[t.x]), organ_point(a, ma.vertices[t.y]),
-                                 organ_point(a, ma.vertices[t.z])};
-        const glm::vec3 tb[3] = {organ_point(b, mb.vertices[u.x]), organ_point(b, mb.vertices[u.y]),
-                                 organ_point(b, mb.vertices[u.z])};
-        if (geom::triangles_overlap(ta, tb)) return true;
-      }
-    return false;
-  };
+  const ReferenceBranches branches{p};
   PlacementCounts counts;
   std::vector<Organ> kept;
   for (const Organ& grown : p.organs) {
-    std::vector<Organ> candidates{grown};
-    // turned by +-turn_deg about its X, then its Y axis; at `shrink` of its size; its fallback
-    for (const glm::vec3 axis : {glm::vec3(1, 0, 0), glm::vec3(0, 1, 0)})
-      for (const double deg : {opt.turn_deg, -opt.turn_deg}) {
-        if (opt.turn_deg == 0.0) continue;
-        Organ t = grown;
-        t.orientation = glm::normalize(grown.orientation * glm::angleAxis(static_cast<float>(glm::radians(deg)), axis));
-        candidates.push_back(t);
-      }
-    if (opt.shrink < 1.0) {
-      Organ s = grown;
-      s.size = static_cast<float>(s.size * opt.shrink);
-      candidates.push_back(s);
-    }
-    if (const auto f = fallback(grown)) candidates.push_back(*f);
+    const std::vector<Organ> candidates = reference_candidates(grown, opt, branches, fallback(grown));
     bool fitted = false;
     for (std::size_t v = 0; v < candidates.size() && !fitted; ++v) {
       const Organ& o = candidates[v];
-      if (branch_blocks(o)) {
+      if (branches.block(o, shapes.of(o))) {
         ++blocked;
         continue;
       }
       const OrientedBox box = organ_box(o, shapes.of(o));
       fitted = std::none_of(kept.begin(), kept.end(), [&](const Organ& k) {
-        return boxes_overlap(box, organ_box(k, shapes.of(k))) && triangles_meet(o, k);
+        return boxes_overlap(box, organ_box(k, shapes.of(k))) && reference_triangles_meet(shapes, o, k);
       });
       if (!fitted) continue;
       kept.push_back(o);
@@ -349,14 +430,19 @@ PlacementCounts reference_placement(Plant& p, const OrganOptions& opt, std::size
   return counts;
 }
 
-// Shoots of nodes wandering through a small cube, with leaves, young leaves, flowers and buds of sizes
-// a factor of six apart on the nodes and between them, so that organs meet each other and branches.
+// Shoots of nodes wandering through a small cube, half of them branching from the others, with leaves, young leaves,
+// flowers and buds of sizes a factor of six apart on the nodes and between them, so that organs meet each other and
+// branches.
 Plant cluster(std::size_t organs) {
   Plant p;
   Rng rng(5, 2);
   for (int s = 0; s < 8; ++s) {
     glm::vec3 at(rng.uniform(0, 0.5), rng.uniform(0, 0.5), rng.uniform(0, 0.5));
     std::int32_t parent = kNoParent;
+    if (s >= 4) {  // a branch from a node of an earlier shoot, which becomes a joint
+      parent = static_cast<std::int32_t>(rng.next_u64() % p.nodes.size());
+      at = p.nodes[static_cast<std::size_t>(parent)].position + 0.02f * rng.unit_vector();
+    }
     for (int k = 0; k < 12; ++k) {
       p.nodes.push_back(
           {at, static_cast<float>(rng.uniform(0.002, 0.01)), parent, 0, static_cast<std::uint32_t>(s), 0});
