@@ -188,7 +188,8 @@ bool Deriver::bind(const Rule& r, const LString& in, std::size_t m, std::size_t 
         c = symbol_of(w);
         off -= count_of(w);
         if (c == '[' || c == ']') {
-          if (flat || c == '[') {  // '[' leads from a branch into its parent
+          if (c == '[' && !flat && s_.left_in_branch) return false;  // the reference's reading: its branch ends
+          if (flat || c == '[') {                                    // '[' leads from a branch into its parent
             --pos;
             continue;
           }
@@ -340,7 +341,7 @@ int Deriver::choose(const LString& in, std::size_t m, std::size_t poff, double* 
       break;
     }
     double p = r.probability.eval(env, *s_.host);
-    if (p > 1.0) p *= 0.01;
+    if (s_.units == ProbabilityUnits::Percent || (s_.units == ProbabilityUnits::Auto && p > 1.0)) p *= 0.01;
     if (!(p > 0.0)) continue;
     if (s_.probability == ProbabilityMode::Sequential) {
       if (draw(s_.seed, s_.stream, generation, m, ri) < p) return ri;

@@ -29,6 +29,9 @@
 namespace growbench::lsys {
 
 enum class ProbabilityMode { Sequential, Normalized };
+// How a rule's probability reads: Auto, a fraction up to 1 and a percentage above it; Fraction, 0 to 1
+// (1 or more: always); Percent, 0 to 100.
+enum class ProbabilityUnits { Auto, Fraction, Percent };
 
 // The turtle's state at a module, for rules whose conditions or arguments read x y z A L W U V.
 struct TurtleVars {
@@ -42,8 +45,10 @@ struct DeriveSettings {
   std::uint64_t seed;
   std::uint64_t stream;  // e.g. the plant (scene seed) index
   ProbabilityMode probability;
+  ProbabilityUnits units;
   bool brackets_transparent;  // [ or ] in the ignore list: contexts are matched on the flat string
   bool siblings;              // Context Includes Siblings: a right context goes on in the next sibling branch
+  bool left_in_branch;        // a left context stops at its branch's start, as a right context at its end
   std::size_t max_symbols;
   std::size_t max_params;
   std::array<double, kMaxSlots> env;  // a b c d T and user variables filled in, the rest 0

@@ -80,10 +80,17 @@ const AlgorithmInfo kInfo = {
             param::boolean("context_siblings", false)
                 .doc("Context Includes Siblings (pre-Houdini 10): a right context that reaches the end of its "
                      "branch goes on in the next sibling branch"),
+            param::choice("left_context", "parent", {"parent", "branch"})
+                .doc("parent: a left context passes out of its branch into the parent, skipping sibling branches "
+                     "(ABOP); branch: it stops at its branch's start, as a right context stops at its end"),
             param::choice("probability", "sequential", {"sequential", "normalized"})
                 .doc("sequential: each applicable rule fires with its own chance, in order (Houdini); normalized: one "
                      "of "
                      "the applicable probabilistic rules by weight (ABOP)"),
+            param::choice("probability_units", "auto", {"auto", "fraction", "percent"})
+                .doc("how a rule's probability reads. auto: up to 1 a fraction, above 1 a percentage (the "
+                     "reference defines 0 to 1, its topiary example writes ': 80'), and a constant between 1 and 2, "
+                     "which could be either, is an error; fraction: 0 to 1; percent: 0 to 100"),
             param::choice("convention", "houdini", {"houdini", "abop"})
                 .doc("houdini: + turns right; abop: + turns left (The Algorithmic Beauty of Plants)"),
             param::boolean("continuous_length", true).doc("fractional generation scales new lengths"),
@@ -231,6 +238,29 @@ lsys::Image load_image(const char* param, const std::string& file) {
 }
 
 // An organ OBJ named by a grammar file is found beside the file, as its author wrote it.
+// probability_units, checked against the grammar's constant probabilities: under auto a constant above 1
+// and below 2 (':1.5') is a fraction of certainty to some readers and a percentage to others, so it is
+// refused rather than read as either; under fraction, one above 1 is refused.
+lsys::ProbabilityUnits probability_units(const lsys::Grammar& g, const std::string& units) {
+  const auto u = units == "fraction"  ? lsys::ProbabilityUnits::Fraction
+                 : units == "percent" ? lsys::ProbabilityUnits::Percent
+                                      : lsys::ProbabilityUnits::Auto;
+  for (const auto& r : g.rules) {
+    if (r.probability.empty() || !r.probability.constant()) continue;
+    const double v = r.probability.constant_value();
+    if (u == lsys::ProbabilityUnits::Auto && v > 1.0 && v < 2.0)
+      throw InputError(
+          fmt::format("{}: probability {} is ambiguous: with probability_units=auto a probability "
+                      "above 1 is a percentage ({}%), yet it reads as a fraction (always); expected a "
+                      "fraction up to 1 or a percentage of 2 or more, or set probability_units=fraction "
+                      "or percent",
+                      r.where, v, v));
+    if (u == lsys::ProbabilityUnits::Fraction && v > 1.0)
+      throw InputError(fmt::format("{}: probability {}: expected 0 to 1 with probability_units=fraction", r.where, v));
+  }
+  return u;
+}
+
 std::string organ_relative_to(const std::string& key, const std::string& value, const std::string& grammar) {
   namespace fs = std::filesystem;
   if (key.rfind("organ_", 0) != 0 || value.empty() || fs::path(value).is_absolute()) return value;
@@ -351,8 +381,10 @@ Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* quer
       .stream = 0,  // set for each plant before it is rewritten
       .probability =
           p.text("probability") == "normalized" ? lsys::ProbabilityMode::Normalized : lsys::ProbabilityMode::Sequential,
+      .units = probability_units(s.grammar, p.text("probability_units")),
       .brackets_transparent = s.grammar.ignore.test('[') || s.grammar.ignore.test(']'),
       .siblings = p.boolean("context_siblings"),
+      .left_in_branch = p.text("left_context") == "branch",
       .max_symbols = max_symbols,
       .max_params = max_symbols * 2,
       .env = {},

@@ -31,8 +31,10 @@ DeriveSettings settings(const NoHost& host) {
           .seed = 1,
           .stream = 0,
           .probability = ProbabilityMode::Sequential,
+          .units = ProbabilityUnits::Auto,
           .brackets_transparent = false,
           .siblings = false,
+          .left_in_branch = false,
           .max_symbols = 200'000'000,
           .max_params = 400'000'000,
           .env = {}};

@@ -95,6 +95,12 @@ TEST(LSystemDerivation, BranchAwareContext) {
   EXPECT_EQ(derive("B[C]A", "B < A = X", 1), "B[C]X");
   EXPECT_EQ(derive("BCA", "B < A = X", 1), "BCA");
   EXPECT_EQ(derive("BCA", "B < A = X", 1, {"context_ignore=C"}), "BCX");
+  // left_context=branch: it stops at its branch's start, as a right context stops at its end; sibling
+  // branches before it in its own branch are still skipped
+  EXPECT_EQ(derive("B[A]", "B < A = X", 1, {"left_context=branch"}), "B[A]");
+  EXPECT_EQ(derive("B[C]A", "B < A = X", 1, {"left_context=branch"}), "B[C]X");
+  EXPECT_EQ(derive("[BA]", "B < A = X", 1, {"left_context=branch"}), "[BX]");
+  EXPECT_EQ(derive("B[A]", "B < A = X", 1, {"left_context=branch", "context_ignore=[]"}), "B[X]");
   // context parameters bind
   EXPECT_EQ(derive("B(2)A(3)C(4)", "B(x) < A(y) > C(z) : x + z > y = A(x*y*z)", 1), "B(2)A(24)C(4)");
 }
@@ -255,6 +261,32 @@ TEST(LSystemProbability, NormalizedRulesShareOneChoice) {
   Params q = lsys_params(std::string(30000, 'A'), "A = X : 80", 1);
   const auto c3 = counts(derive_lsystem(q, 3, nullptr, nullptr, 0));
   EXPECT_LT(chi_square(c3, {{'X', 0.8}, {'A', 0.2}}, 30000), 10.8);
+}
+
+// probability_units: ':1.5' once read as 1.5% under the rule that a probability above 1 is a
+// percentage, while ':1' was certain. Under auto it is refused as ambiguous, naming its line; fraction
+// reads the reference's definition (0 to 1) and percent reads 0 to 100.
+TEST(LSystemProbability, UnitsReadProbabilitiesAsAskedAndRefuseTheAmbiguous) {
+  const std::string a = test::error_of(
+      [] { derive_lsystem(lsys_params(std::string(100, 'A'), "A = X : 1.5", 1), 3, nullptr, nullptr, 0); });
+  EXPECT_NE(a.find("parameter 'rules':1: probability 1.5 is ambiguous"), std::string::npos) << a;
+  EXPECT_NE(a.find("set probability_units=fraction or percent"), std::string::npos) << a;
+  // fraction: 0.5 is half; 1.5 is out of range
+  const auto half = counts(derive_lsystem(
+      lsys_params(std::string(30000, 'A'), "A = X : 0.5", 1, {"probability_units=fraction"}), 3, nullptr, nullptr, 0));
+  EXPECT_LT(chi_square(half, {{'X', 0.5}, {'A', 0.5}}, 30000), 10.8);
+  EXPECT_NE(test::error_of([] {
+              derive_lsystem(lsys_params("A", "A = X : 1.5", 1, {"probability_units=fraction"}), 3, nullptr, nullptr,
+                             0);
+            }).find("probability 1.5: expected 0 to 1 with probability_units=fraction"),
+            std::string::npos);
+  // percent: ': 1' is 1%, not certain
+  const auto one = counts(derive_lsystem(
+      lsys_params(std::string(30000, 'A'), "A = X : 1", 1, {"probability_units=percent"}), 3, nullptr, nullptr, 0));
+  EXPECT_LT(chi_square(one, {{'X', 0.01}, {'A', 0.99}}, 30000), 10.8);
+  // auto: a percentage of 2 or more still reads as one
+  const auto two = counts(derive_lsystem(lsys_params(std::string(30000, 'A'), "A = X : 2", 1), 3, nullptr, nullptr, 0));
+  EXPECT_LT(chi_square(two, {{'X', 0.02}, {'A', 0.98}}, 30000), 10.8);
 }
 
 TEST(LSystemProbability, SeedChangesTheStringAndRepeats) {
