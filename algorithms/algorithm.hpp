@@ -84,6 +84,9 @@ class GrowthAlgorithm {
   [[nodiscard]] virtual std::optional<Params> effective_params() const { return std::nullopt; }
   // The files its parameters named and it read, as (parameter, path): the record keeps their content hashes.
   [[nodiscard]] virtual std::vector<std::pair<std::string, std::string>> input_files() const { return {}; }
+  // What in its input parses but is likely not what was meant (a grammar's '/30'), each naming where: the
+  // record keeps them and `run` prints them. After start().
+  [[nodiscard]] virtual std::vector<std::string> warnings() const { return {}; }
   // Algorithm-specific figures for the trial record (e.g. attraction points left).
   [[nodiscard]] virtual std::vector<std::pair<std::string, double>> stats() const { return {}; }
   // Its word on the plant as grown (OwnVerdict above); called after finish().

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "algorithms/lsystem/lstring.hpp"
 #include "core/errors.hpp"
@@ -155,6 +156,7 @@ class LineParser {
       OutModule m;
       m.symbol = c;
       ++k;
+      note_bare_number(s, k);
       std::size_t j = k;
       while (j < s.text.size() && s.text[j] == ' ') ++j;
       if (j < s.text.size() && s.text[j] == '(') {
@@ -204,6 +206,29 @@ class LineParser {
     }
     return out;
   }
+
+  // Digits straight after a turtle command that takes a number ('/30'): as written they are symbols of
+  // their own, which parse_grammar keeps as a warning unless a rule rewrites one of them.
+  void note_bare_number(Span s, std::size_t k) {
+    constexpr std::string_view kTakesNumber = "+-&^\\/~!\";_T";
+    const char c = s.text[k - 1];
+    if (kTakesNumber.find(c) == std::string_view::npos || k >= s.text.size()) return;
+    std::size_t e = k;
+    while (e < s.text.size() && (std::isdigit(static_cast<unsigned char>(s.text[e])) || s.text[e] == '.')) ++e;
+    while (e > k && s.text[e - 1] == '.') --e;  // a trailing '.' is the polygon command
+    if (e == k || s.text[k] == '.') return;
+    const std::string_view digits = s.text.substr(k, e - k);
+    pending.push_back(
+        {fmt::format("{}:{}: '{}{}' reads as '{}' followed by the symbols '{}'; if {} is its argument, "
+                     "write '{}({})'",
+                     where_, s.column + k - 1, c, digits, c, fmt::join(digits, "', '"), digits, c, digits),
+         std::string(digits)});
+  }
+
+  struct Pending {
+    std::string message, symbols;
+  };
+  std::vector<Pending> pending;  // note_bare_number's, for parse_grammar to keep or drop
 
   Rule rule(Span line) {
     Rule r;
@@ -367,6 +392,7 @@ std::string read_text(const std::string& path, const char* what) {
 Grammar parse_grammar(const GrammarText& premise, const std::vector<GrammarText>& rules,
                       const std::vector<std::string>& user_variables, const std::string& ignore) {
   Grammar g;
+  std::vector<LineParser::Pending> pending;
   g.user_variables = user_variables;
   for (std::size_t k = 0; k < ignore.size(); ++k) {
     const char c = ignore[k];
@@ -381,6 +407,7 @@ Grammar parse_grammar(const GrammarText& premise, const std::vector<GrammarText>
       if (blank_or_comment(lines[k])) continue;
       LineParser p(fmt::format("{}:{}", src.source, src.first_line + k), "a rule", g);
       Rule r = p.rule({lines[k], k == 0 ? src.first_column : 1});
+      pending.insert(pending.end(), p.pending.begin(), p.pending.end());
       r.where = fmt::format("{}:{}", src.source, src.first_line + k);
       if (g.rules.size() >= 65535) throw InputError(fmt::format("{}: too many rules", r.where));
       g.rules_for[static_cast<unsigned char>(r.pred.symbol)].push_back(static_cast<std::uint16_t>(g.rules.size()));
@@ -397,6 +424,7 @@ Grammar parse_grammar(const GrammarText& premise, const std::vector<GrammarText>
       LineParser p(fmt::format("{}:{}", premise.source, premise.first_line + k), "the premise", g);
       const ExprScope scope{nullptr, &g.user_variables};
       auto mods = p.modules({lines[k], k == 0 ? premise.first_column : 1}, scope);
+      pending.insert(pending.end(), p.pending.begin(), p.pending.end());
       for (auto& m : mods) {
         for (const auto& a : m.args) {
           g.uses_turtle |= a.use().turtle;
@@ -408,6 +436,10 @@ Grammar parse_grammar(const GrammarText& premise, const std::vector<GrammarText>
     if (g.premise.empty())
       throw InputError(fmt::format("{}: the premise is empty; expected at least one symbol", premise.source));
   }
+  for (const auto& w : pending)
+    if (std::none_of(w.symbols.begin(), w.symbols.end(),
+                     [&](char d) { return !g.rules_for[static_cast<unsigned char>(d)].empty(); }))
+      g.warnings.push_back(w.message);
   return g;
 }
 

@@ -519,6 +519,7 @@ class LSystem final : public GrowthAlgorithm {
   // The grammar file's settings under the user's: what it grew with.
   std::optional<Params> effective_params() const override { return setup_.params; }
   std::vector<std::pair<std::string, std::string>> input_files() const override { return setup_.inputs; }
+  std::vector<std::string> warnings() const override { return setup_.grammar.warnings; }
 
   // A grammar is a program in the input, whose arithmetic can divide by zero or overflow: the invalid plant
   // it draws is bad input, not a bug.

@@ -175,6 +175,27 @@ TEST(LSystemReference, AvoidPlacementKeepsMostOrgansOfAFineStemmedCherry) {
   EXPECT_EQ(avoid.results.metrics->at("leaf_overlap").get<double>(), 0.0);
 }
 
+// A turn followed by digits ('/30') reads as the turn and the digits as symbols of their own, as the
+// reference's syntax says; it was silent. The record now keeps a warning naming the line and column, with
+// the argument form, unless a rule rewrites those digits (then they are meant as symbols).
+TEST(LSystemReference, ABareNumberAfterATurnIsAWarningUnlessTheDigitsAreSymbols) {
+  TrialSpec spec;
+  spec.algorithm = "lsystem";
+  spec.scene = "envelope";
+  spec.metrics = false;
+  spec.params = {"premise=A", "rules=A = F/30A\nB = +5.5F", "generations=2"};
+  const TrialRecord r = run_trial_record(spec);
+  ASSERT_EQ(r.results.warnings.size(), 2u);
+  EXPECT_EQ(r.results.warnings[0],
+            "parameter 'rules':1:6: '/30' reads as '/' followed by the symbols '3', '0'; if 30 is its argument, "
+            "write '/(30)'");
+  EXPECT_EQ(r.results.warnings[1].substr(0, 42), "parameter 'rules':2:5: '+5.5' reads as '+'");
+  spec.params = {"premise=A", "rules=A = F/30A\n3 = F", "generations=2"};
+  EXPECT_TRUE(run_trial_record(spec).results.warnings.empty());
+  spec.params = {"premise=A", "rules=A = F/(30)A", "generations=2"};
+  EXPECT_TRUE(run_trial_record(spec).results.warnings.empty());
+}
+
 // J/K/M's stamps set the settings of their shape that leaf_param_a/b/c name (Houdini's Leaf Params), as a
 // stamped input geometry does: J(s,0,6) with leaf_param_a=petals draws a six-petalled blossom. A module
 // without the stamp keeps the plain shape; a setting the shape lacks, or an OBJ shape, is an error.

@@ -133,6 +133,7 @@ Outcome run_one(RunArgs& a) {
   write_scene_glb((std::filesystem::path(a.out_dir) / "scene.glb").string(), load_scene(spec.scene, spec.scene_params));
   if (!a.quiet && isatty(STDERR_FILENO)) fmt::print(stderr, "\r{:60}\r", "");
   print_record(rec, spec, a.out_dir);
+  for (const auto& w : rec.results.warnings) fmt::print(stderr, "warning: {}\n", w);
   return render ? render_run(a.out_dir, *render) : Outcome::ok;
 }
 

@@ -401,6 +401,7 @@ struct TrialResults {
   Curve curve;
   nlohmann::json params = nlohmann::json::object();  // the algorithm's effective parameters by name
   std::vector<InputFile> inputs;                     // the files it read them from, when any
+  std::vector<std::string> warnings;                 // what in its input parsed but likely was not meant
   std::map<std::string, double> algorithm_stats;
   std::uint64_t threads = 0;              // the threads it ran with
   std::optional<OrganPassRecord> organs;  // only when the pass ran (an organ option was given)
@@ -419,6 +420,7 @@ struct TrialResults {
                       field("curve", &T::curve).with(kNoCsv),
                       field("params", &T::params).with(kNoCsv),
                       field("inputs", &T::inputs).with(kNoCsv),
+                      field("warnings", &T::warnings).with(kNoCsv | kOmitEmpty),
                       field("algorithm_stats", &T::algorithm_stats),
                       field("threads", &T::threads),
                       field("organs", &T::organs),

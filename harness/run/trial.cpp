@@ -570,10 +570,12 @@ void organ_pass(const TrialSpec& spec, const OrganOptions& options, const Params
   rec.results.organs = std::move(out);
 }
 
-// What the algorithm's own input files set, and their hashes (a grammar's premise, not the default's).
+// What the algorithm's own input files set, and their hashes (a grammar's premise, not the default's), and
+// what it warned of in its input.
 void record_inputs(const GrowthAlgorithm& algo, TrialResults& r) {
   if (const auto effective = algo.effective_params()) r.params = effective->to_json();
   for (const auto& [param, path] : algo.input_files()) r.inputs.push_back({param, path, file_hash(path)});
+  r.warnings = algo.warnings();
 }
 
 }  // namespace
