@@ -68,6 +68,13 @@ const AlgorithmInfo kInfo = {
             param::real("random_scale", 0.0)
                 .range(0, 1)
                 .doc("every move length is scaled by 1 + random_scale * uniform(-1, 1)"),
+            param::boolean("point_attributes", false)
+                .doc("Houdini's Point Attributes: every node also gets up (the turtle's up vector), lage and gen "
+                     "(the rewrite that made the module drawing it) as attributes in skeleton.ply, plant.ply and "
+                     "plant.glb"),
+            param::real("vertical_increment", 1.0)
+                .range(0, 1e6)
+                .doc("Houdini's Vertical Increment: what lage adds per drawn segment from the root"),
             param::real("u_increment", 0.1).range(-1e4, 1e4).doc("default increment of ' (colour index U)"),
             param::real("v_increment", 0.1).range(-1e4, 1e4).doc("default increment of # (colour index V)"),
             param::real("b", 0.0).range(-1e12, 1e12).doc("expression variable b"),
@@ -341,6 +348,15 @@ Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* quer
     for (const auto& st : file->settings)
       if (st.key == "premise") premise = file->setting_text(st);
   s.grammar = lsys::parse_grammar(premise, rules, user_names, p.text("context_ignore"));
+  if (p.boolean("point_attributes")) {
+    s.grammar.uses_age = true;  // gen is the plant's rewrites less the module's age
+    for (const char* name : {"up", "lage", "gen"})
+      if (std::find(s.grammar.strings.begin(), s.grammar.strings.end(), name) != s.grammar.strings.end())
+        throw InputError(
+            fmt::format("point_attributes: the grammar sets '{}' itself with a(\"{}\", ...); "
+                        "expected one or the other",
+                        name, name));
+  }
 
   s.host = std::make_unique<Host>();
   s.host->seed_ = seed;
@@ -440,6 +456,9 @@ Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* quer
       .organ_shape = {},
       .color_image = nullptr,
       .stamps = nullptr,
+      .point_attributes = p.boolean("point_attributes"),
+      .vertical_increment = p.real("vertical_increment"),
+      .generation = 0,  // the plant's, set when it is drawn
   };
   organ_setup(p, s);
   const double generations = p.real("generations");
@@ -584,6 +603,7 @@ class LSystem final : public GrowthAlgorithm {
                       ? nullptr
                       : &setup_.stamps;
       ts.birth_step = static_cast<std::uint32_t>(step_);
+      ts.generation = pl.generation;
       ts.fraction = (setup_.fraction > 0.0 && pl.generation == setup_.rewrites) ? setup_.fraction : 1.0;
       const bool need_states = setup_.grammar.uses_turtle && pl.generation < setup_.rewrites;
       const auto r = lsys::interpret(pl.cur, ts, setup_.grammar.strings, plant_, need_states ? &pl.states : nullptr);

@@ -169,7 +169,10 @@ void BM_LsysTurtle(benchmark::State& state) {
                              .organ_kind = {OrganKind::Leaf, OrganKind::Flower, OrganKind::Bud},
                              .organ_shape = {kKindShape, kKindShape, kKindShape},
                              .color_image = nullptr,
-                             .stamps = nullptr};
+                             .stamps = nullptr,
+                             .point_attributes = false,
+                             .vertical_increment = 1.0,
+                             .generation = 0};
   std::size_t nodes = 0;
   Plant reused;
   for (auto _ : state) {

@@ -196,6 +196,40 @@ TEST(LSystemReference, ABareNumberAfterATurnIsAWarningUnlessTheDigitsAreSymbols)
   EXPECT_TRUE(run_trial_record(spec).results.warnings.empty());
 }
 
+// Houdini's Point Attributes: gen is the rewrite that made the module drawing a node (it was the branch
+// order, and lage and up were missing). FA with A = FA, two rewrites, draws FFF from the premise's F and
+// those rewrites 1 and 2 made; lage counts vertical_increment per segment; up is the turtle's, unit and
+// across the heading, and turns with a pitch.
+TEST(LSystemReference, PointAttributesGiveUpLageAndTheGenerationThatMadeEachNode) {
+  const Plant p = draw("FA", {"rules=A = F&(90)A", "generations=2", "point_attributes=true", "vertical_increment=0.5"});
+  auto attr = [&](const std::string& name) {
+    const auto it = std::find_if(p.node_attributes.begin(), p.node_attributes.end(),
+                                 [&](const NodeAttribute& a) { return a.name == name; });
+    EXPECT_NE(it, p.node_attributes.end()) << name;
+    return it == p.node_attributes.end() ? std::vector<float>{} : it->values;
+  };
+  ASSERT_EQ(p.nodes.size(), 4u);  // the root and three segments
+  EXPECT_EQ(attr("gen"), (std::vector<float>{0, 0, 1, 2}));
+  EXPECT_EQ(attr("lage"), (std::vector<float>{0, 0.5f, 1.0f, 1.5f}));
+  const std::vector<float> up = attr("up");
+  ASSERT_EQ(up.size(), 12u);
+  for (std::size_t n = 1; n < 4; ++n) {
+    const glm::vec3 u(up[3 * n], up[3 * n + 1], up[3 * n + 2]);
+    const glm::vec3 h = glm::normalize(p.nodes[n].position - p.nodes[n - 1].position);
+    EXPECT_NEAR(glm::length(u), 1.0f, 1e-5f) << n;
+    EXPECT_NEAR(glm::dot(u, h), 0.0f, 1e-5f) << n;
+  }
+  // the pitch between the second and third segments turned the up vector
+  EXPECT_LT(std::abs(up[6] * up[9] + up[7] * up[10] + up[8] * up[11]), 0.5f);
+  // Without the flag there are none of them.
+  const Plant plain = draw("FA", {"rules=A = F&(90)A", "generations=2"});
+  EXPECT_TRUE(plain.node_attributes.empty());
+  EXPECT_NE(test::error_of([] {
+              draw("a(\"up\", 1, 0, 0)FA", {"rules=A = FA", "generations=1", "point_attributes=true"});
+            }).find("point_attributes: the grammar sets 'up' itself"),
+            std::string::npos);
+}
+
 // J/K/M's stamps set the settings of their shape that leaf_param_a/b/c name (Houdini's Leaf Params), as a
 // stamped input geometry does: J(s,0,6) with leaf_param_a=petals draws a six-petalled blossom. A module
 // without the stamp keeps the plain shape; a setting the shape lacks, or an OBJ shape, is an error.

@@ -29,6 +29,7 @@ bool fits_float(const glm::dvec3& p) {
 struct State {
   glm::dvec3 pos{0.0}, H{0.0, 1.0, 0.0}, L{-1.0, 0.0, 0.0}, U{0.0, 0.0, 1.0};
   double length = 0.0, width = 0.0, angle = 0.0, arc = 0.0, u = 0.0, v = 0.0;
+  double lage = 0.0;  // Point Attributes' lage: vertical_increment per drawn segment from the root
   std::int32_t node = kNoParent;
   std::int32_t group = -1;
   std::uint32_t shoot = 0;
@@ -112,6 +113,7 @@ class Interpreter {
           double width = k > 1 ? a[1] : t.width;
           if (fresh && s_.continuous_width) width *= s_.fraction;
           const bool draw = c == 'F' || c == 'H';
+          if (s_.point_attributes) module_gen_ = s_.generation - (str_.ages.size() > m ? str_.ages[m] : 0);
           if (draw && t.node == kNoParent) t.node = add_node(t.pos, width, kNoParent, t, {});
           const glm::dvec3 before = t.pos;
           t.pos += t.H * len;
@@ -128,9 +130,10 @@ class Interpreter {
             break;
           }
           if (c == 'F' || c == 'H' || c == 'G') t.arc += glm::length(t.pos - before);
-          if (draw)
+          if (draw) {
+            t.lage += s_.vertical_increment;
             t.node = add_node(t.pos, width, t.node, t, k > 2 ? tube_shape(a, k) : TubeShape{});
-          else if (c == 'f' || c == 'h')
+          } else if (c == 'f' || c == 'h')
             t.node = kNoParent;
           break;
         }
@@ -368,6 +371,11 @@ class Interpreter {
       const glm::vec3 c = srgb_to_linear(glm::vec3(px[0], px[1], px[2]) / 255.0f);
       node_colors_.insert(node_colors_.end(), {c.r, c.g, c.b});
     }
+    if (s_.point_attributes) {
+      const glm::vec3 up(t.U);
+      node_points_.insert(node_points_.end(),
+                          {up.x, up.y, up.z, static_cast<float>(t.lage), static_cast<float>(std::max(0, module_gen_))});
+    }
     if (tube.sections != 0 || tube.divisions != 0) {
       if (!tubes_used_) node_tubes_.assign(plant_.nodes.size() - 1 - first_node_, TubeShape{});
       tubes_used_ = true;
@@ -527,14 +535,28 @@ class Interpreter {
           attr.values.push_back(id < snap.size() && cpt < 3 ? snap[id][static_cast<std::size_t>(cpt)] : 0.0f);
       }
     }
-    if (s_.color_image) {
+    // An attribute the turtle gives each node of this plant, after the zeros of earlier plants' nodes.
+    auto per_node = [&](const std::string& name, int comps) -> std::vector<float>& {
       auto it = std::find_if(plant_.node_attributes.begin(), plant_.node_attributes.end(),
-                             [](const NodeAttribute& x) { return x.name == "Cd"; });
+                             [&](const NodeAttribute& x) { return x.name == name; });
       if (it == plant_.node_attributes.end()) {
-        plant_.node_attributes.push_back({"Cd", 3, std::vector<float>(first_node * 3, 0.0f)});
+        plant_.node_attributes.push_back({name, comps, std::vector<float>(first_node * comps, 0.0f)});
         it = plant_.node_attributes.end() - 1;
       }
-      it->values.insert(it->values.end(), node_colors_.begin(), node_colors_.end());
+      return it->values;
+    };
+    if (s_.color_image) {
+      auto& cd = per_node("Cd", 3);
+      cd.insert(cd.end(), node_colors_.begin(), node_colors_.end());
+    }
+    if (s_.point_attributes) {
+      auto &up = per_node("up", 3), &lage = per_node("lage", 1), &gen = per_node("gen", 1);
+      for (std::size_t q = 0; q + 5 <= node_points_.size(); q += 5) {
+        up.insert(up.end(), node_points_.begin() + static_cast<std::ptrdiff_t>(q),
+                  node_points_.begin() + static_cast<std::ptrdiff_t>(q + 3));
+        lage.push_back(node_points_[q + 3]);
+        gen.push_back(node_points_[q + 4]);
+      }
     }
     // attributes other plants made before this one: pad with zeros for this plant's nodes
     for (auto& attr : plant_.node_attributes)
@@ -554,6 +576,8 @@ class Interpreter {
   std::vector<int> attr_components_;
   std::vector<TubeShape> node_tubes_;
   std::vector<float> node_colors_;                          // Apply Color: 3 per node of this plant
+  std::vector<float> node_points_;                          // Point Attributes: up, lage, gen per node
+  int module_gen_ = 0;                                      // gen of the module drawing now
   std::unordered_map<std::string, std::uint16_t> stamped_;  // stamped shape names -> Plant::organ_shapes
   std::int32_t group_counter_ = 0;
   bool groups_used_ = false, attrs_used_ = false, tubes_used_ = false;
