@@ -20,6 +20,7 @@
 #include <ctime>
 #include <filesystem>
 #include <optional>
+#include <sstream>
 
 #include <fmt/format.h>
 #include <stb_image.h>
@@ -81,7 +82,9 @@ const AlgorithmInfo kInfo = {
             param::real("c", 0.0).range(-1e12, 1e12).doc("expression variable c"),
             param::real("d", 0.0).range(-1e12, 1e12).doc("expression variable d"),
             param::text("variables").doc("user variables, single letters: 'k=0.5, q=2'"),
-            param::text("channels").doc("values of chan(0), chan(1), ...: '1, 0.5'"),
+            param::text("channels")
+                .doc("values of chan(0), chan(1), ...: '1, 0.5'; a channel may be animated over the generation being "
+                     "made, as keys generation:value, linear between them: '0:0 4:1, 0.5'"),
             param::text("context_ignore")
                 .doc("symbols skipped when matching contexts, e.g. '+-F'; with '[' or ']' brackets become transparent"),
             param::boolean("context_siblings", false)
@@ -156,6 +159,22 @@ const std::vector<std::string>& setting_names() {
   return names;
 }
 
+// A channel chan(k) reads: keys (generation, value), linear between them and held beyond them (one key:
+// a constant), as Houdini's animated channels are read at the current frame, a generation here.
+struct Channel {
+  std::vector<std::pair<double, double>> keys;
+  [[nodiscard]] double at(double g) const {
+    if (g <= keys.front().first) return keys.front().second;
+    for (std::size_t k = 1; k < keys.size(); ++k)
+      if (g < keys[k].first) {
+        const auto& [g0, v0] = keys[k - 1];
+        const auto& [g1, v1] = keys[k];
+        return v0 + (v1 - v0) * (g - g0) / (g1 - g0);
+      }
+    return keys.back().second;
+  }
+};
+
 class Host final : public lsys::ExprHost {
  public:
   double in(double x, double y, double z) const override {
@@ -182,7 +201,7 @@ class Host final : public lsys::ExprHost {
     const auto k = static_cast<long>(std::floor(index));
     if (k < 0 || static_cast<std::size_t>(k) >= channels_.size())
       throw InputError(fmt::format("chan({}) has no value: 'channels' gives {} value(s)", k, channels_.size()));
-    return channels_[static_cast<std::size_t>(k)];
+    return channels_[static_cast<std::size_t>(k)].at(generation_);
   }
 
   const SceneQuery* query_ = nullptr;
@@ -190,25 +209,43 @@ class Host final : public lsys::ExprHost {
   lsys::Image image_;
   std::uint64_t seed_ = 0;
   std::uint64_t stream_ = 0;  // the plant being rewritten: plants are rewritten one after another
-  std::vector<double> channels_;
+  double generation_ = 0.0;   // the generation being made (0: the premise), the time chan() reads at
+  std::vector<Channel> channels_;
 };
 
-std::vector<double> parse_channels(const std::string& text) {
-  std::vector<double> out;
+// One number, strictly: the whole of `text`.
+double channel_number(const std::string& text, const std::string& item) {
+  char* e = nullptr;
+  const double v = std::strtod(text.c_str(), &e);
+  if (text.empty() || e == text.c_str() || *e != '\0' || !std::isfinite(v))
+    throw InputError(fmt::format("channels: in '{}', expected a number, found '{}'", item, text));
+  return v;
+}
+
+// Comma-separated channels, each a number or keys 'generation:value ...' in increasing generation.
+std::vector<Channel> parse_channels(const std::string& text) {
+  std::vector<Channel> out;
   std::size_t start = 0;
   while (start < text.size()) {
     std::size_t end = text.find(',', start);
     if (end == std::string::npos) end = text.size();
-    std::string item = text.substr(start, end - start);
-    item.erase(0, item.find_first_not_of(" \t"));
-    item.erase(item.find_last_not_of(" \t") + 1);
-    if (!item.empty()) {
-      char* e = nullptr;
-      const double v = std::strtod(item.c_str(), &e);
-      if (e == item.c_str() || *e != '\0')
-        throw InputError(fmt::format("channels: expected a number, found '{}'", item));
-      out.push_back(v);
+    const std::string item = text.substr(start, end - start);
+    std::istringstream words(item);
+    Channel ch;
+    for (std::string w; words >> w;) {
+      const std::size_t colon = w.find(':');
+      if (colon == std::string::npos) {
+        if (!ch.keys.empty() || words >> w)
+          throw InputError(fmt::format("channels: in '{}', expected one number or keys generation:value", item));
+        ch.keys.push_back({0.0, channel_number(w, item)});
+        break;
+      }
+      const double g = channel_number(w.substr(0, colon), item);
+      if (!ch.keys.empty() && !(g > ch.keys.back().first))
+        throw InputError(fmt::format("channels: in '{}', the generations of the keys must increase", item));
+      ch.keys.push_back({g, channel_number(w.substr(colon + 1), item)});
     }
+    if (!ch.keys.empty()) out.push_back(std::move(ch));
     start = end + 1;
   }
   return out;
@@ -515,6 +552,7 @@ class LSystem final : public GrowthAlgorithm {
       if (!pl.started || pl.generation >= setup_.rewrites) continue;
       const auto t0 = std::chrono::steady_clock::now();
       use_stream(pl.stream);
+      setup_.host->generation_ = pl.generation + 1;
       deriver_->rewrite(pl.cur, pl.next, pl.generation + 1, pl.states);
       rewrite_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       std::swap(pl.cur, pl.next);
@@ -579,6 +617,7 @@ class LSystem final : public GrowthAlgorithm {
     for (auto& pl : plants_) {
       if (pl.started || pl.start_step > step_) continue;
       use_stream(pl.stream);
+      setup_.host->generation_ = 0;
       deriver_->premise(pl.cur);
       pl.started = true;
     }
@@ -671,6 +710,7 @@ DerivedString derive_lsystem(const Params& params, std::uint64_t seed, const Sce
       Plant scratch;
       lsys::interpret(cur, ts, setup.grammar.strings, scratch, &states);
     }
+    setup.host->generation_ = g;
     deriver.rewrite(cur, next, g, states);
     std::swap(cur, next);
   }

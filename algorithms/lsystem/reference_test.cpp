@@ -230,6 +230,31 @@ TEST(LSystemReference, PointAttributesGiveUpLageAndTheGenerationThatMadeEachNode
             std::string::npos);
 }
 
+// chan() read constants only; Houdini's channels are animated. A channel's keys generation:value are read
+// at the generation being made, linear between keys and held beyond them: the segments made by
+// rewrites 1, 2 and 3 under keys 1:1 3:3 are 1, 2 and 3 long, and 5 beyond the last key.
+TEST(LSystemReference, AnimatedChannelsAreReadAtTheGenerationBeingMade) {
+  const Plant p = draw("A", {"rules=A = F(chan(1))A", "generations=4", "channels=0.5, 1:1 3:3 4:5"});
+  std::vector<float> ys;
+  for (const auto& n : p.nodes) ys.push_back(n.position.y);
+  EXPECT_EQ(ys, (std::vector<float>{0, 1, 3, 6, 11}));
+  EXPECT_EQ(draw("A", {"rules=A = F(chan(1))A", "generations=2", "channels=0.5, 1:1 3:3"}).nodes.back().position.y,
+            3.0f);
+  EXPECT_EQ(draw("A", {"rules=A = F(chan(0))", "generations=1", "channels=0.25"}).nodes.back().position.y, 0.25f);
+  EXPECT_EQ(test::error_of([] {
+              draw("A", {"rules=A = F(chan(0))", "generations=1", "channels=2:1 1:0"});
+            }),
+            "channels: in '2:1 1:0', the generations of the keys must increase");
+  EXPECT_EQ(test::error_of([] {
+              draw("A", {"rules=A = F(chan(0))", "generations=1", "channels=1 2"});
+            }),
+            "channels: in '1 2', expected one number or keys generation:value");
+  EXPECT_EQ(test::error_of([] {
+              draw("A", {"rules=A = F(chan(0))", "generations=1", "channels=1:x"});
+            }),
+            "channels: in '1:x', expected a number, found 'x'");
+}
+
 // J/K/M's stamps set the settings of their shape that leaf_param_a/b/c name (Houdini's Leaf Params), as a
 // stamped input geometry does: J(s,0,6) with leaf_param_a=petals draws a six-petalled blossom. A module
 // without the stamp keeps the plain shape; a setting the shape lacks, or an OBJ shape, is an error.
