@@ -135,6 +135,7 @@ struct DerivedString {
   std::size_t bytes = 0;  // memory of the string
   int generations = 0;
   std::vector<std::pair<char, std::size_t>> counts;  // by symbol, in ASCII order
+  std::vector<std::string> rules;  // the rules it rewrote with, one line each, as a rules file holds them
 };
 
 // What an algorithm that rewrites a string (an L-system) offers beyond growing: the string derived alone,

@@ -726,6 +726,7 @@ DerivedString derive_lsystem(const Params& params, std::uint64_t seed, const Sce
   for (int c = 0; c < 128; ++c)
     if (counts[static_cast<std::size_t>(c)] > 0)
       out.counts.emplace_back(static_cast<char>(c), counts[static_cast<std::size_t>(c)]);
+  for (const auto& r : setup.grammar.rules) out.rules.push_back(r.text);
   return out;
 }
 

@@ -12,6 +12,7 @@
 
 #include "algorithms/algorithm.hpp"
 #include "harness/cli/command.hpp"
+#include "harness/record/files.hpp"
 #include "scenes/scene_library.hpp"
 #include "scenes/scene_query.hpp"
 
@@ -24,6 +25,7 @@ struct LsystemArgs {
   std::vector<std::string> sets;
   std::string generations;
   std::string scene;
+  std::string write_rules;
   std::uint64_t seed = 1;
   bool print = false, examples = false;
   std::size_t limit = 0;
@@ -56,6 +58,14 @@ Outcome derive(const LsystemArgs& a) {
   fmt::print(stderr, "generation {}: {} modules, {} parameters, {:.1f} MiB, derived in {:.6f} s ({:.6f} s CPU)\n",
              d.generations, d.modules, d.params, d.bytes / (1024.0 * 1024.0), d.seconds, d.cpu_seconds);
   for (const auto& [c, n] : d.counts) fmt::print(stderr, "  {}  {}\n", c, n);
+  if (!a.write_rules.empty()) {
+    // Houdini's Write Rule Parameters to File: the rules as read, one per line, for rules_file.
+    std::string text = fmt::format("# the rules of {}, written by growbench lsystem --write-rules\n",
+                                   a.file.empty() ? "the parameters" : a.file);
+    for (const auto& r : d.rules) text += r + "\n";
+    write_file_atomic(a.write_rules, text);
+    fmt::print(stderr, "wrote {} rules to {}\n", d.rules.size(), a.write_rules);
+  }
   return Outcome::ok;
 }
 
@@ -75,6 +85,9 @@ Command add_lsystem(CLI::App& app) {
       ->default_val(0)
       ->check(integer_in(0, SIZE_MAX));
   cmd->add_flag("--examples", a->examples, "list the example grammars");
+  cmd->add_option("--write-rules", a->write_rules,
+                  "write the rules it rewrote with to this file, one per line, which rules_file=FILE reads "
+                  "(Houdini's Write Rule Parameters to File)");
   return {cmd, [a] { return derive(*a); }};
 }
 
