@@ -188,7 +188,7 @@ bool Deriver::bind(const Rule& r, const LString& in, std::size_t m, std::size_t 
         c = symbol_of(w);
         off -= count_of(w);
         if (c == '[' || c == ']') {
-          if (c == '[' && !flat && s_.left_in_branch) return false;  // the reference's reading: its branch ends
+          if (c == '[' && !flat && s_.left_in_branch) return false;  // left_context=branch: its branch's start ends it
           if (flat || c == '[') {                                    // '[' leads from a branch into its parent
             --pos;
             continue;

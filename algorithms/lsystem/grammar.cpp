@@ -210,7 +210,7 @@ class LineParser {
   // Digits straight after a turtle command that takes a number ('/30'): as written they are symbols of
   // their own, which parse_grammar keeps as a warning unless a rule rewrites one of them.
   void note_bare_number(Span s, std::size_t k) {
-    constexpr std::string_view kTakesNumber = "+-&^\\/~!\";_T";
+    constexpr std::string_view kTakesNumber = "+-&^\\/~!?;@\"_'#T";
     const char c = s.text[k - 1];
     if (kTakesNumber.find(c) == std::string_view::npos || k >= s.text.size()) return;
     std::size_t e = k;

@@ -73,8 +73,8 @@ struct Grammar {
   bool uses_turtle = false;
   bool uses_age = false;
   bool has_context = false;
-  // What parses but is likely not what was meant, FILE:LINE:COLUMN first: a turn followed by digits
-  // ('/30', read as '/' and the symbols '3' and '0') where no rule rewrites those digits.
+  // What parses but is likely not what was meant, FILE:LINE:COLUMN first: a command that takes a number
+  // followed by digits ('/30', read as '/' and the symbols '3' and '0') where no rule rewrites those digits.
   std::vector<std::string> warnings;
 };
 

@@ -75,7 +75,7 @@ const AlgorithmInfo kInfo = {
                      "plant.glb"),
             param::real("vertical_increment", 1.0)
                 .range(0, 1e6)
-                .doc("Houdini's Vertical Increment: what lage adds per drawn segment from the root"),
+                .doc("Houdini's Vertical Increment: what lage adds per drawn segment along the turtle's path"),
             param::real("u_increment", 0.1).range(-1e4, 1e4).doc("default increment of ' (colour index U)"),
             param::real("v_increment", 0.1).range(-1e4, 1e4).doc("default increment of # (colour index V)"),
             param::real("b", 0.0).range(-1e12, 1e12).doc("expression variable b"),
@@ -229,7 +229,9 @@ std::vector<Channel> parse_channels(const std::string& text) {
   while (start < text.size()) {
     std::size_t end = text.find(',', start);
     if (end == std::string::npos) end = text.size();
-    const std::string item = text.substr(start, end - start);
+    std::string item = text.substr(start, end - start);
+    for (std::size_t c = item.find(':'); c != std::string::npos; c = item.find(':', c + 1))
+      while (c + 1 < item.size() && (item[c + 1] == ' ' || item[c + 1] == '\t')) item.erase(c + 1, 1);
     std::istringstream words(item);
     Channel ch;
     for (std::string w; words >> w;) {
@@ -245,7 +247,10 @@ std::vector<Channel> parse_channels(const std::string& text) {
         throw InputError(fmt::format("channels: in '{}', the generations of the keys must increase", item));
       ch.keys.push_back({g, channel_number(w.substr(colon + 1), item)});
     }
-    if (!ch.keys.empty()) out.push_back(std::move(ch));
+    if (ch.keys.empty())
+      throw InputError(
+          fmt::format("channels: channel {} is empty; expected a number or keys generation:value", out.size()));
+    out.push_back(std::move(ch));
     start = end + 1;
   }
   return out;
@@ -281,7 +286,6 @@ lsys::Image load_image(const char* param, const std::string& file) {
   return image;
 }
 
-// An organ OBJ named by a grammar file is found beside the file, as its author wrote it.
 // probability_units, checked against the grammar's constant probabilities: under auto a constant above 1
 // and below 2 (':1.5') is a fraction of certainty to some readers and a percentage to others, so it is
 // refused rather than read as either; under fraction, one above 1 is refused.
@@ -295,9 +299,9 @@ lsys::ProbabilityUnits probability_units(const lsys::Grammar& g, const std::stri
     if (u == lsys::ProbabilityUnits::Auto && v > 1.0 && v < 2.0)
       throw InputError(
           fmt::format("{}: probability {} is ambiguous: with probability_units=auto a probability "
-                      "above 1 is a percentage ({}%), yet it reads as a fraction (always); expected a "
-                      "fraction up to 1 or a percentage of 2 or more, or set probability_units=fraction "
-                      "or percent",
+                      "above 1 is a percentage ({}%), though it may be meant as a fraction (certain); "
+                      "expected a fraction up to 1 or a percentage of 2 or more, or set "
+                      "probability_units=fraction or percent",
                       r.where, v, v));
     if (u == lsys::ProbabilityUnits::Fraction && v > 1.0)
       throw InputError(fmt::format("{}: probability {}: expected 0 to 1 with probability_units=fraction", r.where, v));
@@ -305,6 +309,7 @@ lsys::ProbabilityUnits probability_units(const lsys::Grammar& g, const std::stri
   return u;
 }
 
+// An organ OBJ named by a grammar file is found beside the file, as its author wrote it.
 std::string organ_relative_to(const std::string& key, const std::string& value, const std::string& grammar) {
   namespace fs = std::filesystem;
   if (key.rfind("organ_", 0) != 0 || value.empty() || fs::path(value).is_absolute()) return value;

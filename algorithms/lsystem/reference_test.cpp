@@ -175,17 +175,18 @@ TEST(LSystemReference, AvoidPlacementKeepsMostOrgansOfAFineStemmedCherry) {
   EXPECT_EQ(avoid.results.metrics->at("leaf_overlap").get<double>(), 0.0);
 }
 
-// A turn followed by digits ('/30') reads as the turn and the digits as symbols of their own, as the
-// reference's syntax says; it was silent. The record now keeps a warning naming the line and column, with
-// the argument form, unless a rule rewrites those digits (then they are meant as symbols).
+// A command that takes a number followed by digits ('/30') reads as the command and the digits as
+// symbols of their own, as the reference's syntax says; it was silent. The record now keeps a warning naming the line
+// and column, with the argument form, unless a rule rewrites those digits (then they are meant as symbols).
 TEST(LSystemReference, ABareNumberAfterATurnIsAWarningUnlessTheDigitsAreSymbols) {
   TrialSpec spec;
   spec.algorithm = "lsystem";
   spec.scene = "envelope";
   spec.metrics = false;
-  spec.params = {"premise=A", "rules=A = F/30A\nB = +5.5F", "generations=2"};
+  spec.params = {"premise=A", "rules=A = F/30A\nB = +5.5F?2", "generations=2"};
   const TrialRecord r = run_trial_record(spec);
-  ASSERT_EQ(r.results.warnings.size(), 2u);
+  ASSERT_EQ(r.results.warnings.size(), 3u);
+  EXPECT_EQ(r.results.warnings[2].substr(0, 40), "parameter 'rules':2:10: '?2' reads as '?");
   EXPECT_EQ(r.results.warnings[0],
             "parameter 'rules':1:6: '/30' reads as '/' followed by the symbols '3', '0'; if 30 is its argument, "
             "write '/(30)'");
@@ -253,6 +254,12 @@ TEST(LSystemReference, AnimatedChannelsAreReadAtTheGenerationBeingMade) {
               draw("A", {"rules=A = F(chan(0))", "generations=1", "channels=1:x"});
             }),
             "channels: in '1:x', expected a number, found 'x'");
+  EXPECT_EQ(test::error_of([] {
+              draw("A", {"rules=A = F(chan(0))", "generations=1", "channels=1,,2"});
+            }),
+            "channels: channel 1 is empty; expected a number or keys generation:value");
+  // a space after a key's colon is read as written without one
+  EXPECT_EQ(draw("A", {"rules=A = F(chan(0))A", "generations=2", "channels=1: 1 3: 3"}).nodes.back().position.y, 3.0f);
 }
 
 // J/K/M's stamps set the settings of their shape that leaf_param_a/b/c name (Houdini's Leaf Params), as a

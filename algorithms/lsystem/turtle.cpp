@@ -29,7 +29,7 @@ bool fits_float(const glm::dvec3& p) {
 struct State {
   glm::dvec3 pos{0.0}, H{0.0, 1.0, 0.0}, L{-1.0, 0.0, 0.0}, U{0.0, 0.0, 1.0};
   double length = 0.0, width = 0.0, angle = 0.0, arc = 0.0, u = 0.0, v = 0.0;
-  double lage = 0.0;  // Point Attributes' lage: vertical_increment per drawn segment from the root
+  double lage = 0.0;  // Point Attributes' lage: vertical_increment per drawn segment along the path
   std::int32_t node = kNoParent;
   std::int32_t group = -1;
   std::uint32_t shoot = 0;

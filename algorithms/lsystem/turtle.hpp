@@ -83,7 +83,7 @@ struct TurtleSettings {
   const Image* color_image;                  // Apply Color: each node's Cd from it at the turtle's (u, v)
   const OrganStamps* stamps;                 // Leaf Params A, B, C; null when none is set
   // Houdini's Point Attributes: each node also gets up (the turtle's up vector), lage (vertical_increment
-  // per segment from the root) and gen (the rewrite that made the module drawing it: `generation`, the
+  // per drawn segment along the path) and gen (the rewrite that made the module drawing it: `generation`, the
   // plant's rewrites so far, less the module's age).
   bool point_attributes;
   double vertical_increment;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <span>
 
 #include <glm/gtc/quaternion.hpp>
@@ -247,9 +248,10 @@ class ShapeTests {
   Aabb tried_all_;
 };
 
-// The branch segments, for the test that an organ's box meets no segment's capsule but its stem's. An
-// organ's stem is the chain of segments from the branch point its node hangs from: a flower on a short,
-// fine pedicel sits within the capsule of the pedicel's first segments, which hold it rather than cross it.
+// The branch segments, for the test that an organ's shape comes within no segment's capsule but its
+// stem's (blocking_part). An organ's stem is the chain of segments from the branch point its node hangs
+// from: a flower on a short, fine pedicel sits within the capsule of the pedicel's first segments, which
+// hold it rather than cross it.
 class Branches {
  public:
   explicit Branches(const std::vector<PlantNode>& nodes)
@@ -299,19 +301,14 @@ class Branches {
     return starts ? std::pair{collar, 1.0f} : std::pair{0.0f, 1.0f - collar};
   }
 
-  // The organ's orientation turned (by the least rotation) so that its axis, its local +Z, points from the
-  // joint its stem leaves (or its chain's root) to its node; unchanged for an organ on no node, or at its
-  // joint.
+  // The organ's orientation pointed (pointed_along) from the joint its stem leaves, or its chain's first
+  // node where there is none, to its node; unchanged for an organ on no node.
   [[nodiscard]] glm::quat along_stem(const Organ& o) const {
     if (o.node == kNoParent) return o.orientation;
     const auto n = static_cast<std::size_t>(o.node);
     const std::int32_t joint = nodes_[chain_[n]].parent;
     const glm::vec3 from = nodes_[joint == kNoParent ? chain_[n] : static_cast<std::size_t>(joint)].position;
-    const glm::vec3 d = nodes_[n].position - from;
-    const float len = glm::length(d);
-    if (!(len > 1e-6f * std::max(1.0f, glm::length(from)))) return o.orientation;
-    const glm::vec3 axis = glm::normalize(o.orientation * glm::vec3(0, 0, 1));
-    return glm::rotation(axis, d / len) * o.orientation;
+    return pointed_along(o.orientation, from, nodes_[n].position);
   }
 
   // Whether a segment's blocking part (blocking_part) meets the shape of the candidate `tests`
@@ -390,6 +387,14 @@ bool boxes_overlap(const OrientedBox& a, const OrientedBox& b) {
   return true;
 }
 
+glm::quat pointed_along(const glm::quat& q, const glm::vec3& from, const glm::vec3& to) {
+  const glm::vec3 d = to - from;
+  const float len = glm::length(d);
+  if (!(len > 1e-6f * std::max(1.0f, glm::length(from)))) return q;
+  const glm::vec3 axis = glm::normalize(q * glm::vec3(0, 0, 1));
+  return glm::rotation(axis, d / len) * q;
+}
+
 bool capsule_meets_box(const glm::dvec3& p, const glm::dvec3& q, double r, const OrientedBox& box) {
   auto local = [&](const glm::dvec3& x) {
     const glm::dvec3 d = x - box.centre;
@@ -450,13 +455,13 @@ class Candidates {
       : fallbacks_(plant, opt), branches_(branches) {
     if (opt.turn_deg > 0.0) {
       const auto a = static_cast<float>(glm::radians(opt.turn_deg));
-      for (const glm::vec3 axis : {glm::vec3(1, 0, 0), glm::vec3(0, 1, 0)})
-        for (const float sign : {1.0f, -1.0f}) own_.push_back({glm::angleAxis(sign * a, axis), 1.0f, false});
-      own_.push_back({glm::quat(1, 0, 0, 0), 1.0f, true});
-      for (const glm::vec3 axis : {glm::vec3(1, 0, 0), glm::vec3(0, 1, 0)})
-        for (const float sign : {1.0f, -1.0f}) own_.push_back({glm::angleAxis(sign * a, axis), 1.0f, true});
+      for (const bool along : {false, true}) {
+        if (along) own_.push_back({std::nullopt, 1.0f, true});
+        for (const glm::vec3 axis : {glm::vec3(1, 0, 0), glm::vec3(0, 1, 0)})
+          for (const float sign : {1.0f, -1.0f}) own_.push_back({glm::angleAxis(sign * a, axis), 1.0f, along});
+      }
     }
-    if (opt.shrink < 1.0) own_.push_back({glm::quat(1, 0, 0, 0), opt.shrink, false});
+    if (opt.shrink < 1.0) own_.push_back({std::nullopt, opt.shrink, false});
   }
 
   [[nodiscard]] std::uint8_t count(OrganKind kind) const {
@@ -468,7 +473,7 @@ class Candidates {
     if (v <= own_.size()) {
       const Own& c = own_[v - 1];
       if (c.along) o.orientation = branches_.along_stem(o);
-      o.orientation = glm::normalize(o.orientation * c.turn);
+      if (c.turn) o.orientation = glm::normalize(o.orientation * *c.turn);
       o.size = static_cast<float>(o.size * c.scale);
       return o;
     }
@@ -477,7 +482,7 @@ class Candidates {
 
  private:
   struct Own {
-    glm::quat turn;
+    std::optional<glm::quat> turn;
     double scale;
     bool along;  // first pointed along its stem
   };

@@ -43,6 +43,9 @@ struct OrientedBox {
 };
 OrientedBox organ_box(const Organ& organ, const OrganShape& shape);
 bool boxes_overlap(const OrientedBox& a, const OrientedBox& b);
+// The orientation q turned by the least rotation that points its local +Z from `from` to `to`; q itself
+// where the two points are too close to give a direction.
+glm::quat pointed_along(const glm::quat& q, const glm::vec3& from, const glm::vec3& to);
 // Whether the capsule from p to q with radius r meets the box.
 bool capsule_meets_box(const glm::dvec3& p, const glm::dvec3& q, double r, const OrientedBox& box);
 

@@ -248,25 +248,6 @@ TEST(OrganPlacement, KeptOrgansNeverMeetAndTheResultIsTheSameForAnyThreadCount) 
   EXPECT_GT(before, 50u);
 }
 
-// The distance from a segment to a triangle, by ternary search along the segment (the distance to a
-// convex set is convex along a line), apart from geom::segment_triangle_distance's closed form.
-double reference_segment_triangle(const glm::vec3& a, const glm::vec3& b, const glm::vec3 (&t)[3]) {
-  auto f = [&](double s) {
-    const glm::dvec3 x = glm::dvec3(a) + s * (glm::dvec3(b) - glm::dvec3(a));
-    return glm::length(
-        x - geom::closest_feature_on_triangle(x, glm::dvec3(t[0]), glm::dvec3(t[1]), glm::dvec3(t[2])).point);
-  };
-  double lo = 0.0, hi = 1.0;
-  for (int k = 0; k < 60; ++k) {
-    const double m1 = lo + (hi - lo) / 3.0, m2 = hi - (hi - lo) / 3.0;
-    if (f(m1) < f(m2))
-      hi = m2;
-    else
-      lo = m1;
-  }
-  return std::min({f(0.0), f(1.0), f(0.5 * (lo + hi))});
-}
-
 float point_to_segment(const glm::vec3& x, const glm::vec3& a, const glm::vec3& b) {
   const glm::vec3 ab = b - a;
   const float l2 = glm::dot(ab, ab);
@@ -321,7 +302,7 @@ struct ReferenceBranches {
         if (std::min({point_to_segment(v[0], a, b), point_to_segment(v[1], a, b), point_to_segment(v[2], a, b)}) >
             r + edge + 1e-5f)
           continue;
-        if (reference_segment_triangle(a, b, v) < r) return true;
+        if (geom::segment_triangle_distance(a, b, v) < r) return true;
       }
     }
     return false;
@@ -330,10 +311,8 @@ struct ReferenceBranches {
   [[nodiscard]] Organ along_stem(Organ o) const {
     if (o.node == kNoParent) return o;
     const auto [joint, first] = joint_of(o.node);
-    const glm::vec3 d = node(o.node).position - node(joint == kNoParent ? first : joint).position;
-    if (glm::length(d) < 1e-6f) return o;
-    const glm::vec3 axis = glm::mat3_cast(o.orientation)[2];
-    o.orientation = glm::normalize(glm::rotation(glm::normalize(axis), glm::normalize(d)) * o.orientation);
+    o.orientation =
+        pointed_along(o.orientation, node(joint == kNoParent ? first : joint).position, node(o.node).position);
     return o;
   }
 };
@@ -366,8 +345,9 @@ std::vector<Organ> reference_candidates(const Organ& grown, const OrganOptions& 
   };
   if (opt.turn_deg != 0.0) {
     turned(grown);
-    out.push_back(b.along_stem(grown));
-    turned(out.back());
+    const Organ along = b.along_stem(grown);  // a copy: turned() adds to `out`
+    out.push_back(along);
+    turned(along);
   }
   if (opt.shrink < 1.0) {
     Organ s = grown;
@@ -490,13 +470,12 @@ TEST(OrganPlacement, DecidesAsTheBruteForceDefinitionForAnyThreadCount) {
       EXPECT_EQ(got.fallen_back, want.fallen_back) << threads;
       EXPECT_EQ(got.dropped, want.dropped) << threads;
       EXPECT_EQ(placed.organ_shapes, reference.organ_shapes) << threads;
-      // The same organs, each as the definition takes it; a turned organ's quaternion may differ in its last
-      // bit, as the two compute the same rotation in different translation units.
+      // The same organs, each as the definition takes it, with the same quaternions.
       ASSERT_EQ(placed.organs.size(), reference.organs.size()) << threads;
       for (std::size_t k = 0; k < placed.organs.size(); ++k) {
         const Organ &a = placed.organs[k], &b = reference.organs[k];
         EXPECT_TRUE(a.position == b.position && a.size == b.size && a.shape == b.shape && a.kind == b.kind &&
-                    a.node == b.node && std::abs(glm::dot(a.orientation, b.orientation)) > 1.0f - 1e-6f)
+                    a.node == b.node && a.orientation == b.orientation)
             << "organ " << k << ", " << threads << " threads";
       }
       hashes.push_back(placed.geometry_hash());
