@@ -550,6 +550,8 @@ class Interpreter {
       cd.insert(cd.end(), node_colors_.begin(), node_colors_.end());
     }
     if (s_.point_attributes) {
+      for (const auto& [name, comps] : {std::pair{"up", 3}, {"lage", 1}, {"gen", 1}}) per_node(name, comps);
+      // All three exist now, so holding one cannot be invalidated by making another.
       auto &up = per_node("up", 3), &lage = per_node("lage", 1), &gen = per_node("gen", 1);
       for (std::size_t q = 0; q + 5 <= node_points_.size(); q += 5) {
         up.insert(up.end(), node_points_.begin() + static_cast<std::ptrdiff_t>(q),
