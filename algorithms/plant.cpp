@@ -130,6 +130,13 @@ std::string Plant::geometry_hash() const {
     bytes("geometry", 8);
     put(branch_geometry);
   }
+  if (tube_style != TubeStyle{}) {
+    bytes("tubestyle", 9);
+    put(tube_style.tension);
+    put(tube_style.branch_blend);
+    put(tube_style.uvs);
+    put(tube_style.v_increment);
+  }
   hasher->flush();
   return fmt::format("{:016x}", XXH3_64bits_digest(hasher->st));
 }
@@ -210,6 +217,11 @@ std::string Plant::validate() const {
       return fmt::format("group prefix '{}' has a character other than letters, digits and '_'", group_prefix);
   if (branch_geometry != BranchGeometry::Tube && branch_geometry != BranchGeometry::Skeleton)
     return fmt::format("branch geometry {} is unknown", static_cast<int>(branch_geometry));
+  const TubeStyle& t = tube_style;
+  if (!(t.tension >= 0.0f && t.tension <= 1.0f) || !(t.branch_blend >= 0.0f && t.branch_blend <= 1.0f))
+    return fmt::format("tube tension {} and branch blend {} (expected each in [0, 1])", t.tension, t.branch_blend);
+  if (!std::isfinite(t.v_increment))
+    return fmt::format("tube v increment {} (expected a finite number)", t.v_increment);
   return {};
 }
 

@@ -66,6 +66,24 @@ constexpr int kMaxTubeSections = 64, kMinTubeDivisions = 3, kMaxTubeDivisions = 
 // Geometry Type Skeleton).
 enum class BranchGeometry : std::uint8_t { Tube, Skeleton };
 
+// How tubes run between their nodes and whether they carry texture coordinates (Houdini's Tube options).
+// The default keeps every tube as it was before these existed: rings on the straight segment, no UVs.
+struct TubeStyle {
+  // Of the rings inside a segment cut into sections: 1 puts them on the straight segment at equal steps;
+  // below 1 they follow a cardinal spline through the nodes, whose tangents are (1 - tension) times the
+  // central difference, so 0 sweeps most smoothly.
+  float tension = 1.0f;
+  // How much a side branch's first segment leaves along its parent's direction (0: its own straight line;
+  // 1: the tangent at the branch point is the parent's heading).
+  float branch_blend = 0.0f;
+  // Texture coordinates: u runs once around each ring (with a seam vertex), v grows by v_increment per
+  // segment from the root (Houdini's Vertical Increment), so that a bark image tiles along the branches.
+  bool uvs = false;
+  float v_increment = 1.0f;
+  bool operator==(const TubeStyle&) const = default;
+  [[nodiscard]] bool curved() const { return tension != 1.0f || branch_blend != 0.0f; }
+};
+
 // An image an algorithm paints over the scene's surfaces (the vines' texture). Renders lay it over the
 // surfaces' own material, and it stands for the plant there: a plant with decals is drawn by them.
 // The image's (u, v) cover [0, 1]^2 with v up: its top row is v = 1, as in OBJ texture coordinates.
@@ -94,6 +112,7 @@ struct Plant {
   // Group g of node_groups is named group_prefix + g (group_name); letters, digits and '_' only.
   std::string group_prefix;
   BranchGeometry branch_geometry = BranchGeometry::Tube;
+  TubeStyle tube_style;
 
   void clear() {
     nodes.clear();
@@ -106,13 +125,14 @@ struct Plant {
     node_tubes.clear();
     group_prefix.clear();
     branch_geometry = BranchGeometry::Tube;
+    tube_style = {};
   }
   // The name of group g (>= 0): group_prefix + g, or "group" + g without a prefix.
   [[nodiscard]] std::string group_name(std::int32_t g) const;
   [[nodiscard]] std::size_t leaf_count() const;
   [[nodiscard]] double total_length() const;  // sum of segment lengths (node to parent)
   // A hash of the canonical content (positions, radii, topology, organs, polygons, and the optional
-  // per-node data, group prefix and branch geometry when present) as 16 hex digits. Equal hashes mean
+  // per-node data, group prefix, branch geometry and tube style when present) as 16 hex digits. Equal hashes mean
   // bit-identical plants; a plant without the optional data hashes as it did before they existed.
   [[nodiscard]] std::string geometry_hash() const;
   // Whether some organ has a shape or tint of its own (what hashes and snapshots then carry).

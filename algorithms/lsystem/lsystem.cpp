@@ -19,6 +19,7 @@
 #include <cstring>
 #include <ctime>
 #include <filesystem>
+#include <numbers>
 #include <optional>
 #include <sstream>
 
@@ -65,7 +66,12 @@ const AlgorithmInfo kInfo = {
             param::real("angle_scale", 0.9).range(0, 1e4).doc("factor of ; (and divisor of @)"),
             param::real("thickness", 0.02).range(0, 1e3).unit("m").doc("initial width (node radius = width / 2)"),
             param::real("thickness_scale", 0.7).range(0, 1e4).doc("factor of ! (and divisor of ?)"),
-            param::real("gravity", 0.2).range(-100, 100).doc("tropism of T toward -Y (radians per unit sin); also T"),
+            param::real("gravity", 0.2)
+                .range(-100, 100)
+                .doc("tropism of T toward -Y (per unit sin, in gravity_units); also T"),
+            param::choice("gravity_units", "radians", {"radians", "degrees"})
+                .doc("what T's amount bends by per unit sin: radians (ABOP's tropism) or degrees, as every other "
+                     "turtle angle (a grammar written for Houdini with T(5) on short stems)"),
             param::real("random_scale", 0.0)
                 .range(0, 1)
                 .doc("every move length is scaled by 1 + random_scale * uniform(-1, 1)"),
@@ -140,6 +146,16 @@ const AlgorithmInfo kInfo = {
             param::choice("geometry", "tube", {"tube", "skeleton"})
                 .doc("tube: tubes around the branches (F(l,w,s,d): s cross sections, d divisions); skeleton: "
                      "the branches' polylines alone (Houdini's Geometry Type)"),
+            param::real("tension", 1.0)
+                .range(0, 1)
+                .doc("Houdini's Tension, for the sections inside an F: 1 keeps them on the straight segment, lower "
+                     "sweeps them along a smooth curve through the nodes"),
+            param::real("branch_blend", 0.0)
+                .range(0, 1)
+                .doc("Houdini's Branch Blend: how much a branch's first sections leave along its parent's heading"),
+            param::boolean("tube_uvs", false)
+                .doc("Houdini's Apply Tube Texture Coordinates: u around each tube, v growing by vertical_increment "
+                     "per segment"),
             param::text("group_prefix", "lsys")
                 .doc("names of g groups: the prefix and the group number (letters, digits and _)"),
             param::integer("max_symbols", 50'000'000)
@@ -478,6 +494,7 @@ Setup make_setup(const Params& given, std::uint64_t seed, const SceneQuery* quer
       .thickness = p.real("thickness"),
       .thickness_scale = p.real("thickness_scale"),
       .gravity = p.real("gravity"),
+      .gravity_unit = p.text("gravity_units") == "degrees" ? std::numbers::pi / 180.0 : 1.0,
       .random_scale = p.real("random_scale"),
       .uv_increment = {p.real("u_increment"), p.real("v_increment")},
       .convention = p.text("convention") == "abop" ? lsys::Convention::Abop : lsys::Convention::Houdini,
@@ -635,6 +652,11 @@ class LSystem final : public GrowthAlgorithm {
     plant_.group_prefix = setup_.params.text("group_prefix");
     plant_.branch_geometry =
         setup_.params.text("geometry") == "skeleton" ? BranchGeometry::Skeleton : BranchGeometry::Tube;
+    plant_.tube_style = {.tension = static_cast<float>(setup_.params.real("tension")),
+                         .branch_blend = static_cast<float>(setup_.params.real("branch_blend")),
+                         .uvs = setup_.params.boolean("tube_uvs"),
+                         .v_increment = static_cast<float>(setup_.params.real("vertical_increment"))};
+    if (!plant_.tube_style.uvs) plant_.tube_style.v_increment = TubeStyle{}.v_increment;  // unused: keeps the hash
     for (auto& pl : plants_) {
       if (!pl.started) continue;
       lsys::TurtleSettings ts = setup_.turtle;

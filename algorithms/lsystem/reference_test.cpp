@@ -1,6 +1,6 @@
 // The Houdini L-system reference's semantics where growbench once read it otherwise: T(g) bends toward -Y
-// and never past it, ~(a) turns the heading by at most a, % removes the rest of its branch from the string,
-// rand() differs between the plants of one scene, and a grammar file's settings are what the record keeps.
+// and never past it (in radians or degrees), ~(a) turns the heading by at most a, % removes the rest of its branch from
+// the string, rand() differs between the plants of one scene, and a grammar file's settings are what the record keeps.
 #include <cmath>
 #include <filesystem>
 #include <numbers>
@@ -68,6 +68,15 @@ TEST(LSystemReference, GravityBendsTowardDownAndNeverPastIt) {
   // Again and again it stays down; a negative g lifts it, at most to straight up.
   EXPECT_NEAR(segment(draw("FF+(90)FT(5)FT(5)FT(5)F"), 6).y, -1.0, 1e-6);
   EXPECT_NEAR(segment(draw("FF+(90)FT(-5)F"), 4).y, 1.0, 1e-6);
+}
+
+// gravity_units=degrees reads T's amount as an angle, as every other turtle angle: from horizontal, T(5)
+// bends the next segment 5 degrees down rather than hanging it. The gravity parameter, T's default, too.
+TEST(LSystemReference, GravityInDegreesBendsByThatAngle) {
+  const double five = 5.0 * std::numbers::pi / 180.0;
+  EXPECT_NEAR(segment(draw("FF+(90)FT(5)F", {"gravity_units=degrees"}), 4).y, -std::sin(five), 1e-6);
+  EXPECT_NEAR(segment(draw("FF+(90)FTF", {"gravity_units=degrees", "gravity=5"}), 4).y, -std::sin(five), 1e-6);
+  EXPECT_NEAR(segment(draw("FF+(90)FTF", {"gravity=0.5"}), 4).y, -std::sin(0.5), 1e-6);
 }
 
 // ~(a) draws a heading within a degrees of the current one: over many draws none turns further, and they

@@ -156,7 +156,7 @@ class Interpreter {
           break;
         }
         case 'T': {
-          const double g = k > 0 ? a[0] : s_.gravity;
+          const double g = (k > 0 ? a[0] : s_.gravity) * s_.gravity_unit;
           const glm::dvec3 down(0.0, -1.0, 0.0);
           const glm::dvec3 axis = glm::cross(t.H, down);
           const double sin_between = glm::length(axis);

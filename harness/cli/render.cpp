@@ -52,7 +52,7 @@ Command add_render(CLI::App& app) {
       ->check(integer_in(0, 16384));
   cmd->add_option("--branches", ro.branches,
                   "branches as cones (cone and sphere chains) or mesh "
-                  "(the mesher's tubes as mesh2)")
+                  "(the mesher's tubes as mesh2; always for tubes an L-system's tension or branch_blend curves)")
       ->default_val("cones")
       ->check(CLI::IsMember({"cones", "mesh"}));
   cmd->add_option("--min-branch-px", ro.min_branch_px,

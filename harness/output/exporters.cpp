@@ -214,6 +214,10 @@ std::uint64_t write_obj(const std::string& path, const OutputMesh& m) {
     const glm::vec3& n = m.normals[i];
     fmt::format_to(fmt::appender(b), FMT_COMPILE("vn {:.4f} {:.4f} {:.4f}\n"), n.x, n.y, n.z);
   });
+  // Texture coordinates share the vertices' numbering, as the normals do.
+  out.records(m.uvs.size(), [&](std::size_t i, Buf& b) {
+    fmt::format_to(fmt::appender(b), FMT_COMPILE("vt {:.6g} {:.6g}\n"), m.uvs[i].x, m.uvs[i].y);
+  });
   for (const auto& g : m.groups) {
     if (g.plant_group.empty())
       out.print("g {}\nusemtl {}\n", g.name, g.material);
@@ -221,7 +225,10 @@ std::uint64_t write_obj(const std::string& path, const OutputMesh& m) {
       out.print("g {} {}\nusemtl {}\n", g.name, g.plant_group, g.material);
     out.records(g.triangle_count, [&](std::size_t i, Buf& b) {
       const glm::uvec3 f = m.triangles[g.first_triangle + i] + glm::uvec3(1);
-      fmt::format_to(fmt::appender(b), FMT_COMPILE("f {0}//{0} {1}//{1} {2}//{2}\n"), f.x, f.y, f.z);
+      if (m.uvs.empty())
+        fmt::format_to(fmt::appender(b), FMT_COMPILE("f {0}//{0} {1}//{1} {2}//{2}\n"), f.x, f.y, f.z);
+      else
+        fmt::format_to(fmt::appender(b), FMT_COMPILE("f {0}/{0}/{0} {1}/{1}/{1} {2}/{2}/{2}\n"), f.x, f.y, f.z);
     });
     out.records(g.line_count, [&](std::size_t i, Buf& b) {
       const glm::uvec2 l = m.lines[g.first_line + i] + glm::uvec2(1);
@@ -234,8 +241,9 @@ std::uint64_t write_obj(const std::string& path, const OutputMesh& m) {
 std::uint64_t write_ply(const std::string& path, const OutputMesh& m) {
   auto file = std::make_unique<AtomicFile>(path);
   AtomicFile& f = *file;
-  const bool extras = !m.colors.empty() || !m.attributes.empty();
+  const bool extras = !m.colors.empty() || !m.attributes.empty() || !m.uvs.empty();
   std::string vertex_extras, edges;
+  if (!m.uvs.empty()) vertex_extras += "property float s\nproperty float t\n";  // the names most readers take
   if (!m.colors.empty()) vertex_extras += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
   for (const auto& a : m.attributes)
     for (const auto& name : ply_properties(a.name, a.components))
@@ -259,6 +267,7 @@ std::uint64_t write_ply(const std::string& path, const OutputMesh& m) {
     for (std::size_t i = 0; i < m.positions.size(); ++i) {
       r.put(m.positions[i]);
       r.put(m.normals[i]);
+      if (!m.uvs.empty()) r.put(m.uvs[i]);
       if (!m.colors.empty())
         for (int c = 0; c < 3; ++c) r.put(srgb_byte(m.colors[i][c]));
       for (const auto& a : m.attributes)
@@ -396,6 +405,11 @@ std::map<std::string, int> shared_attributes(GltfBuilder& b, const OutputMesh& m
     for (auto& c : clamped) c = glm::clamp(c, glm::vec3(0.0f), glm::vec3(1.0f));
     attrs["COLOR_0"] = b.vertex_floats(&clamped[0].x, nv, 3);
   }
+  if (!m.uvs.empty()) {  // glTF's v runs down the image, OBJ's up
+    std::vector<glm::vec2> flipped(b.count_only ? 0 : nv);
+    for (std::size_t i = 0; i < flipped.size(); ++i) flipped[i] = {m.uvs[i].x, 1.0f - m.uvs[i].y};
+    attrs["TEXCOORD_0"] = b.vertex_floats(b.count_only ? nullptr : &flipped[0].x, nv, 2);
+  }
   if (m.birth_steps.size() == nv && b.count_only) {
     attrs[kBirthStep] = b.vertex_floats(nullptr, nv, 1);
   } else if (m.birth_steps.size() == nv) {
@@ -430,7 +444,7 @@ void build_plain_glb(GltfBuilder& b, const OutputMesh& m) {
     return;
   }
   // One allocation for the whole binary chunk (positions, normals, indices, each padded to 4 bytes).
-  std::size_t vertex_floats = (m.colors.empty() ? 6 : 9) + (m.birth_steps.empty() ? 0 : 1);
+  std::size_t vertex_floats = (m.colors.empty() ? 6 : 9) + (m.birth_steps.empty() ? 0 : 1) + (m.uvs.empty() ? 0 : 2);
   for (const auto& a : m.attributes) vertex_floats += static_cast<std::size_t>(a.components);
   if (!b.count_only)
     b.buffer.data.reserve(vertex_floats * m.positions.size() * sizeof(float) + m.triangles.size() * sizeof(glm::uvec3) +
@@ -867,6 +881,11 @@ Json piece_attributes(CompactGlb& g, const OutputMesh& m, const Piece& p, const 
             static_cast<std::uint16_t>(std::lround(std::clamp(m.colors[p.vertices[i]][k], 0.0f, 1.0f) * 65535.0f));
     attrs["COLOR_0"] = vertex_accessor(g, col, kUnsignedShort, "VEC3", true);
   }
+  if (!m.uvs.empty()) {  // float: v grows along the branches without bound, so it does not normalize
+    std::vector<std::array<float, 2>> uv(n);
+    for (std::size_t i = 0; i < n; ++i) uv[i] = {m.uvs[p.vertices[i]].x, 1.0f - m.uvs[p.vertices[i]].y};
+    attrs["TEXCOORD_0"] = vertex_accessor(g, uv, kFloat, "VEC2", false);
+  }
   if (m.birth_steps.size() == m.positions.size()) {
     std::vector<std::uint32_t> steps(n);
     for (std::size_t i = 0; i < n; ++i) steps[i] = m.birth_steps[p.vertices[i]];
@@ -1202,12 +1221,13 @@ constexpr char kAttributesTag[4] = {'A', 'T', 'T', 'R'};  // u64 n, per attribut
                                                           // i32 components, u64 value count, floats
 constexpr char kTubesTag[4] = {'T', 'U', 'B', 'E'};       // u64 n, per node u16 sections, u16 divisions
 constexpr char kGeometryTag[4] = {'G', 'E', 'O', 'M'};    // u8 branch geometry
+constexpr char kTubeStyleTag[4] = {'T', 'S', 'T', 'Y'};   // f32 tension, f32 branch blend, u8 uvs, f32 v increment
 constexpr char kOrganStyleTag[4] = {'O', 'R', 'G', 'N'};  // u64 n, per shape name: u64 length, name;
                                                           // per organ u16 shape, 3 f32 tint
 
 bool has_sections(const Plant& p) {
   return !p.node_groups.empty() || !p.node_attributes.empty() || !p.node_tubes.empty() ||
-         p.branch_geometry != BranchGeometry::Tube || p.organs_styled();
+         p.branch_geometry != BranchGeometry::Tube || p.tube_style != TubeStyle{} || p.organs_styled();
 }
 
 void put_tag(AtomicFile& b, const char (&tag)[4], std::size_t length) {
@@ -1247,6 +1267,13 @@ void write_sections(AtomicFile& b, const Plant& plant) {
   if (plant.branch_geometry != BranchGeometry::Tube) {
     put_tag(b, kGeometryTag, 1);
     put(b, static_cast<std::uint8_t>(plant.branch_geometry));
+  }
+  if (plant.tube_style != TubeStyle{}) {
+    put_tag(b, kTubeStyleTag, 4 + 4 + 1 + 4);
+    put(b, plant.tube_style.tension);
+    put(b, plant.tube_style.branch_blend);
+    put(b, static_cast<std::uint8_t>(plant.tube_style.uvs));
+    put(b, plant.tube_style.v_increment);
   }
   if (plant.organs_styled()) {
     std::size_t length = 8 + plant.organs.size() * (2 + 12);
@@ -1293,6 +1320,11 @@ void read_sections(SnapshotReader& r, Plant& plant) {
       const auto geometry = r.get<std::uint8_t>();
       if (geometry > static_cast<std::uint8_t>(BranchGeometry::Skeleton)) r.fail("has an unknown branch geometry");
       plant.branch_geometry = static_cast<BranchGeometry>(geometry);
+    } else if (is(kTubeStyleTag)) {
+      plant.tube_style.tension = r.get<float>();
+      plant.tube_style.branch_blend = r.get<float>();
+      plant.tube_style.uvs = r.get<std::uint8_t>() != 0;
+      plant.tube_style.v_increment = r.get<float>();
     } else if (is(kOrganStyleTag)) {
       plant.organ_shapes.resize(r.count(8));
       for (auto& name : plant.organ_shapes) name = r.text(r.count(1));

@@ -58,6 +58,8 @@ struct TubeExtras {
   const NodeAttribute* cd = nullptr;                  // a("Cd", ...): vertex colours
   std::vector<const NodeAttribute*> attributes;       // the other a(): OutputMesh::attributes from `first_attribute`
   std::size_t first_attribute = 0;
+  TubeStyle style;
+  std::vector<float> v;  // each node's texture v, when style.uvs
   [[nodiscard]] bool vertex_data() const { return cd != nullptr || !attributes.empty(); }
 };
 
@@ -97,11 +99,13 @@ std::int32_t group_of(const TubeExtras& x, std::int32_t node) {
 // Rings start..end of a tube with `sides` vertices each, the frame carried along from `normal`
 // (parallel transport in projection form: the previous normal made perpendicular to the tangent), then
 // the quads between them. One loop with its values in locals, as this is most of a big plant's meshing.
+// With texture v per ring (`tex_v`), each ring has a seam vertex more, at u = 1 over the first.
 void add_strip(OutputMesh& m, const std::vector<glm::vec3>& pts, const std::vector<float>& rad, std::size_t start,
-               std::size_t end, int sides, glm::vec3& normal) {
+               std::size_t end, int sides, glm::vec3& normal, const std::vector<float>* tex_v) {
   const auto base = static_cast<std::uint32_t>(m.positions.size());
   const std::size_t n = pts.size();
   const float fsides = static_cast<float>(sides);
+  const int ring = sides + (tex_v ? 1 : 0);
   glm::vec3 carried = normal;
   for (std::size_t j = start; j <= end; ++j) {
     const glm::vec3 a = pts[j == 0 ? 0 : j - 1], b = pts[j + 1 < n ? j + 1 : j];
@@ -110,20 +114,22 @@ void add_strip(OutputMesh& m, const std::vector<glm::vec3>& pts, const std::vect
     if (glm::length(nrm) < 1e-6f) nrm = any_perpendicular(t);
     carried = glm::normalize(nrm);
     const glm::vec3 binormal = glm::cross(t, carried);
-    for (int s = 0; s < sides; ++s) {
-      const float ang = 2.0f * std::numbers::pi_v<float> * static_cast<float>(s) / fsides;
+    for (int s = 0; s < ring; ++s) {
+      const int around = s % sides;  // the seam vertex repeats the first's position
+      const float ang = 2.0f * std::numbers::pi_v<float> * static_cast<float>(around) / fsides;
       const glm::vec3 d = std::cos(ang) * carried + std::sin(ang) * binormal;
       m.positions.push_back(pts[j] + rad[j] * d);
       m.normals.push_back(d);
+      if (tex_v) m.uvs.emplace_back(static_cast<float>(s) / fsides, (*tex_v)[j]);
     }
   }
   normal = carried;
-  const auto S = static_cast<std::uint32_t>(sides);
+  const auto S = static_cast<std::uint32_t>(sides), R = static_cast<std::uint32_t>(ring);
   const auto segments = static_cast<std::uint32_t>(end - start);
   for (std::uint32_t j = 0; j < segments; ++j) {
     for (std::uint32_t s = 0; s < S; ++s) {
-      const std::uint32_t a = base + j * S + s, b = base + j * S + (s + 1) % S;
-      const std::uint32_t c = a + S, d = b + S;
+      const std::uint32_t a = base + j * R + s, b = base + j * R + (s + 1) % R;
+      const std::uint32_t c = a + R, d = b + R;
       m.triangles.emplace_back(a, b, d);
       m.triangles.emplace_back(a, d, c);
     }
@@ -131,50 +137,100 @@ void add_strip(OutputMesh& m, const std::vector<glm::vec3>& pts, const std::vect
 }
 
 // The rings of a tube along a chain: points and radii; and, only when needed, the divisions of each
-// segment (ring j to j + 1) and each ring's source of per-node values.
+// segment (ring j to j + 1), each ring's source of per-node values and its texture v.
 struct TubePath {
   std::vector<glm::vec3> pts;
   std::vector<float> rad;
   std::vector<std::uint16_t> divisions;  // when the plant has node tubes
   std::vector<RingSource> src;           // when `sources`
   std::vector<std::uint32_t> steps;      // each ring's birth step: its segment's end node's
+  std::vector<float> v;                  // when the style has UVs
   bool sources = false;
 };
 
-// Points and radii along the chain, with the rings inside each segment's sections; a side branch starts
-// at its parent's node with its own radius.
+// The chain's nodes that start a segment of non-zero length (the first always), as indices into `chain`.
+std::vector<std::size_t> kept_nodes(const Plant& plant, const std::vector<std::int32_t>& chain) {
+  std::vector<std::size_t> kept;
+  glm::vec3 last(0.0f);
+  for (std::size_t j = 0; j < chain.size(); ++j) {
+    const glm::vec3 p = plant.nodes[static_cast<std::size_t>(chain[j])].position;
+    if (!kept.empty() && glm::length(p - last) < 1e-7f) continue;
+    kept.push_back(j);
+    last = p;
+  }
+  return kept;
+}
+
+// The tangents of TubeStyle's cardinal spline at the kept nodes. A side branch's first tangent leans
+// toward the heading its parent arrived with, by branch_blend.
+std::vector<glm::vec3> chain_tangents(const Plant& plant, const std::vector<std::int32_t>& chain,
+                                      const std::vector<std::size_t>& kept, const TubeStyle& style) {
+  const std::size_t n = kept.size();
+  auto at = [&](std::size_t i) { return plant.nodes[static_cast<std::size_t>(chain[kept[i]])].position; };
+  const float k = 1.0f - style.tension;
+  std::vector<glm::vec3> t(n, glm::vec3(0.0f));
+  if (n < 2) return t;
+  t[0] = k * (at(1) - at(0));
+  t[n - 1] = k * (at(n - 1) - at(n - 2));
+  for (std::size_t i = 1; i + 1 < n; ++i) t[i] = 0.5f * k * (at(i + 1) - at(i - 1));
+  const PlantNode& first = plant.nodes[static_cast<std::size_t>(chain[0])];
+  if (first.parent != kNoParent && style.branch_blend > 0.0f) {  // a chain starts at a root or a branch point
+    const glm::vec3 in = first.position - plant.nodes[static_cast<std::size_t>(first.parent)].position;
+    if (glm::length(in) > 0.0f)
+      t[0] = glm::mix(t[0], glm::normalize(in) * glm::length(at(1) - at(0)), style.branch_blend);
+  }
+  return t;
+}
+
+// The point a fraction f along the segment from node p0 to p1: on the straight segment, or on the
+// Hermite curve with tangents m0 and m1 when the style curves tubes.
+glm::vec3 section_point(const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& m0, const glm::vec3& m1, float f,
+                        bool curved) {
+  if (!curved) return p0 + (p1 - p0) * f;
+  const float f2 = f * f, f3 = f2 * f;
+  return (2 * f3 - 3 * f2 + 1) * p0 + (f3 - 2 * f2 + f) * m0 + (-2 * f3 + 3 * f2) * p1 + (f3 - f2) * m1;
+}
+
+// Points and radii along the chain; most plants need nothing else, in vectors that do not escape.
+void plain_tube_path(TubePath& t, const Plant& plant, const std::vector<std::int32_t>& chain, const MesherOptions& o) {
+  std::vector<glm::vec3> pts;
+  std::vector<float> rad;
+  std::vector<std::uint32_t> steps;
+  for (std::size_t j = 0; j < chain.size(); ++j) {
+    const auto& node = plant.nodes[static_cast<std::size_t>(chain[j])];
+    const glm::vec3 p = node.position;
+    if (!pts.empty() && glm::length(p - pts.back()) < 1e-7f) continue;  // drop zero-length segments
+    float r = node.radius;
+    // A chain's first ring is its first segment's: it appears with that segment's end.
+    std::uint32_t step = node.birth_step;
+    if (j == 0 && chain.size() > 1) {
+      const auto& next = plant.nodes[static_cast<std::size_t>(chain[1])];
+      if (next.shoot != node.shoot) r = std::min(r, next.radius);
+      step = next.birth_step;
+    }
+    pts.push_back(p);
+    rad.push_back(std::max(r, o.min_radius > 0.0f ? o.min_radius : 1e-4f));
+    steps.push_back(step);
+  }
+  t.pts = std::move(pts);
+  t.rad = std::move(rad);
+  t.steps = std::move(steps);
+}
+
+// Points and radii along the chain, with the rings inside each segment's sections (on the style's
+// curve); a side branch starts at its parent's node with its own radius.
 void tube_path(TubePath& t, const Plant& plant, const std::vector<std::int32_t>& chain, const MesherOptions& o,
                const TubeExtras& x, int sides) {
-  if (!x.tubes && !t.sources) {  // most plants: points and radii alone, in vectors that do not escape
-    std::vector<glm::vec3> pts;
-    std::vector<float> rad;
-    std::vector<std::uint32_t> steps;
-    for (std::size_t j = 0; j < chain.size(); ++j) {
-      const auto& node = plant.nodes[static_cast<std::size_t>(chain[j])];
-      const glm::vec3 p = node.position;
-      if (!pts.empty() && glm::length(p - pts.back()) < 1e-7f) continue;  // drop zero-length segments
-      float r = node.radius;
-      // A chain's first ring is its first segment's: it appears with that segment's end.
-      std::uint32_t step = node.birth_step;
-      if (j == 0 && chain.size() > 1) {
-        const auto& next = plant.nodes[static_cast<std::size_t>(chain[1])];
-        if (next.shoot != node.shoot) r = std::min(r, next.radius);
-        step = next.birth_step;
-      }
-      pts.push_back(p);
-      rad.push_back(std::max(r, o.min_radius > 0.0f ? o.min_radius : 1e-4f));
-      steps.push_back(step);
-    }
-    t.pts = std::move(pts);
-    t.rad = std::move(rad);
-    t.steps = std::move(steps);
-    return;
-  }
-  for (std::size_t j = 0; j < chain.size(); ++j) {
+  if (!x.tubes && !t.sources && !x.style.uvs) return plain_tube_path(t, plant, chain, o);
+  const std::vector<std::size_t> kept = kept_nodes(plant, chain);
+  const bool curved = x.tubes && x.style.curved();
+  const std::vector<glm::vec3> tangents =
+      curved ? chain_tangents(plant, chain, kept, x.style) : std::vector<glm::vec3>();
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    const std::size_t j = kept[i];
     const auto id = chain[j];
     const auto& node = plant.nodes[static_cast<std::size_t>(id)];
     const glm::vec3 p = node.position;
-    if (!t.pts.empty() && glm::length(p - t.pts.back()) < 1e-7f) continue;  // drop zero-length segments
     // A lateral branch (its first node's shoot differs from the parent's) starts with its own radius,
     // and its own values: those of its first segment's end.
     float r = node.radius;
@@ -189,19 +245,22 @@ void tube_path(TubePath& t, const Plant& plant, const std::vector<std::int32_t>&
       step = next.birth_step;
     }
     r = std::max(r, o.min_radius > 0.0f ? o.min_radius : 1e-4f);
-    if (x.tubes && !t.pts.empty()) {
+    const float tex_v = x.style.uvs ? x.v[static_cast<std::size_t>(id)] : 0.0f;
+    if (x.tubes && i > 0) {
       const TubeShape shape = (*x.tubes)[static_cast<std::size_t>(id)];
       const auto d = static_cast<std::uint16_t>(shape.divisions != 0 ? shape.divisions : sides);
       const glm::vec3 p0 = t.pts.back();
-      const float r0 = t.rad.back();
+      const float r0 = t.rad.back(), v0 = x.style.uvs ? t.v.back() : 0.0f;
       const std::int32_t from = t.sources ? t.src.back().b : id;
+      const glm::vec3 m0 = curved ? tangents[i - 1] : glm::vec3(0.0f), m1 = curved ? tangents[i] : glm::vec3(0.0f);
       for (int k = 1; k < shape.sections; ++k) {  // the section boundaries inside the segment
         const float f = static_cast<float>(k) / static_cast<float>(shape.sections);
-        t.pts.push_back(p0 + (p - p0) * f);
+        t.pts.push_back(section_point(p0, p, m0, m1, f, curved));
         t.rad.push_back(r0 + (r - r0) * f);
         t.divisions.push_back(d);
         t.steps.push_back(node.birth_step);
         if (t.sources) t.src.push_back({from, id, f});
+        if (x.style.uvs) t.v.push_back(v0 + (tex_v - v0) * f);
       }
       t.divisions.push_back(d);
     }
@@ -209,6 +268,7 @@ void tube_path(TubePath& t, const Plant& plant, const std::vector<std::int32_t>&
     t.rad.push_back(r);
     t.steps.push_back(step);
     if (t.sources) t.src.push_back({own, own, 0.0f});
+    if (x.style.uvs) t.v.push_back(tex_v);
   }
 }
 
@@ -239,11 +299,11 @@ void add_tube(OutputMesh& m, const Plant& plant, const std::vector<std::int32_t>
     std::size_t end = divisions.empty() ? pts.size() - 1 : start + 1;
     while (end + 1 < pts.size() && segment_divisions(end) == d) ++end;
     const auto base = static_cast<std::uint32_t>(m.positions.size());
-    add_strip(m, pts, rad, start, end, d, normal);
-    const auto S = static_cast<std::uint32_t>(d);
-    for (std::size_t j = start; j <= end; ++j) m.birth_steps.insert(m.birth_steps.end(), S, path.steps[j]);
+    add_strip(m, pts, rad, start, end, d, normal, x.style.uvs ? &path.v : nullptr);
+    const auto S = static_cast<std::uint32_t>(d), R = S + (x.style.uvs ? 1 : 0);
+    for (std::size_t j = start; j <= end; ++j) m.birth_steps.insert(m.birth_steps.end(), R, path.steps[j]);
     if (vertex_data)
-      for (std::size_t j = start; j <= end; ++j) add_vertex_data(m, x, src[j], S);
+      for (std::size_t j = start; j <= end; ++j) add_vertex_data(m, x, src[j], R);
     if (triangle_groups)
       for (std::size_t j = start; j < end; ++j)
         triangle_groups->insert(triangle_groups->end(), 2 * S, group_of(x, src[j + 1].b));
@@ -251,7 +311,7 @@ void add_tube(OutputMesh& m, const Plant& plant, const std::vector<std::int32_t>
       first_ring = base;
       first_sides = d;
     }
-    last_ring = base + static_cast<std::uint32_t>(end - start) * S;
+    last_ring = base + static_cast<std::uint32_t>(end - start) * R;
     last_sides = d;
     start = end;
   }
@@ -264,6 +324,7 @@ void add_tube(OutputMesh& m, const Plant& plant, const std::vector<std::int32_t>
       m.normals.push_back(start ? -t : t);
       m.birth_steps.push_back(path.steps[j]);
       if (vertex_data) add_vertex_data(m, x, src[j], 1);
+      if (x.style.uvs) m.uvs.emplace_back(0.5f, path.v[j]);
       const std::uint32_t ring = start ? first_ring : last_ring;
       const auto S = static_cast<std::uint32_t>(start ? first_sides : last_sides);
       for (std::uint32_t s = 0; s < S; ++s) {
@@ -332,6 +393,17 @@ void add_branches(OutputMesh& m, const Plant& plant, const MesherOptions& o) {
     m.attributes.back().values.resize(m.positions.size() * static_cast<std::size_t>(a.components), 0.0f);
   }
   if (x.cd) pad_colors(m);
+  x.style = plant.tube_style;
+  if (x.style.uvs && plant.branch_geometry == BranchGeometry::Tube) {
+    m.uvs.resize(m.positions.size(), glm::vec2(0.0f));
+    x.v.resize(plant.nodes.size());  // parents precede children
+    for (std::size_t i = 0; i < plant.nodes.size(); ++i) {
+      const std::int32_t p = plant.nodes[i].parent;
+      x.v[i] = p == kNoParent ? 0.0f : x.v[static_cast<std::size_t>(p)] + x.style.v_increment;
+    }
+  } else {
+    x.style.uvs = false;
+  }
   std::vector<std::int32_t> groups;  // per triangle or line, when the plant has groups
   const auto first_triangle = m.triangles.size(), first_line = m.lines.size();
   if (plant.branch_geometry == BranchGeometry::Skeleton) {
@@ -385,6 +457,7 @@ void complete_vertex_data(OutputMesh& m) {
       if (std::isnan(c.x)) c = material_color("");  // in no part
   }
   for (auto& a : m.attributes) a.values.resize(m.positions.size() * static_cast<std::size_t>(a.components), 0.0f);
+  if (!m.uvs.empty()) m.uvs.resize(m.positions.size(), glm::vec2(0.0f));
 }
 
 void add_organ(OutputMesh& m, const Organ& organ, const OrganShape& shape, const glm::vec3* color, std::uint32_t step) {

@@ -63,6 +63,9 @@ struct OutputMesh {
   // vertex it adds; mesh_plant gives the vertices left without one their group's material_color.
   std::vector<glm::vec3> colors;
   std::vector<VertexAttribute> attributes;  // each empty or complete, as colors
+  // Texture coordinates (OBJ convention, v up): empty unless the plant's TubeStyle asks for them, else one
+  // per position, (0, 0) on vertices of parts without their own (organs, polygons).
+  std::vector<glm::vec2> uvs;
   // The growth step at which each vertex's part of the plant appeared (PlantNode::birth_step of the node
   // a tube ring or skeleton vertex stands for, of an organ's node), one per position, so that a viewer can
   // show the plant as it grew. Not an `attributes` entry: it never reaches OBJ or PLY, and the glTF writer

@@ -535,12 +535,23 @@ void write_cones(Out out, const Plant& plant, const RadiusFloor& floor) {
         });
 }
 
-// Branches as RenderOptions::branches asks: cone chains, or the mesher's tubes as one mesh2.
+// Whether some tube's sections leave its straight segment (TubeStyle), which cones cannot draw.
+bool curved_tubes(const Plant& plant) {
+  return plant.tube_style.curved() && std::any_of(plant.node_tubes.begin(), plant.node_tubes.end(),
+                                                  [](const TubeShape& t) { return t.sections > 1; });
+}
+
+// Branches as RenderOptions::branches asks: cone chains, or the mesher's tubes as one mesh2. Curved tubes
+// are drawn as the mesh either way, so that the picture shows what the files hold.
 void write_branches(Out out, const Plant& plant, const RenderOptions& o, const Camera& camera) {
-  if (o.branches == "mesh") {
-    Plant branches;  // the tubes alone, with the cross sections and divisions F(l,w,s,d) gave them
+  if (o.branches != "cones" && o.branches != "mesh")
+    throw InputError(fmt::format("render branches '{}': expected cones or mesh", o.branches));
+  if (o.branches == "mesh" || curved_tubes(plant)) {
+    Plant branches;  // the tubes alone, with the cross sections, divisions and style F(l,w,s,d) gave them
     branches.nodes = plant.nodes;
     branches.node_tubes = plant.node_tubes;
+    branches.tube_style = plant.tube_style;
+    branches.tube_style.uvs = false;
     const OutputMesh tubes = mesh_plant(branches, o.mesher);
     if (!tubes.triangles.empty()) {
       fmt::format_to(out, "// branches: {} nodes as one mesh2\n", plant.nodes.size());
@@ -548,10 +559,8 @@ void write_branches(Out out, const Plant& plant, const RenderOptions& o, const C
                   static_cast<std::uint32_t>(tubes.triangles.size()));
       fmt::format_to(out, "  texture {{ GB_Bark }}\n}}\n");
     }
-  } else if (o.branches == "cones") {
-    write_cones(out, plant, pixel_radius_floor(camera, render_height(o), o.min_branch_px));
   } else {
-    throw InputError(fmt::format("render branches '{}': expected cones or mesh", o.branches));
+    write_cones(out, plant, pixel_radius_floor(camera, render_height(o), o.min_branch_px));
   }
 }
 

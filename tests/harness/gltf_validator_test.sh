@@ -16,7 +16,7 @@ mkdir -p "$out/tmp"
 TMPDIR="$out/tmp" "$tests" --gtest_filter='Glb.*:Exporters.*:PlantAttributes*.*' > "$out/tests.log"
 for layout in plain instanced compact; do
   "$growbench" run -q -a ivy -s wall --set max_root_length=0.75 --glb $layout -o "$out/ivy-$layout" > /dev/null
-  "$growbench" run -q -a lsystem -s column --set grammar=bracketed-plant --set generations=4 --organ color_jitter=0.3 \
+  "$growbench" run -q -a lsystem -s column --set grammar=bracketed-plant --set generations=4 --set tube_uvs=true --organ color_jitter=0.3 \
     --glb $layout -o "$out/lsystem-$layout" > /dev/null
   "$growbench" run -q -a spacecol -s envelope --set point_count=2000 --glb $layout -o "$out/spacecol-$layout" > /dev/null
   # A plant with no geometry (a suite's input check grows none): still a valid file.

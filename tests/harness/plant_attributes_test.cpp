@@ -424,6 +424,107 @@ TEST_F(PlantAttributes, TubeSectionsAndDivisionsFollowF) {
   EXPECT_NE(p.geometry_hash(), grow("F(1,0.1)F(1,0.1)").geometry_hash());
 }
 
+// The centre of the ring of `n` vertices from `first`.
+glm::vec3 ring_centre(const OutputMesh& m, std::size_t first, std::size_t n) {
+  glm::vec3 c(0.0f);
+  for (std::size_t k = first; k < first + n; ++k) c += m.positions[k];
+  return c / static_cast<float>(n);
+}
+
+// Tension 0 puts a segment's middle ring on the cardinal spline through the nodes: for nodes P0, P1, P2
+// the Hermite midpoint of P1..P2 with tangents (P2 - P0) / 2 and P2 - P1 is (P1 + P2) / 2 + (up - d) / 16
+// for P1 - P0 = up and P2 - P1 = d. Tension 1 keeps it on the segment; so does a plain F (one section).
+TEST_F(PlantAttributes, TensionSweepsTheSectionsAlongACurveThroughTheNodes) {
+  const std::string premise = "F(1,0.1,2,4)+(90)F(1,0.1,2,4)";
+  const Plant straight = grow(premise);
+  const Plant swept = grow(premise, {"tension=0"});
+  ASSERT_EQ(swept.nodes.size(), 3u);
+  const glm::vec3 p0 = swept.nodes[0].position, p1 = swept.nodes[1].position, p2 = swept.nodes[2].position;
+  const glm::vec3 up = p1 - p0, d = p2 - p1;
+  ASSERT_NEAR(glm::dot(up, d), 0.0f, 1e-6f);
+  const OutputMesh ms = mesh_plant(straight), mc = mesh_plant(swept);
+  ASSERT_EQ(mc.positions.size(), ms.positions.size());  // rings: P0, middle, P1, middle, P2 (one strip of 4)
+  auto near = [](const glm::vec3& a, const glm::vec3& b) { return glm::length(a - b) < 1e-5f; };
+  EXPECT_TRUE(near(ring_centre(ms, 4, 4), p0 + 0.5f * up));
+  EXPECT_TRUE(near(ring_centre(ms, 12, 4), p1 + 0.5f * d));
+  EXPECT_TRUE(near(ring_centre(mc, 4, 4), p0 + 0.5f * up + (up - d) / 16.0f));
+  EXPECT_TRUE(near(ring_centre(mc, 12, 4), p1 + 0.5f * d + (up - d) / 16.0f));
+  EXPECT_TRUE(near(ring_centre(mc, 8, 4), p1));  // the nodes stay where they are
+  EXPECT_EQ(swept.tube_style.tension, 0.0f);
+  EXPECT_NE(swept.geometry_hash(), straight.geometry_hash());
+  EXPECT_EQ(grow(premise, {"tension=1"}).geometry_hash(), straight.geometry_hash());
+  EXPECT_EQ(mesh_plant(grow("F+(90)F", {"tension=0"})).positions, mesh_plant(grow("F+(90)F")).positions);
+}
+
+// Branch blend 1 starts a side branch along its parent's heading: its middle ring is at
+// P1 + d / 2 + up / 8 (the Hermite midpoint with tangents up, of the branch's length, and 0 at tension 1).
+TEST_F(PlantAttributes, BranchBlendStartsABranchAlongItsParentsHeading) {
+  const std::string premise = "F(1,0.1)[+(90)F(1,0.1,2,4)]F";
+  const Plant plain = grow(premise), blended = grow(premise, {"branch_blend=1"});
+  ASSERT_EQ(blended.nodes.size(), 4u);
+  const glm::vec3 p0 = blended.nodes[0].position, p1 = blended.nodes[1].position, p2 = blended.nodes[2].position;
+  ASSERT_EQ(blended.nodes[2].parent, 1);
+  const glm::vec3 up = p1 - p0, d = p2 - p1;
+  // the trunk (3 rings of 6 and two cap centres), then the branch: rings of 4 at P1, its middle, P2
+  const OutputMesh mp = mesh_plant(plain), mb = mesh_plant(blended);
+  const std::size_t branch = 3 * 6 + 2;
+  auto near = [](const glm::vec3& a, const glm::vec3& b) { return glm::length(a - b) < 1e-5f; };
+  EXPECT_TRUE(near(ring_centre(mp, branch + 4, 4), p1 + 0.5f * d));
+  EXPECT_TRUE(near(ring_centre(mb, branch + 4, 4), p1 + 0.5f * d + up / 8.0f));
+  EXPECT_TRUE(near(ring_centre(mb, branch, 4), p1));
+  EXPECT_TRUE(near(ring_centre(mb, 6, 6), p1));  // the trunk is as it was
+}
+
+// tube_uvs: u runs 0..1 around each ring (a seam vertex repeats the first), v grows by vertical_increment
+// per segment from the root, and OBJ (vt), PLY (s, t) and glTF (TEXCOORD_0, v down) carry them.
+TEST_F(PlantAttributes, TubeUvsRunAroundTheRingsAndAlongTheSegments) {
+  const Plant p = grow("F(1,0.1,2,4)F", {"tube_uvs=true", "vertical_increment=0.5"});
+  const OutputMesh m = mesh_plant(p);
+  // a strip of 3 rings of 4 + 1, then (the divisions change to 6) a strip of 2 rings of 6 + 1, 2 cap centres
+  ASSERT_EQ(m.positions.size(), 3u * 5u + 2u * 7u + 2u);
+  ASSERT_EQ(m.uvs.size(), m.positions.size());
+  const std::vector<float> v = {0.0f, 0.25f, 0.5f};
+  for (std::size_t r = 0; r < 3; ++r)
+    for (std::size_t s = 0; s < 5; ++s) {
+      EXPECT_FLOAT_EQ(m.uvs[r * 5 + s].x, static_cast<float>(s) / 4.0f) << r << " " << s;
+      EXPECT_FLOAT_EQ(m.uvs[r * 5 + s].y, v[r]) << r << " " << s;
+    }
+  EXPECT_EQ(m.positions[4], m.positions[0]);  // the seam
+  EXPECT_FLOAT_EQ(m.uvs[15].y, 0.5f);
+  EXPECT_FLOAT_EQ(m.uvs[22].y, 1.0f);
+  EXPECT_FLOAT_EQ(m.uvs[28].x, 1.0f);
+  // every triangle is a real one: no index reaches past its strip
+  for (const auto& t : m.triangles)
+    for (int k = 0; k < 3; ++k) ASSERT_LT(t[k], m.positions.size());
+
+  const auto dir = test::temp_dir("attr_uvs");
+  write_obj((dir / "p.obj").string(), m);
+  tinyobj::ObjReader r;
+  ASSERT_TRUE(r.ParseFromFile((dir / "p.obj").string())) << r.Error();
+  ASSERT_EQ(r.GetAttrib().texcoords.size(), 2 * m.positions.size());
+  EXPECT_FLOAT_EQ(r.GetAttrib().texcoords[2 * 22 + 1], 1.0f);
+  const auto& first = r.GetShapes()[0].mesh.indices[0];
+  EXPECT_EQ(first.texcoord_index, first.vertex_index);
+  write_ply((dir / "p.ply").string(), m);
+  const Ply ply = read_ply(dir / "p.ply");
+  EXPECT_EQ(ply.element("vertex").columns.at("t")[22], 1.0);
+  EXPECT_EQ(ply.element("vertex").columns.at("s")[3], 0.75);
+  write_glb((dir / "p.glb").string(), m);
+  const tinygltf::Model model = load_glb(dir / "p.glb");
+  const auto& prim = model.meshes[0].primitives[0];
+  ASSERT_TRUE(prim.attributes.count("TEXCOORD_0"));
+  const std::vector<float> uv = floats_of(model, prim.attributes.at("TEXCOORD_0"));
+  EXPECT_FLOAT_EQ(uv[2 * 22 + 1], 0.0f);  // glTF's v is 1 - OBJ's
+  EXPECT_FLOAT_EQ(uv[2 * 5 + 1], 0.75f);
+
+  // without tube_uvs nothing changes: no texture coordinates, the same hash as before the option existed
+  EXPECT_TRUE(mesh_plant(grow("F(1,0.1,2,4)F")).uvs.empty());
+  EXPECT_EQ(grow("F", {"vertical_increment=0.5"}).geometry_hash(), grow("F").geometry_hash());
+  EXPECT_NE(p.geometry_hash(), grow("F(1,0.1,2,4)F").geometry_hash());
+  write_plant_snapshot((dir / "p.gbplant").string(), p);
+  EXPECT_EQ(read_plant_snapshot((dir / "p.gbplant").string()).tube_style, p.tube_style);
+}
+
 TEST_F(PlantAttributes, SkeletonGeometryIsLinesInEveryFormat) {
   const Plant p = grow("g(2)F[+F]F", {"geometry=skeleton"});
   EXPECT_EQ(p.branch_geometry, BranchGeometry::Skeleton);
