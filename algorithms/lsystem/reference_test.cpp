@@ -204,6 +204,11 @@ TEST(LSystemReference, ABareNumberAfterATurnIsAWarningUnlessTheDigitsAreSymbols)
   EXPECT_TRUE(run_trial_record(spec).results.warnings.empty());
   spec.params = {"premise=A", "rules=A = F/(30)A", "generations=2"};
   EXPECT_TRUE(run_trial_record(spec).results.warnings.empty());
+  // A trial that fails has no record: its error carries the warnings, which may say why it failed.
+  spec.params = {"premise=A", "rules=A = AA/30", "generations=30", "max_symbols=1000"};
+  const std::string e = test::error_of([&] { run_trial_record(spec); });
+  EXPECT_NE(e.find("L-system runaway"), std::string::npos) << e;
+  EXPECT_NE(e.find("\n  warning: parameter 'rules':1:7: '/30' reads as '/'"), std::string::npos) << e;
 }
 
 // Houdini's Point Attributes: gen is the rewrite that made the module drawing a node (it was the branch

@@ -578,6 +578,14 @@ void record_inputs(const GrowthAlgorithm& algo, TrialResults& r) {
   r.warnings = algo.warnings();
 }
 
+// A failed trial has no record to keep what the algorithm warned of in its input, and a warning (a '/30'
+// read as '/', '3', '0') often explains the failure: the error carries them.
+std::string with_warnings(const std::string& message, const std::vector<std::string>& warnings) {
+  std::string out = message;
+  for (const auto& w : warnings) out += "\n  warning: " + w;
+  return out;
+}
+
 }  // namespace
 
 TrialRecord run_trial_record(const TrialSpec& spec, const std::function<void(const Progress&)>& progress,
@@ -611,7 +619,11 @@ TrialRecord run_trial_record(const TrialSpec& spec, const std::function<void(con
   rec.results.params = params.to_json();
   if (!spec.leaf_obj.empty()) rec.leaf_obj = spec.leaf_obj;
 
-  grow(spec, params, st, timer, rec, progress);
+  try {
+    grow(spec, params, st, timer, rec, progress);
+  } catch (const InputError& e) {
+    throw InputError(with_warnings(e.what(), st.algo->warnings()));
+  }
   record_inputs(*st.algo, rec.results);
   const Plant& plant = st.algo->plant();
   // An algorithm whose input can draw an invalid plant (an L-system's grammar is a program) refuses it in
