@@ -222,15 +222,15 @@ void plain_tube_path(TubePath& t, const Plant& plant, const std::vector<std::int
 void tube_path(TubePath& t, const Plant& plant, const std::vector<std::int32_t>& chain, const MesherOptions& o,
                const TubeExtras& x, int sides) {
   if (!x.tubes && !t.sources && !x.style.uvs) return plain_tube_path(t, plant, chain, o);
-  const std::vector<std::size_t> kept = kept_nodes(plant, chain);
   const bool curved = x.tubes && x.style.curved();
   const std::vector<glm::vec3> tangents =
-      curved ? chain_tangents(plant, chain, kept, x.style) : std::vector<glm::vec3>();
-  for (std::size_t i = 0; i < kept.size(); ++i) {
-    const std::size_t j = kept[i];
+      curved ? chain_tangents(plant, chain, kept_nodes(plant, chain), x.style) : std::vector<glm::vec3>();
+  std::size_t i = 0;  // the kept node's index (kept_nodes)
+  for (std::size_t j = 0; j < chain.size(); ++j) {
     const auto id = chain[j];
     const auto& node = plant.nodes[static_cast<std::size_t>(id)];
     const glm::vec3 p = node.position;
+    if (!t.pts.empty() && glm::length(p - t.pts.back()) < 1e-7f) continue;  // drop zero-length segments
     // A lateral branch (its first node's shoot differs from the parent's) starts with its own radius,
     // and its own values: those of its first segment's end.
     float r = node.radius;
@@ -269,6 +269,7 @@ void tube_path(TubePath& t, const Plant& plant, const std::vector<std::int32_t>&
     t.steps.push_back(step);
     if (t.sources) t.src.push_back({own, own, 0.0f});
     if (x.style.uvs) t.v.push_back(tex_v);
+    ++i;
   }
 }
 
