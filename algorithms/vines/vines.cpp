@@ -30,6 +30,7 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <stb_image.h>
 #include <tbb/parallel_for.h>
 
@@ -67,7 +68,11 @@ const AlgorithmInfo kInfo = {
             param::choice("seams", "cross", {"cross", "stop"})
                 .doc("metric=surface: a grower that reaches a UV chart border continues in the chart across the "
                      "mesh edge (cross) or stops there"),
-            param::real("influence", 4).range(0.5, 200).unit("cells").doc("influence radius of an attractor"),
+            param::real("influence", 4)
+                .range(0.5, 200)
+                .unit("cells")
+                .doc("influence radius of an attractor; left at its default, divided by sqrt(share) for tags, "
+                     "where share = 1/tags + tag_mix (1 - 1/tags) is the part of the attractors a vine may take"),
             param::real("kill", 1.5)
                 .range(0.05, 200)
                 .unit("cells")
@@ -96,10 +101,11 @@ const AlgorithmInfo kInfo = {
                 .doc("a grower stops after killing this many attractors (0: no limit)"),
             param::integer("kill_limit_offset", 3)
                 .range(0, 1000000)
-                .doc("a child's kill count starts at its parent's plus this"),
+                .doc("a side branch's kill count starts this far below its parent's (a strand's next grower "
+                     "carries its parent's count on)"),
             param::integer("kill_limit_jitter", 0)
                 .range(0, 1000000)
-                .doc("the inherited count varies at random by up to this many"),
+                .doc("a side branch's starting count varies at random by up to this many"),
             param::real("tip_width", 0.4).range(0.01, 100).unit("cells").doc("vine width at the tips"),
             param::real("max_width", 3).range(0.01, 1000).unit("cells").doc("widest vine (the pipe model is capped)"),
             param::real("pipe_exponent", 2.5).range(1, 4).doc("pipe model exponent n: w^n = sum of children's w^n"),
@@ -223,6 +229,10 @@ class Vines final : public GrowthAlgorithm {
     make_surface();
     place_attractors(mask ? &*mask : nullptr);
     place_roots(p.text("roots"), mask ? &*mask : nullptr);
+    params_ = p;
+    if (!p.was_set("influence")) params_.set("influence", fmt::format("{}", cfg_.influence));
+    warnings_.clear();
+    warn_of_rootless_tags();
     iteration_ = 0;
     last_kill_ = 0;
     activate(0);
@@ -230,7 +240,6 @@ class Vines final : public GrowthAlgorithm {
 
   bool step() override {
     ++iteration_;
-    dbg_active_ += active_.size();
     claim();
     if (apply_claims() > 0) last_kill_ = iteration_;
     const std::size_t before = growers_.size();
@@ -244,13 +253,13 @@ class Vines final : public GrowthAlgorithm {
   }
 
   void finish() override {
-    if (getenv("VINES_DEBUG"))
-      fprintf(stderr, "active sum %zu, iterations %d, growers %zu, attractors %zu\n", dbg_active_, iteration_,
-              growers_.size(), center_.size());
     finished_ = true;
     plant_stale_ = true;
     build_plant();
   }
+
+  std::optional<Params> effective_params() const override { return params_; }
+  std::vector<std::string> warnings() const override { return warnings_; }
 
   const Plant& plant() const override {
     if (plant_stale_) build_plant();
@@ -405,6 +414,23 @@ class Vines final : public GrowthAlgorithm {
 
   void place_attractors(const vines::Mask* mask);
   void place_roots(const std::string& roots, const vines::Mask* mask);
+
+  // A tag no root carries leaves the attractors only it may take out of reach: the vines stop short of
+  // them, which looks like a stall. Said, with how many.
+  void warn_of_rootless_tags() {
+    std::uint32_t rooted = 0;
+    for (const auto t : tag_) rooted |= 1u << t;
+    std::vector<int> missing;
+    for (int t = 0; t < cfg_.tags; ++t)
+      if (!((rooted >> t) & 1u)) missing.push_back(t);
+    if (missing.empty()) return;
+    const auto unreachable = std::count_if(tags_.begin(), tags_.end(), [&](std::uint16_t a) { return !(a & rooted); });
+    warnings_.push_back(fmt::format(
+        "tags={} but {} root{} carry only {} of them: no root carries tag {}, so {} of the {} attractors (those "
+        "only {} may take) are never reached; give each tag a root (roots='u,v,tag;...') or fewer tags",
+        cfg_.tags, tag_.size(), tag_.size() == 1 ? "" : "s", cfg_.tags - static_cast<int>(missing.size()),
+        fmt::join(missing, ", "), unreachable, tags_.size(), missing.size() == 1 ? "it" : "those tags"));
+  }
   std::vector<std::pair<Location, int>> parse_roots(const std::string& text) const;
   Location snapped(const Location& l) const;
 
@@ -549,6 +575,8 @@ class Vines final : public GrowthAlgorithm {
   std::uint64_t seed_ = 0;
   vines::Config cfg_{};
   std::string leaf_texture_, mask_path_;
+  Params params_;  // as given, with the influence radius the default became
+  std::vector<std::string> warnings_;
   std::int32_t mesh_ = kNone;
   Canvas canvas_;
   bool climbable_ = true;  // the canvas projects onto climbable meshes; without any it stands free
@@ -556,7 +584,6 @@ class Vines final : public GrowthAlgorithm {
   float cell_m_ = 1.0f, reach_ = 1.0f;
   int iteration_ = 0, last_kill_ = 0;
   std::size_t seam_crossings_ = 0;
-  std::size_t dbg_active_ = 0;
 
   // Attractors (structure of arrays): resting place in metric cells, triangle, wiggle phase, tag bits.
   std::vector<glm::vec3> center_;
@@ -797,8 +824,11 @@ std::int32_t Vines::add_grower(const Location& at, std::int32_t parent, int tag,
     order_.push_back(static_cast<std::uint16_t>(first ? order_[up] : order_[up] + 1));
     (first ? first_child_[up] : next_sibling_[static_cast<std::size_t>(last_child_[up])]) = g;
     last_child_[up] = g;
-    kills = kills_[up] + cfg_.kill_limit_offset;
-    if (cfg_.kill_limit_jitter > 0) {
+    // The strand's next grower carries its count on, so a strand halts once it has killed kill_limit
+    // attractors along its length; a side branch starts kill_limit_offset below its parent, so the growers
+    // behind a halted tip branch into what it leaves (the README says why not above, as the caption reads).
+    kills = first ? kills_[up] : kills_[up] - cfg_.kill_limit_offset;
+    if (!first && cfg_.kill_limit_jitter > 0) {
       Rng rng(seed_, kStreamKills, static_cast<std::uint64_t>(g));
       const int span = 2 * cfg_.kill_limit_jitter + 1;
       kills += std::min(static_cast<int>(rng.uniform() * span), span - 1) - cfg_.kill_limit_jitter;
@@ -1085,6 +1115,17 @@ std::vector<OutputFile> Vines::write_outputs(const OutputRequest& r) const {
 
 namespace vines {
 
+// The influence radius: as given, or by default widened for exclusive tags, each of which sees only its
+// share of the attractors, so that a vine reaches as many of its own as an untagged vine does (spacing
+// grows as 1 / sqrt(density)). At the bare default, 4 exclusive tags stalled at resolution 128.
+float influence_of(const Params& p) {
+  const double given = p.real("influence");
+  if (p.was_set("influence")) return static_cast<float>(given);
+  const double tags = static_cast<double>(p.integer("tags")), mix = p.real("tag_mix");
+  const double share = 1.0 / tags + mix * (1.0 - 1.0 / tags);
+  return static_cast<float>(given / std::sqrt(share));
+}
+
 Config make_config(const Params& p) {
   const std::string& space = p.text("space");
   const std::string& leaves = p.text("leaves");
@@ -1098,7 +1139,7 @@ Config make_config(const Params& p) {
       .grid_nodes = p.text("nodes") == "grid",
       .metric = p.text("metric") == "uv" ? Metric::Uv : Metric::Surface,
       .cross_seams = p.text("seams") == "cross",
-      .influence = static_cast<float>(p.real("influence")),
+      .influence = influence_of(p),
       .kill = static_cast<float>(p.real("kill")),
       .step = static_cast<float>(p.real("step")),
       .stall_iterations = static_cast<int>(p.integer("stall_iterations")),
