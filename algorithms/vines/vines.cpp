@@ -229,8 +229,11 @@ class Vines final : public GrowthAlgorithm {
     make_surface();
     place_attractors(mask ? &*mask : nullptr);
     place_roots(p.text("roots"), mask ? &*mask : nullptr);
-    params_ = p;
-    if (!p.was_set("influence")) params_.set("influence", fmt::format("{}", cfg_.influence));
+    params_.reset();  // the record keeps the parameters as given, unless the default influence was widened
+    if (static_cast<double>(cfg_.influence) != p.real("influence")) {
+      params_ = p;
+      params_->set("influence", fmt::format("{}", cfg_.influence));
+    }
     warnings_.clear();
     warn_of_rootless_tags();
     iteration_ = 0;
@@ -575,7 +578,7 @@ class Vines final : public GrowthAlgorithm {
   std::uint64_t seed_ = 0;
   vines::Config cfg_{};
   std::string leaf_texture_, mask_path_;
-  Params params_;  // as given, with the influence radius the default became
+  std::optional<Params> params_;  // as given, with the influence radius the default became
   std::vector<std::string> warnings_;
   std::int32_t mesh_ = kNone;
   Canvas canvas_;

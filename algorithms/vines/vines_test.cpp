@@ -48,7 +48,7 @@ Grown grow_vines(const Scene& scene, const SceneQuery& query, const std::vector<
   for (int i = 0; i < 20000 && algo->step(); ++i) {
   }
   algo->finish();
-  Grown g{algo->plant(), {}, {}, algo->warnings(), algo->effective_params()->real("influence")};
+  Grown g{algo->plant(), {}, {}, algo->warnings(), algo->effective_params().value_or(p).real("influence")};
   for (const auto& [k, v] : algo->stats()) g.stats[k] = v;
   if (!out.empty()) {
     g.dir = test::temp_dir(out);
