@@ -151,6 +151,7 @@ void BM_LsysTurtle(benchmark::State& state) {
                              .thickness = 0.01,
                              .thickness_scale = 0.9,
                              .gravity = 0.2,
+                             .gravity_unit = 1.0,
                              .random_scale = 0.0,
                              .uv_increment = {0.1, 0.1},
                              .convention = Convention::Houdini,

@@ -59,15 +59,15 @@ struct OrganStamps {
 };
 
 struct TurtleSettings {
-  double step;                // default F length (m)
-  double step_scale;          // " and _
-  double angle;               // default turn (degrees)
-  double angle_scale;         // ; and @
-  double thickness;           // default width (m)
-  double thickness_scale;     // ! and ?
-  double gravity;             // T: susceptibility (gravity_units per unit |H x down|)
-  double gravity_unit = 1.0;  // radians per unit of T's amount
-  double random_scale;        // lengths scaled by 1 + random_scale * uniform(-1, 1)
+  double step;             // default F length (m)
+  double step_scale;       // " and _
+  double angle;            // default turn (degrees)
+  double angle_scale;      // ; and @
+  double thickness;        // default width (m)
+  double thickness_scale;  // ! and ?
+  double gravity;          // T: susceptibility (gravity_units per unit |H x down|)
+  double gravity_unit;     // radians per unit of T's amount
+  double random_scale;     // lengths scaled by 1 + random_scale * uniform(-1, 1)
   glm::dvec2 uv_increment;
   Convention convention;
   double fraction;  // < 1: modules of the last generation are scaled by it (fractional generations); else 1
