@@ -148,13 +148,18 @@ struct TubePath {
   bool sources = false;
 };
 
+// Whether the tube drops the segment from a to b: too short to have a direction.
+bool zero_length(const glm::vec3& a, const glm::vec3& b) {
+  return glm::length(b - a) < 1e-7f;
+}
+
 // The chain's nodes that start a segment of non-zero length (the first always), as indices into `chain`.
 std::vector<std::size_t> kept_nodes(const Plant& plant, const std::vector<std::int32_t>& chain) {
   std::vector<std::size_t> kept;
   glm::vec3 last(0.0f);
   for (std::size_t j = 0; j < chain.size(); ++j) {
     const glm::vec3 p = plant.nodes[static_cast<std::size_t>(chain[j])].position;
-    if (!kept.empty() && glm::length(p - last) < 1e-7f) continue;
+    if (!kept.empty() && zero_length(last, p)) continue;
     kept.push_back(j);
     last = p;
   }
@@ -199,7 +204,7 @@ void plain_tube_path(TubePath& t, const Plant& plant, const std::vector<std::int
   for (std::size_t j = 0; j < chain.size(); ++j) {
     const auto& node = plant.nodes[static_cast<std::size_t>(chain[j])];
     const glm::vec3 p = node.position;
-    if (!pts.empty() && glm::length(p - pts.back()) < 1e-7f) continue;  // drop zero-length segments
+    if (!pts.empty() && zero_length(pts.back(), p)) continue;
     float r = node.radius;
     // A chain's first ring is its first segment's: it appears with that segment's end.
     std::uint32_t step = node.birth_step;
@@ -230,7 +235,7 @@ void tube_path(TubePath& t, const Plant& plant, const std::vector<std::int32_t>&
     const auto id = chain[j];
     const auto& node = plant.nodes[static_cast<std::size_t>(id)];
     const glm::vec3 p = node.position;
-    if (!t.pts.empty() && glm::length(p - t.pts.back()) < 1e-7f) continue;  // drop zero-length segments
+    if (!t.pts.empty() && zero_length(t.pts.back(), p)) continue;
     // A lateral branch (its first node's shoot differs from the parent's) starts with its own radius,
     // and its own values: those of its first segment's end.
     float r = node.radius;
