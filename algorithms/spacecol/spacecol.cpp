@@ -16,12 +16,14 @@
 #include "algorithms/spacecol/spacecol.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <memory>
 #include <sstream>
 
 #include <fmt/format.h>
+#include <glm/gtc/noise.hpp>
 #include <tbb/parallel_for.h>
 
 #include "algorithms/colonization.hpp"
@@ -46,6 +48,11 @@ const AlgorithmInfo kInfo = {
             param::text("points_file")
                 .doc("text file of attraction points, one 'x y z' (or x,y,z) per line, # comments (points=file)"),
             param::integer("point_count", 20000).range(1, 1e7).doc("number of attraction points sampled"),
+            param::real("center_density", 0.0)
+                .range(0, 16)
+                .doc("envelope points grow denser toward its centre, density ~ exp(-k s^2), s the distance from "
+                     "the centre in half-sizes of the envelope (0: uniform). The Hyphae notes' fix for roots around "
+                     "a volume whose veins stop at the first points they reach"),
             param::real("surface_offset", 0.01)
                 .range(0, 10)
                 .unit("m")
@@ -64,7 +71,15 @@ const AlgorithmInfo kInfo = {
                 .doc("added to each normalised growth direction (e.g. 0,0.2,0 bends growth upward)"),
             param::real("noise", 0.0)
                 .range(0, 10)
-                .doc("random unit vector times this is added to each growth direction"),
+                .doc("noise vector times this is added to each growth direction (see noise_field)"),
+            param::choice("noise_field", "position", {"position", "random"})
+                .doc("position: a coherent simplex-noise field of the node's position, so neighbouring branches "
+                     "bend alike (the Hyphae notes' noise(CLPOS)); random: a fresh random unit vector per node "
+                     "and step"),
+            param::real("noise_scale", 0.25)
+                .range(1e-4, 1e3)
+                .unit("m")
+                .doc("feature size of the position noise field: it turns over about this distance"),
             param::choice("surface", "free", {"free", "avoid", "cling"})
                 .doc("free: ignore solids; avoid: push nodes out of solids; cling: hold nodes at cling_distance from "
                      "the "
@@ -121,6 +136,7 @@ CollectWithin<Keep> collect_within(float r2, std::vector<std::pair<std::uint32_t
 using colonization::safe_normalize;
 
 using spacecol::Leaves;
+using spacecol::NoiseField;
 using spacecol::Points;
 using spacecol::Surface;
 constexpr std::int32_t kNone = -1;
@@ -172,6 +188,9 @@ class SpaceColonization final : public PortableGrowthAlgorithm {
     if (cfg_.surface != Surface::Free && !query.has_sdf())
       throw InputError("algorithm 'spacecol': surface=avoid/cling needs the scene's distance field");
 
+    Rng offsets(seed, 0x40000001ull, 0);  // each seed reads its own part of the noise field
+    for (glm::vec3& o : noise_offset_)
+      o = glm::vec3(offsets.uniform(0.0, 256.0), offsets.uniform(0.0, 256.0), offsets.uniform(0.0, 256.0));
     sample_points(p.text("points_file"));
     closest_.assign(pts_.size(), kNone);
     closest_d2_.assign(pts_.size(), 0.0f);
@@ -258,6 +277,16 @@ class SpaceColonization final : public PortableGrowthAlgorithm {
           pts_.size(), count, what, scene_->name, next));
   }
 
+  // Rejection sampling for center_density: keeps q with probability exp(-k s^2), s its distance from the
+  // envelope's centre in half-sizes (an ellipsoid's radii, else half the bounding box).
+  [[nodiscard]] bool near_center(const Shape& env, const glm::vec3& q, double u) const {
+    const Aabb b = env.bounds();
+    const glm::vec3 c = env.kind == Shape::Kind::Sphere ? env.center : 0.5f * (b.min + b.max);
+    const glm::vec3 half = env.kind == Shape::Kind::Sphere ? env.radii : 0.5f * b.size();
+    const glm::vec3 s = (q - c) / glm::max(half, glm::vec3(1e-20f));
+    return u < std::exp(-static_cast<double>(cfg_.center_density) * glm::dot(s, s));
+  }
+
   void sample_points(const std::string& points_file) {
     Points mode = cfg_.points;
     if (mode == Points::Auto)
@@ -275,13 +304,15 @@ class SpaceColonization final : public PortableGrowthAlgorithm {
           count,
           [&](std::size_t i) {
             Rng rng(seed_, 0xE1u, 4 * i);
-            for (int tries = 0; tries < 64; ++tries) {
+            for (int tries = 0; tries < (cfg_.center_density > 0.0f ? 1024 : 64); ++tries) {
               glm::vec3 q;
               if (env.kind == Shape::Kind::Sphere)
                 q = env.center + rng.in_unit_ball() * env.radii;
               else
                 q = b.min + glm::vec3(rng.uniform(), rng.uniform(), rng.uniform()) * b.size();
-              if (env.kind != Shape::Kind::Mesh || query_->inside_shape(kEnvelopeShape, q)) return q;
+              if (env.kind == Shape::Kind::Mesh && !query_->inside_shape(kEnvelopeShape, q)) continue;
+              if (cfg_.center_density > 0.0f && !near_center(env, q, rng.uniform())) continue;
+              return q;
             }
             return glm::vec3(std::numeric_limits<float>::quiet_NaN());
           },
@@ -460,8 +491,16 @@ class SpaceColonization final : public PortableGrowthAlgorithm {
   glm::vec3 steer(glm::vec3 dir, std::size_t v, std::uint64_t salt) const {
     dir = safe_normalize(dir + cfg_.tropism, dir);
     if (cfg_.noise > 0.0f) {
-      Rng rng(seed_, 0x40000000ull + v, static_cast<std::uint64_t>(step_) * 4 + salt);
-      dir = safe_normalize(dir + cfg_.noise * rng.unit_vector(), dir);
+      glm::vec3 n;
+      if (cfg_.noise_field == NoiseField::Position) {
+        const glm::vec3 q = node_pos_[v] / cfg_.noise_scale;
+        n = glm::vec3(glm::simplex(q + noise_offset_[0]), glm::simplex(q + noise_offset_[1]),
+                      glm::simplex(q + noise_offset_[2]));
+      } else {
+        Rng rng(seed_, 0x40000000ull + v, static_cast<std::uint64_t>(step_) * 4 + salt);
+        n = rng.unit_vector();
+      }
+      dir = safe_normalize(dir + cfg_.noise * n, dir);
     }
     return dir;
   }
@@ -791,7 +830,8 @@ class SpaceColonization final : public PortableGrowthAlgorithm {
   const Scene* scene_ = nullptr;
   const HostQueries* query_ = nullptr;
   std::uint64_t seed_ = 0;
-  spacecol::Config cfg_{};  // set by start()
+  std::array<glm::vec3, 3> noise_offset_{};  // where each component of the position noise is read
+  spacecol::Config cfg_{};                   // set by start()
   bool ever_influenced_ = false;
 
   std::vector<glm::vec3> pts_;
@@ -851,12 +891,15 @@ Config make_config(const Params& p) {
                 : points == "file"    ? Points::File
                                       : Points::Auto,
       .point_count = static_cast<std::size_t>(p.integer("point_count")),
+      .center_density = static_cast<float>(p.real("center_density")),
       .surface_offset = static_cast<float>(p.real("surface_offset")),
       .influence = static_cast<float>(p.real("influence")),
       .kill = static_cast<float>(p.real("kill")),
       .step = static_cast<float>(p.real("step")),
       .tropism = glm::vec3(p.vec3("tropism")),
       .noise = static_cast<float>(p.real("noise")),
+      .noise_field = p.text("noise_field") == "random" ? NoiseField::Random : NoiseField::Position,
+      .noise_scale = static_cast<float>(p.real("noise_scale")),
       .surface = surface == "cling"   ? Surface::Cling
                  : surface == "avoid" ? Surface::Avoid
                                       : Surface::Free,

@@ -84,6 +84,59 @@ TEST(SpaceColonization, TwoSymmetricPointsBranch) {
   EXPECT_EQ(forks, 1);
 }
 
+// Mean angle between each segment and its parent's, in radians.
+double mean_turn(const Plant& p) {
+  double sum = 0.0;
+  int n = 0;
+  for (std::size_t i = 0; i < p.nodes.size(); ++i) {
+    const std::int32_t a = p.nodes[i].parent;
+    if (a < 0 || p.nodes[static_cast<std::size_t>(a)].parent < 0) continue;
+    const glm::vec3 s0 = p.nodes[static_cast<std::size_t>(a)].position -
+                         p.nodes[static_cast<std::size_t>(p.nodes[static_cast<std::size_t>(a)].parent)].position;
+    const glm::vec3 s1 = p.nodes[i].position - p.nodes[static_cast<std::size_t>(a)].position;
+    sum += std::acos(std::clamp(glm::dot(glm::normalize(s0), glm::normalize(s1)), -1.0f, 1.0f));
+    ++n;
+  }
+  return n > 0 ? sum / n : 0.0;
+}
+
+// The Hyphae notes add noise(CLPOS), a smooth field of position: a chain toward one point wanders, but
+// each step turns only a little. A fresh random vector per step turns it sharply every step.
+TEST(SpaceColonization, PositionNoiseBendsSmoothlyRandomNoiseJitters) {
+  const Scene s = open_space({{0, 0, 0}});
+  SceneQuery q(s, {.build_sdf = false});
+  const std::string one = points_file("noise", "1 0 0\n");
+  const Plant smooth = grow("spacecol", s, q, exact(one, {"noise=0.5", "noise_scale=0.5"}));
+  const Plant jitter = grow("spacecol", s, q, exact(one, {"noise=0.5", "noise_field=random"}));
+  float off_axis = 0.0f;
+  for (const auto& n : smooth.nodes) off_axis = std::max(off_axis, std::hypot(n.position.y, n.position.z));
+  EXPECT_GT(off_axis, 0.02f) << "the noise must bend the chain off the straight line";
+  EXPECT_LT(glm::distance(smooth.nodes.back().position, glm::vec3(1, 0, 0)), 0.05f) << "and it still arrives";
+  EXPECT_LT(mean_turn(smooth), 0.25 * mean_turn(jitter)) << mean_turn(smooth) << " vs " << mean_turn(jitter);
+  EXPECT_GT(mean_turn(jitter), 0.2);
+  EXPECT_NE(grow("spacecol", s, q, exact(one, {"noise=0.5"}), 1, 2).geometry_hash(), smooth.geometry_hash())
+      << "each seed reads its own part of the field";
+}
+
+// The Hyphae notes' fix for veins that stop at the first points they reach: more points toward the
+// volume's centre. The nodes follow the points inward.
+TEST(SpaceColonization, CenterDensityDrawsTheVeinsInward) {
+  const Scene s = load_scene("envelope");
+  const SceneQuery q(s);
+  const Shape& env = *s.envelope;
+  auto mean_depth = [&](const Plant& p) {
+    double sum = 0.0;
+    for (const auto& n : p.nodes) sum += glm::length((n.position - env.center) / env.radii);
+    return sum / static_cast<double>(p.nodes.size());
+  };
+  const Plant flat = grow("spacecol", s, q, {"point_count=3000", "leaves=none"});
+  const Plant dense = grow("spacecol", s, q, {"point_count=3000", "leaves=none", "center_density=4"});
+  ASSERT_EQ(env.kind, Shape::Kind::Sphere);
+  EXPECT_LT(mean_depth(dense), 0.8 * mean_depth(flat)) << mean_depth(dense) << " vs " << mean_depth(flat);
+  EXPECT_EQ(grow("spacecol", s, q, {"point_count=3000", "leaves=none", "center_density=0"}).geometry_hash(),
+            flat.geometry_hash());
+}
+
 TEST(SpaceColonization, OpenAndClosedVenationDiffer) {
   // Two roots equidistant from one point. Open venation: the point pulls only its nearest node (ties
   // to the lower index), so one vein grows. Closed: both roots are in its relative neighbourhood, both
@@ -201,7 +254,10 @@ TEST(SpaceColonization, PlantsAreThoseGrownBeforeThePointTiers) {
            {&envelope, &qe, {"point_count=3000"}, "dfee095c25ce8fc7"},
            {&envelope, &qe, {"venation=closed", "point_count=2000"}, "d3bf8a1eca51bfcf"},
            {&wall, &qw, {"surface=cling", "point_count=2000"}, "942bc4822577933a"},
-           {&envelope, &qe, {"surface=avoid", "point_count=3000", "noise=0.3", "tropism=0,0.2,0"}, "f18f97a11cd5ca20"},
+           {&envelope,
+            &qe,
+            {"surface=avoid", "point_count=3000", "noise=0.3", "noise_field=random", "tropism=0,0.2,0"},
+            "f18f97a11cd5ca20"},
            {&envelope, &qe, {"point_count=20000", "kill=0.02", "step=0.01"}, "d68f3d0d33164039"},
        })
     for (const int threads : {1, 2})
