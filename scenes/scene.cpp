@@ -176,6 +176,7 @@ struct Hasher {
   void mesh(const TriangleMesh& m) {
     str(m.name);
     pod(m.climbable);
+    if (!m.visible) str("collision-only");  // only then, so every other mesh keeps the hash it always had
     pod(m.vertices.size());
     bytes(m.vertices.data(), m.vertices.size() * sizeof(glm::vec3));
     pod(m.triangles.size());

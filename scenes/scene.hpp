@@ -46,6 +46,9 @@ struct TriangleMesh {
   std::vector<glm::uvec3> triangles;
   // Plants may climb it and surface attraction points are sampled on it (the ground is not climbable).
   bool climbable = true;
+  // Drawn in renders and exported scenes. false: a collision-only object, one plants collide with and
+  // climb but no picture shows (the Hyphae notes' collision object, a guide beside the visible mesh).
+  bool visible = true;
   // Texture coordinates (OBJ `vt`), when the mesh has them: corner k of triangles[i] has
   // uvs[uv_triangles[i][k]]. Both are empty when it has none. v points up the image (OpenGL's and OBJ's
   // convention: the image's top row is v = 1).

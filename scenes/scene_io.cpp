@@ -280,7 +280,7 @@ class JsonScene : public JsonPathReader {
   }
 
   TriangleMesh mesh(const json& j, const std::string& path) const {
-    only_keys(j, path, {"name", "obj", "box", "sphere", "cylinder", "transform", "climbable"});
+    only_keys(j, path, {"name", "obj", "box", "sphere", "cylinder", "transform", "climbable", "visible"});
     TriangleMesh m;
     const std::string name = j.contains("name") ? string(j["name"], path + "/name") : "mesh";
     if (const std::string bad = name_problem(name); !bad.empty()) fail(path + "/name", bad);
@@ -346,6 +346,10 @@ class JsonScene : public JsonPathReader {
     if (j.contains("climbable")) {
       if (!j["climbable"].is_boolean()) fail(path + "/climbable", "expected true or false");
       m.climbable = j["climbable"].get<bool>();
+    }
+    if (j.contains("visible")) {
+      if (!j["visible"].is_boolean()) fail(path + "/visible", "expected true or false");
+      m.visible = j["visible"].get<bool>();
     }
     return m;
   }

@@ -211,6 +211,10 @@ TEST(SpaceColonization, FreeGrowsThroughAWallAvoidDoesNot) {
   EXPECT_EQ(inside_count(avoid), 0);
   EXPECT_GT(avoid.nodes.size(), 5u);
   for (const auto& n : avoid.nodes) EXPECT_GT(n.position.z, 0.1f);  // stopped in front of the wall
+  // A collision-only wall (not drawn) stops the plant all the same.
+  for (auto& m : s.meshes) m.visible = false;
+  SceneQuery hidden(s);
+  EXPECT_EQ(grow("spacecol", s, hidden, exact(f, {"surface=avoid"})).geometry_hash(), avoid.geometry_hash());
 }
 
 TEST(SpaceColonization, ClingStaysOnTheBunny) {

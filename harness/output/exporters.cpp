@@ -560,7 +560,7 @@ void add_scene_meshes(GltfBuilder& b, const Scene& scene) {
   const int ground = scene_material(b.model, "ground", {0.59f, 0.58f, 0.55f});
   const int surface = scene_material(b.model, "surface", {0.80f, 0.78f, 0.74f});
   for (const TriangleMesh& mesh : scene.meshes) {
-    if (mesh.triangles.empty()) continue;
+    if (mesh.triangles.empty() || !mesh.visible) continue;  // a collision-only object is not shown
     const geom::ShadedMesh sm = geom::crease_shaded(mesh);
     Aabb box;
     for (const auto& v : sm.vertices) box.extend(v);

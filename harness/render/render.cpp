@@ -372,6 +372,7 @@ void write_planar_decal_layer(Out out, const SurfaceDecal& d) {
 
 // Whether the studio backdrop keeps scene mesh i: the plant climbs it, or a decal follows it.
 bool kept_in_studio(const Scene& scene, std::size_t i, const std::vector<SurfaceDecal>& decals) {
+  if (!scene.meshes[i].visible) return false;
   return scene.meshes[i].climbable || std::any_of(decals.begin(), decals.end(), [&](const SurfaceDecal& d) {
            return d.mesh >= 0 && static_cast<std::size_t>(d.mesh) == i;
          });
@@ -383,7 +384,7 @@ bool kept_in_studio(const Scene& scene, std::size_t i, const std::vector<Surface
 void write_scene_meshes(Out out, const Scene& scene, const std::vector<SurfaceDecal>& decals, bool studio) {
   for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
     const TriangleMesh& m = scene.meshes[i];
-    if (m.triangles.empty() || (studio && !kept_in_studio(scene, i, decals))) continue;
+    if (m.triangles.empty() || !m.visible || (studio && !kept_in_studio(scene, i, decals))) continue;
     std::vector<const SurfaceDecal*> uv_decals, planar;
     for (const auto& d : decals) {
       if (d.mesh == kPlanarDecal && m.climbable) planar.push_back(&d);

@@ -497,6 +497,26 @@ TEST(PovWriter, StudioBackdropReplacesSkyAndGroundAndKeepsWhatThePlantClimbs) {
   EXPECT_EQ(count_of(studio, "\n  cone {"), tiny_plant().nodes.size() - 1);  // the plant is all there
 }
 
+// A collision-only mesh (visible: false) is in neither the render nor the exported scene, with any backdrop.
+TEST(PovWriter, ACollisionOnlyMeshIsNotDrawn) {
+  const auto dir = test::temp_dir("pov_hidden");
+  Scene scene = far_scene();
+  scene.meshes.push_back(geom::make_box("guide", {-0.2f, 0.0f, -0.7f}, {0.2f, 1.1f, -0.3f}));
+  scene.meshes.back().visible = false;
+  RenderOptions o;
+  for (const Backdrop b : {Backdrop::Scene, Backdrop::Studio}) {
+    o.backdrop = b;
+    write_pov((dir / "s.pov").string(), scene, tiny_plant(), o);
+    const std::string pov = read_file(dir / "s.pov");
+    EXPECT_NE(pov.find("scene mesh 'post'"), std::string::npos);
+    EXPECT_EQ(pov.find("scene mesh 'guide'"), std::string::npos);
+  }
+  write_scene_glb((dir / "scene.glb").string(), scene);
+  const std::string glb = read_file(dir / "scene.glb");
+  EXPECT_NE(glb.find("\"post\""), std::string::npos);
+  EXPECT_EQ(glb.find("\"guide\""), std::string::npos);
+}
+
 TEST(PovRender, AutoCameraFillsTheFrameWithASmallPlant) {
   ASSERT_FALSE(find_povray().empty()) << "povray is not installed (scripts/install-deps installs it)";
   const auto dir = test::temp_dir("render_auto");

@@ -132,7 +132,7 @@ TEST(JsonScene, LoadsMeshesSeedsLightEnvelopeZonesCamera) {
     "schema_version": 1, "name": "mine",
     "meshes": [{"name": "block", "box": {"min": [-1, 0, -1], "max": [1, 2, 1]}},
                {"name": "pole", "cylinder": {"base": [3, 0, 0], "top": [3, 2, 0], "radius": 0.1},
-                "transform": {"translate": [0, 0, 1]}, "climbable": false}],
+                "transform": {"translate": [0, 0, 1]}, "climbable": false, "visible": false}],
     "seeds": [{"position": [0, 0, 1.1], "direction": [0, 2, 0], "start_step": 3}],
     "light": {"type": "point", "position": [0, 5, 5]},
     "envelope": {"type": "sphere", "center": [0, 1, 0], "radius": [2, 1, 2]},
@@ -143,6 +143,11 @@ TEST(JsonScene, LoadsMeshesSeedsLightEnvelopeZonesCamera) {
   EXPECT_EQ(s.name, "mine");
   ASSERT_EQ(s.meshes.size(), 2u);
   EXPECT_FALSE(s.meshes[1].climbable);
+  EXPECT_TRUE(s.meshes[0].visible);
+  EXPECT_FALSE(s.meshes[1].visible);
+  Scene shown = s;
+  shown.meshes[1].visible = true;
+  EXPECT_NE(shown.content_hash(), s.content_hash()) << "a collision-only mesh is part of the scene's content";
   EXPECT_NEAR(s.meshes[1].bounds().center().z, 1.0f, 1e-5f);
   ASSERT_EQ(s.seeds.size(), 1u);
   EXPECT_EQ(s.seeds[0].start_step, 3);
@@ -170,6 +175,8 @@ TEST(JsonScene, ErrorsNameFileAndJsonPath) {
       {R"({"schema_version": 1, "meshes": [{"box": {"min": [0,0,0], "max": [1,"a",1]}}], "seeds": [{"position": [0,0,0]}]})",
        "at /meshes/0/box/max/1: expected a number"},
       {R"({"schema_version": 1, "meshes": [{"bx": {}}]})", "at /meshes/0/bx: unknown key 'bx' (did you mean 'box'?)"},
+      {R"({"schema_version": 1, "meshes": [{"box": {"min": [0,0,0], "max": [1,1,1]}, "visible": 0}]})",
+       "at /meshes/0/visible: expected true or false"},
       {R"({"schema_version": 1, "meshes": [{"box": {"min": [0,0,0], "max": [1,1,1]}}]})",
        "at /seeds: a scene needs at least one seed"},
       {R"({"schema_version": 1, "meshes": [{"box": {"min": [0,0,0], "max": [1,1,1]}}], "seeds": [{"position": [0,0,0]}],
