@@ -83,7 +83,7 @@ const AlgorithmInfo kInfo = {
                 .range(0, 100)
                 .unit("m")
                 .doc("surfaces farther than this from a tip do not attract it"),
-            param::real("approach_angle", 25.0)
+            param::real("approach_angle", 75.0)
                 .range(0, 90)
                 .unit("deg")
                 .doc("a tip in range turns to meet the surface at this angle, falling linearly to 0 (parallel) at "

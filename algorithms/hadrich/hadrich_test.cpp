@@ -132,6 +132,19 @@ TEST(Hadrich, GrowthSlowsInTheShade) {
     }
 }
 
+// The standard boulder is climbed: its seeds stand at its foot, under the bulge, and the shoots must
+// reach the rock and hold to it rather than sag onto the ground beside it. Counted: nodes higher than
+// the seeds could reach without the rock (0.3 m) and within 5 cm of its surface.
+TEST(Hadrich, ShootsClimbTheBoulder) {
+  const Scene s = load_scene("boulder");
+  SceneQuery q(s);
+  const Plant plant = test::grow("hadrich", s, q, {});
+  std::size_t on_rock = 0;
+  for (const auto& n : plant.nodes) on_rock += n.position.y > 0.3f && q.signed_distance(n.position) < 0.05f ? 1 : 0;
+  const double share = static_cast<double>(on_rock) / static_cast<double>(plant.nodes.size());
+  EXPECT_GT(share, 0.5) << on_rock << " of " << plant.nodes.size() << " nodes on the rock";
+}
+
 // Closed solids: no plant node inside the column, the boulder or the bunny.
 TEST(Hadrich, NoNodeInsideClosedSolids) {
   for (const std::string name : {"column", "boulder"}) {
