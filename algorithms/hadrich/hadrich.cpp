@@ -29,6 +29,7 @@
 
 #include <fmt/format.h>
 #define GLM_ENABLE_EXPERIMENTAL  // glm::rotation (shortest arc between two vectors)
+#include <glm/gtc/noise.hpp>
 #include <glm/gtx/quaternion.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -128,6 +129,18 @@ const AlgorithmInfo kInfo = {
                 .range(0, 1000)
                 .unit("m/s^2")
                 .doc("a_g, the downward acceleration of free particles (below Earth's: growth runs in time-lapse)"),
+            param::vec3("start_velocity", glm::dvec3(0.0))
+                .range(-100, 100)
+                .unit("m/s")
+                .doc("velocity every new particle is born with, added to its parent's (the Houdini tool's "
+                     "starting velocity)"),
+            param::real("surface_variability", 0.0)
+                .range(0, 1)
+                .unit("m")
+                .doc("each particle keeps up to this much farther from surfaces than its thickness, drawn per "
+                     "particle, so shoots do not hug the surface as closely (the Houdini tool's variability from "
+                     "surface). It is capped at the distance field's narrow band, where the push-out acts: widen the "
+                     "band (--band-voxels) for more"),
             param::real("stiffness", 0.8)
                 .range(0, 1)
                 .doc("shape matching: fraction of the way to the goal per iteration"),
@@ -159,6 +172,7 @@ const AlgorithmInfo kInfo = {
 constexpr std::uint64_t kNoiseStream = 0x4ad71c00ull << 32;
 constexpr std::uint64_t kBranchStream = 0x4ad7b400ull << 32;
 constexpr std::uint64_t kLeafStream = 0x4ad71e00ull << 32;
+constexpr std::uint64_t kGapStream = 0x4ad79a00ull << 32;
 constexpr std::uint64_t kLightStream = 0x4ad7119bull << 32;
 constexpr std::uint64_t kWindStream = 0x4ad7714dull << 32;
 constexpr glm::vec3 kZ{0.0f, 0.0f, 1.0f};
@@ -307,6 +321,8 @@ Setup make_setup(const Params& p) {
       .gravity = f("gravity"),
       .stiffness = f("stiffness"),
       .damping = f("damping"),
+      .start_velocity = glm::vec3(p.vec3("start_velocity")),
+      .surface_variability = f("surface_variability"),
       .iterations = i("iterations"),
       .friction = f("friction"),
       .elasticity = f("elasticity"),
@@ -340,6 +356,8 @@ std::size_t Particles::bytes_per_particle() {
 
 Simulator::Simulator(const Scene& scene, const SceneQuery& query, const Setup& setup, std::uint64_t seed)
     : scene_(scene), query_(query), cfg_(setup.config), cuts_(setup.cuts), seed_(seed) {
+  Rng gap(seed, kGapStream, 0);  // each seed reads its own part of the surface-gap noise
+  gap_offset_ = glm::vec2(gap.uniform(0.0, 256.0), gap.uniform(0.0, 256.0));
   p_.reserve(cfg_.max_particles);
   seed_started_.assign(scene_.seeds.size(), 0);
   if (scene_.seeds.empty()) throw InputError(fmt::format("hadrich: scene '{}' has no seeds", scene_.name));
@@ -368,7 +386,7 @@ std::int32_t Simulator::activate(std::int32_t parent, const glm::vec3& tail, con
   const float h = 0.05f * cfg_.particle_length;  // a new particle starts at a tenth of its length
   const glm::vec3 f = q * kZ;
   p_.x.push_back(tail + f * h);
-  p_.v.push_back(parent >= 0 ? p_.v[parent] : glm::vec3(0.0f));
+  p_.v.push_back((parent >= 0 ? p_.v[parent] : glm::vec3(0.0f)) + cfg_.start_velocity);
   p_.w.push_back(glm::vec3(0.0f));
   p_.q.push_back(q);
   p_.rest.push_back(parent >= 0 ? glm::conjugate(p_.q[parent]) * q : glm::quat(1, 0, 0, 0));
@@ -723,8 +741,10 @@ void Simulator::contact_pass() {
           p_.flags[i] &= static_cast<std::uint8_t>(~Particles::Anchored);
       }
       const glm::vec3 before = xp;
-      // Pushed out to its longest semi-axis from the surface.
-      const float reach = std::max(p_.half[i], p_.radius[i]);
+      // Pushed out to its longest semi-axis from the surface, plus its own share of the variability.
+      const float body = std::max(p_.half[i], p_.radius[i]);
+      float reach = body;
+      if (cfg_.surface_variability > 0.0f) reach = std::max(body, std::min(body + surface_gap(i), query_.band_width()));
       SceneQuery::BandSample s = query_.band_sample(xp);
       if (!s.in_band && s.distance < 0.0f) {  // deep inside (beyond the band): exact distance and direction
         s.distance = query_.signed_distance(xp);
@@ -733,7 +753,8 @@ void Simulator::contact_pass() {
       // A growing particle touches within a quarter of its reach beyond the contact distance (adaptation
       // brings tips parallel to a surface at about that distance, where the push-out alone would rarely
       // fire).
-      if (p_.has(i, Particles::Growing) && s.in_band && s.distance < 1.25f * reach) p_.flags[i] |= Particles::Touched;
+      if (p_.has(i, Particles::Growing) && s.in_band && s.distance < reach + 0.25f * body)
+        p_.flags[i] |= Particles::Touched;
       bool contact = false;
       if ((s.in_band || s.distance < 0.0f) && s.distance < reach) {
         xp += (reach - s.distance) * s.gradient;
@@ -817,6 +838,13 @@ void Simulator::break_joints() {
     ++broken_;
     ++version_;
   }
+}
+
+// The extra distance particle i keeps from surfaces: a smooth noise along its shoot (neighbours agree, so
+// the shoot lifts off in waves rather than zigzags), in [0, surface_variability).
+float Simulator::surface_gap(std::size_t i) const {
+  const glm::vec2 at(static_cast<float>(p_.rank[i]) / 8.0f, static_cast<float>(p_.shoot[i] % 4096u) * 1.618f);
+  return cfg_.surface_variability * 0.5f * (1.0f + glm::simplex(at + gap_offset_));
 }
 
 void Simulator::physics() {

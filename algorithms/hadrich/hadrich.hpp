@@ -50,6 +50,8 @@ struct Config {
   float leaf_density, phyllotaxis, leaf_size, leaf_light;
   // physics
   float dt, gravity, stiffness, damping;
+  glm::vec3 start_velocity;  // added to the velocity each new particle inherits from its parent
+  float surface_variability;
   int iterations;
   float friction, elasticity, anchor_pull, anchor_release;
   float break_sensitivity;
@@ -145,6 +147,7 @@ class Simulator {
   [[nodiscard]] float occlusion(std::size_t i, const glm::vec3& at) const;
   [[nodiscard]] glm::vec3 wind(std::size_t i) const;
   [[nodiscard]] float max_radius(std::uint16_t order) const;
+  [[nodiscard]] float surface_gap(std::size_t i) const;
   // A child's centre at rest, in its parent's frame: its tail on the parent's head.
   [[nodiscard]] glm::vec3 rest_offset(std::size_t parent, std::size_t child) const;
 
@@ -153,6 +156,7 @@ class Simulator {
   Config cfg_;
   std::vector<Cut> cuts_;
   std::uint64_t seed_;
+  glm::vec2 gap_offset_{0.0f};  // where this seed reads the surface-gap noise
   Particles p_;
   std::vector<Leaf> leaves_;
   std::vector<std::int32_t> tips_;  // growing particles, ascending

@@ -84,6 +84,59 @@ TEST(Hadrich, AdaptationPullsAShootOntoAWallAndKeepsItThere) {
   EXPECT_GT(free_gaps.back(), 0.07f);
 }
 
+// The Houdini tool's variability from surface: each particle keeps its own extra distance from the
+// surface, up to the given amount, so the shoot hugs the wall less closely. It acts within the distance
+// field's narrow band, so a wider band lets a larger variability act.
+TEST(Hadrich, SurfaceVariabilityKeepsShootsFartherFromTheWall) {
+  const Scene s = wall_scene(0.08f);
+  auto settled_gap = [&](const SceneQuery& q, const std::string& variability) {
+    Simulator sim(s, q,
+                  setup({"max_laterals=0", "max_particles=120", "direction_noise=0", "light_rays=0",
+                         "surface_variability=" + variability}),
+                  1);
+    for (int i = 0; i < 600 && sim.step(); ++i) {
+    }
+    const auto gaps = main_shoot_gaps(sim);
+    double sum = 0.0;
+    for (std::size_t k = gaps.size() / 2; k < gaps.size(); ++k) sum += gaps[k];
+    return sum / static_cast<double>(gaps.size() - gaps.size() / 2);
+  };
+  const SceneQuery q(s);
+  const double hug = settled_gap(q, "0"), loose = settled_gap(q, "0.02");
+  // The extra distance is uniform in [0, 0.02): about 0.01 m on average.
+  EXPECT_GT(loose - hug, 0.006) << hug << " -> " << loose;
+  EXPECT_LT(loose - hug, 0.025) << hug << " -> " << loose;
+  // The gap is capped at the distance field's band (the push-out acts only there): a wider band lets a
+  // larger variability act, and neither sends the shoot off the wall.
+  const SceneQuery wide(s, {.band_voxels = 12.0f});
+  const double capped = settled_gap(q, "0.1"), free = settled_gap(wide, "0.1");
+  EXPECT_LT(capped, q.band_width()) << capped;
+  EXPECT_GT(free - capped, 0.01) << capped << " -> " << free;
+  EXPECT_LT(free, 0.1 + 0.02) << free;
+}
+
+// The Houdini tool's starting velocity of new particles. In open space with the light overhead and no
+// noise, the shoot grows straight up; a velocity along +z carries it toward +z, along -z toward -z.
+TEST(Hadrich, StartVelocityCarriesTheShoot) {
+  Scene s;
+  s.name = "test-open";
+  s.meshes.push_back(geom::make_box("far", {10.0f, -0.1f, 10.0f}, {10.1f, 0.0f, 10.1f}));
+  s.seeds.push_back({{0.0f, 0.0f, 0.0f}, {0, 1, 0}, 0});
+  s.light.direction = {0.0f, 1.0f, 0.0f};
+  SceneQuery q(s);
+  auto mean_z = [&](const std::string& set) {
+    Simulator sim(s, q, setup({"max_laterals=0", "max_particles=60", "direction_noise=0", "gravity=0", set}), 1);
+    for (int i = 0; i < 400 && sim.step(); ++i) {
+    }
+    double z = 0.0;
+    for (std::size_t i = 0; i < sim.particles().size(); ++i) z += sim.particles().x[i].z;
+    return z / static_cast<double>(sim.particles().size());
+  };
+  EXPECT_NEAR(mean_z("start_velocity=0,0,0"), 0.0, 1e-6);
+  EXPECT_GT(mean_z("start_velocity=0,0,0.5"), 0.05);
+  EXPECT_LT(mean_z("start_velocity=0,0,-0.5"), -0.05);
+}
+
 // In open space with the sun to the side (+x, up), the shoot turns toward it; with phototropism off it
 // keeps growing straight up.
 TEST(Hadrich, PhototropismTurnsTowardTheLight) {

@@ -159,6 +159,7 @@ Command add_run(CLI::App& app) {
   add_spec_option(run, "--time-limit", spec, "time_limit_s");
   add_spec_option(run, "-t,--threads", spec, "threads");
   add_spec_option(run, "--voxel-size", spec, "voxel_size");
+  add_spec_option(run, "--band-voxels", spec, "band_voxels");
   add_spec_option(run, "--sides", spec, "sides");
   add_spec_option(run, "--budget-nodes", spec, "budget_nodes");
   add_spec_option(run, "--budget-length", spec, "budget_length_m");

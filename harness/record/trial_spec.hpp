@@ -43,6 +43,7 @@ struct TrialSpec {
   double time_limit_s = 0.0;                   // 0: none; checked between steps
   int threads = 0;                             // 0: all cores
   double voxel_size = 0.0;                     // 0: automatic (see SceneQueryOptions)
+  double band_voxels = 0.0;                    // 0: SceneQueryOptions' default
   int sides = 6;                               // tube sides of the branch mesh
   // Comparable budgets across algorithms: stop once the plant has this many nodes / this much branch
   // length (0: no budget). Checked after every step.
@@ -90,6 +91,11 @@ struct TrialSpec {
             .in(kMinVoxelSize, kMaxVoxelSize)
             .with(kZeroOr)
             .describe("distance-field voxel size in metres (0: the scene diagonal / 256)"),
+        field("band_voxels", &S::band_voxels)
+            .in(1, 64)
+            .with(kZeroOr)
+            .describe("half-width of the distance field's narrow band in voxels, where collision and clinging "
+                      "read exact gradients (0: the default)"),
         field("sides", &S::sides).in(3, 64).describe("tube sides of the branch mesh"),
         field("budget_nodes", &S::budget_nodes).in(0, kMaxBudget).describe("stop at this many nodes (0: none)"),
         field("budget_length_m", &S::budget_length_m)

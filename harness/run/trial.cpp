@@ -381,6 +381,7 @@ void load_scene_and_query(const TrialSpec& spec, const Params& params, TrialStat
   });
   SceneQueryOptions qo;
   qo.voxel_size = static_cast<float>(spec.voxel_size);
+  if (spec.band_voxels > 0.0) qo.band_voxels = static_cast<float>(spec.band_voxels);
   st.query = timer.run(Phase::query_build, rec.phases, [&] { return std::make_unique<SceneQuery>(st.scene, qo); });
   PhaseMeasures& q = *rec.phases[Phase::query_build];
   q.bvh_s = st.query->bvh_build_seconds();

@@ -149,9 +149,9 @@ class SuiteReader : public JsonPathReader {
  private:
   // The trial settings a suite file may give, at its top level for every cell or in an algorithm entry for
   // its own: the trial spec's fields of the same names, checked as the spec declares them.
-  static constexpr std::array<const char*, 9> kSettings = {"threads",         "max_steps", "time_limit_s",
-                                                           "voxel_size",      "sides",     "budget_nodes",
-                                                           "budget_length_m", "metrics",   "glb"};
+  static constexpr std::array<const char*, 10> kSettings = {
+      "threads", "max_steps",    "time_limit_s",    "voxel_size", "band_voxels",
+      "sides",   "budget_nodes", "budget_length_m", "metrics",    "glb"};
 
   // What every cell shares, from the top level of the file.
   struct Common {

@@ -45,7 +45,7 @@ TEST(Cli, TheRecordHoldsTheWholeSpecAndReproducesThePlant) {
   const std::string out = (dir / "run").string();
   auto r = growbench(
       "run -q -a spacecol -s wall --set point_count=300 --sides 8 --glb plain --time-limit 100 "
-      "--seed 7 --seed-at 0.5,0.2,0 --budget-nodes 400 --voxel-size 0.05 -o " +
+      "--seed 7 --seed-at 0.5,0.2,0 --budget-nodes 400 --voxel-size 0.05 --band-voxels 6 -o " +
       out);
   ASSERT_EQ(r.status, 0) << r.out;
   std::ifstream in(dir / "run" / "record.json");
@@ -58,6 +58,7 @@ TEST(Cli, TheRecordHoldsTheWholeSpecAndReproducesThePlant) {
   EXPECT_EQ(spec["seed_at"], nlohmann::json::parse("[[0.5, 0.2, 0.0]]"));  // as given
   EXPECT_EQ(spec["budget_nodes"], 400);
   EXPECT_EQ(spec["voxel_size"], 0.05);
+  EXPECT_EQ(spec["band_voxels"], 6.0);
   EXPECT_EQ(spec["params"], nlohmann::json::parse(R"(["point_count=300"])"));
   EXPECT_EQ(spec["out_dir"], out);
   nlohmann::json again = spec;
