@@ -123,6 +123,10 @@ const AlgorithmInfo kInfo = {
             param::real("leaf_light", 0.7)
                 .range(0, 1)
                 .doc("how far a leaf turns its upper side from its phyllotactic pose to face the light"),
+            param::real("flower_density", 0.0)
+                .range(0, 1)
+                .doc("probability of a flower at each phyllotaxis site, beside its leaf, facing the light"),
+            param::real("flower_size", 0.04).range(0, 10).unit("m").doc("flower diameter"),
             // physics
             param::real("dt", 0.025).range(1e-4, 1).unit("s").doc("time step (the paper: 25 ms)"),
             param::real("gravity", 0.5)
@@ -317,6 +321,8 @@ Setup make_setup(const Params& p) {
       .phyllotaxis = f("phyllotaxis") * kDeg,
       .leaf_size = f("leaf_size"),
       .leaf_light = f("leaf_light"),
+      .flower_density = f("flower_density"),
+      .flower_size = f("flower_size"),
       .dt = f("dt"),
       .gravity = f("gravity"),
       .stiffness = f("stiffness"),
@@ -613,12 +619,16 @@ void Simulator::spawn() {
     if (p_.rank[i] % static_cast<std::uint32_t>(cfg_.leaf_step) == 0) {
       Rng leaf(seed_, kLeafStream, idx);
       const double u1 = leaf.uniform(), u2 = leaf.uniform();
+      const float site = static_cast<float>(p_.rank[i] / static_cast<std::uint32_t>(cfg_.leaf_step));
+      const float azimuth = std::fmod(site * cfg_.phyllotaxis, 2.0f * std::numbers::pi_v<float>);
       if (u1 < cfg_.leaf_density) {
-        const float site = static_cast<float>(p_.rank[i] / static_cast<std::uint32_t>(cfg_.leaf_step));
-        leaves_.push_back({i, std::fmod(site * cfg_.phyllotaxis, 2.0f * std::numbers::pi_v<float>),
-                           cfg_.leaf_size * static_cast<float>(0.8 + 0.4 * u2)});
+        leaves_.push_back({i, azimuth, cfg_.leaf_size * static_cast<float>(0.8 + 0.4 * u2)});
         ++live_leaves_;
       }
+      // Drawn after the leaf's numbers, so flowers leave every leaf where it was.
+      if (cfg_.flower_density > 0.0f && leaf.uniform() < cfg_.flower_density)
+        flowers_.push_back({i, azimuth + std::numbers::pi_v<float>,
+                            cfg_.flower_size * static_cast<float>(0.85 + 0.3 * leaf.uniform())});
     }
   }
   tips_.swap(next);  // surviving tips keep their order; new ones have higher indices
@@ -936,6 +946,7 @@ std::size_t Simulator::prune_subtree(std::int32_t root) {
   for (const Leaf& l : leaves_)
     if (dead[l.particle]) --live_leaves_;
   std::erase_if(leaves_, [&](const Leaf& l) { return dead[l.particle] != 0; });
+  std::erase_if(flowers_, [&](const Leaf& l) { return dead[l.particle] != 0; });
   ++version_;
   return removed;
 }
@@ -972,7 +983,7 @@ const Plant& Simulator::plant() const {
     plant_.nodes.push_back(n);
     node_particle_.push_back(static_cast<std::int32_t>(i));
   }
-  plant_.organs.reserve(leaves_.size());
+  plant_.organs.reserve(leaves_.size() + flowers_.size());
   for (const Leaf& l : leaves_) {
     const auto i = static_cast<std::size_t>(l.particle);
     const glm::vec3 f = forward(i);
@@ -1000,8 +1011,32 @@ const Plant& Simulator::plant() const {
     o.node = node_of[i];
     plant_.organs.push_back(o);
   }
+  for (const Leaf& fl : flowers_) plant_.organs.push_back(flower(fl, node_of[static_cast<std::size_t>(fl.particle)]));
   plant_version_ = version_;
   return plant_;
+}
+
+// A flower on a short stalk opposite its site's leaf, facing the light (+Z, the flower's face), or, where
+// a surface hides the light, facing away from the surface.
+Organ Simulator::flower(const Leaf& fl, std::int32_t node) const {
+  const auto i = static_cast<std::size_t>(fl.particle);
+  const glm::vec3 f = forward(i);
+  const glm::vec3 side = p_.q[i] * glm::vec3(std::cos(fl.azimuth), std::sin(fl.azimuth), 0.0f);
+  const glm::vec3 ns = p_.normal[i];
+  glm::vec3 stalk = glm::normalize(side + f);
+  if (glm::length(ns) > 0.5f) stalk -= std::min(0.0f, glm::dot(stalk, ns)) * ns;  // not into the surface
+  const glm::vec3 at = p_.x[i] + f * p_.half[i] + 0.5f * fl.size * stalk;
+  glm::vec3 face = scene_.light.towards(at);
+  if (glm::length(ns) > 0.5f && glm::dot(face, ns) < 0.0f) face = ns;
+  face = glm::normalize(face + 0.3f * side);
+  const glm::vec3 up = glm::normalize(glm::cross(face, any_perpendicular(face)));
+  Organ o;
+  o.position = at;
+  o.orientation = glm::quat_cast(glm::mat3(glm::cross(up, face), up, face));
+  o.size = fl.size;
+  o.kind = OrganKind::Flower;
+  o.node = node;
+  return o;
 }
 
 std::vector<std::pair<std::string, double>> Simulator::stats() const {
@@ -1021,6 +1056,7 @@ std::vector<std::pair<std::string, double>> Simulator::stats() const {
           {"broken", static_cast<double>(broken_)},
           {"pruned", static_cast<double>(pruned_)},
           {"leaves", static_cast<double>(live_leaves_)},
+          {"flowers", static_cast<double>(flowers_.size())},
           {"max_speed_m_s", static_cast<double>(max_speed)},
           {"pool_full", pool_full_ ? 1.0 : 0.0},
           {"bytes_per_particle", static_cast<double>(Particles::bytes_per_particle())}};

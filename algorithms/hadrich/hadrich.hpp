@@ -48,6 +48,7 @@ struct Config {
   int max_laterals, max_order, leaf_step;
   float shoot_density, branch_variance;
   float leaf_density, phyllotaxis, leaf_size, leaf_light;
+  float flower_density, flower_size;
   // physics
   float dt, gravity, stiffness, damping;
   glm::vec3 start_velocity;  // added to the velocity each new particle inherits from its parent
@@ -148,6 +149,7 @@ class Simulator {
   [[nodiscard]] glm::vec3 wind(std::size_t i) const;
   [[nodiscard]] float max_radius(std::uint16_t order) const;
   [[nodiscard]] float surface_gap(std::size_t i) const;
+  [[nodiscard]] Organ flower(const Leaf& fl, std::int32_t node) const;
   // A child's centre at rest, in its parent's frame: its tail on the parent's head.
   [[nodiscard]] glm::vec3 rest_offset(std::size_t parent, std::size_t child) const;
 
@@ -159,6 +161,7 @@ class Simulator {
   glm::vec2 gap_offset_{0.0f};  // where this seed reads the surface-gap noise
   Particles p_;
   std::vector<Leaf> leaves_;
+  std::vector<Leaf> flowers_;       // azimuth: where its stalk leaves the stem; size: its diameter
   std::vector<std::int32_t> tips_;  // growing particles, ascending
   std::vector<std::uint8_t> seed_started_;
   int step_ = 0;

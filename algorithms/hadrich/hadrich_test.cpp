@@ -198,6 +198,33 @@ TEST(Hadrich, ShootsClimbTheBoulder) {
   EXPECT_GT(share, 0.5) << on_rock << " of " << plant.nodes.size() << " nodes on the rock";
 }
 
+// Flowers come from the leaf pass: with flower_density, some sites carry one, every leaf stays where
+// it was (the flower's numbers are drawn after the leaf's), and each flower faces the light or away
+// from the surface it grows on, never into it.
+TEST(Hadrich, FlowersJoinTheLeavesAndFaceOut) {
+  const Scene s = load_scene("wall");
+  SceneQuery q(s);
+  const Plant bare = test::grow("hadrich", s, q, {"max_particles=2000"});
+  const Plant flowering = test::grow("hadrich", s, q, {"max_particles=2000", "flower_density=0.3"});
+  std::vector<const Organ*> leaves, flowers;
+  for (const auto& o : flowering.organs) (o.kind == OrganKind::Flower ? flowers : leaves).push_back(&o);
+  ASSERT_EQ(leaves.size(), bare.organs.size());
+  for (std::size_t k = 0; k < leaves.size(); ++k) EXPECT_EQ(leaves[k]->position, bare.organs[k].position);
+  for (const auto& o : bare.organs) EXPECT_EQ(o.kind, OrganKind::Leaf);
+  // About 0.3 of the sites: the sites are those with a leaf (density 0.7) and those without.
+  const double sites = static_cast<double>(leaves.size()) / 0.7;
+  EXPECT_GT(static_cast<double>(flowers.size()), 0.2 * sites);
+  EXPECT_LT(static_cast<double>(flowers.size()), 0.4 * sites);
+  const glm::vec3 light = glm::normalize(s.light.direction);
+  for (const Organ* f : flowers) {
+    const glm::vec3 face = f->orientation * glm::vec3(0, 0, 1);
+    const glm::vec3 n = q.gradient(f->position);
+    EXPECT_TRUE(glm::dot(face, light) > 0.0f || glm::dot(face, n) > 0.0f) << "a flower faces into the wall";
+    EXPECT_GT(q.signed_distance(f->position), 0.0f);
+    EXPECT_GE(f->node, 0);
+  }
+}
+
 // Closed solids: no plant node inside the column, the boulder or the bunny.
 TEST(Hadrich, NoNodeInsideClosedSolids) {
   for (const std::string name : {"column", "boulder"}) {
