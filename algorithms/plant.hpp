@@ -89,7 +89,9 @@ struct TubeStyle {
 // The image's (u, v) cover [0, 1]^2 with v up: its top row is v = 1, as in OBJ texture coordinates.
 struct SurfaceDecal {
   std::string image;  // PNG file name, relative to the directory of the file that holds the plant
-  // mesh >= 0: the image follows that scene mesh's texture coordinates (TriangleMesh::uvs).
+  // mesh >= 0: the image follows that scene mesh's texture coordinates (TriangleMesh::uvs). It covers
+  // the unit square of them, or, when u_axis.x and v_axis.y are positive, the rectangle from
+  // (origin.x, origin.y) to (origin.x + u_axis.x, origin.y + v_axis.y) (a layout beyond the unit square).
   // mesh == kPlanarDecal: (u, v) sits at origin + u * u_axis + v * v_axis and is projected along
   // u_axis x v_axis onto the climbable meshes; in a scene with none, that rectangle itself wears it.
   std::int32_t mesh = -1;

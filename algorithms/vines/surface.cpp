@@ -97,7 +97,23 @@ Surface::Surface(const TriangleMesh& mesh) {
     const glm::uvec3& ut = mesh.uv_triangles[t];
     uv_.push_back({mesh.uvs[ut.x], mesh.uvs[ut.y], mesh.uvs[ut.z]});
   }
+  fit_uvs();
   build();
+}
+
+void Surface::fit_uvs() {
+  glm::vec2 lo(std::numeric_limits<float>::max()), hi(std::numeric_limits<float>::lowest());
+  for (const auto& t : uv_)
+    for (const glm::vec2& c : t) {
+      lo = glm::min(lo, c);
+      hi = glm::max(hi, c);
+    }
+  if (uv_.empty() || (lo.x >= 0.0f && lo.y >= 0.0f && hi.x <= 1.0f && hi.y <= 1.0f)) return;
+  // The unit square as a decal on the mesh spans [origin, origin + side]^2 of its coordinates.
+  uv_origin_ = lo;
+  uv_side_ = std::max({hi.x - lo.x, hi.y - lo.y, std::numeric_limits<float>::min()});
+  for (auto& t : uv_)
+    for (glm::vec2& c : t) c = glm::min((c - uv_origin_) / uv_side_, glm::vec2(1.0f));
 }
 
 Surface Surface::canvas(const glm::vec3& origin, const glm::vec3& u_axis, const glm::vec3& v_axis) {

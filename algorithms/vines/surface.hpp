@@ -39,7 +39,9 @@ struct Walk {
 class Surface {
  public:
   // A scene mesh with texture coordinates (mesh.has_uvs()). Positions are welded by exact equality, so
-  // a mesh whose seams duplicate vertices is still connected across them.
+  // a mesh whose seams duplicate vertices is still connected across them. Texture coordinates beyond
+  // the unit square (tiled, UDIM-like or negative layouts) are fitted into it: their bounding box is
+  // moved to the origin and scaled uniformly, which keeps charts apart and their shapes (see uv_rect).
   explicit Surface(const TriangleMesh& mesh);
   // The unit square as two triangles spanning origin, origin + u_axis, origin + u_axis + v_axis.
   static Surface canvas(const glm::vec3& origin, const glm::vec3& u_axis, const glm::vec3& v_axis);
@@ -56,6 +58,11 @@ class Surface {
   [[nodiscard]] double mean_area_ratio() const { return mean_ratio_; }
   [[nodiscard]] double surface_area() const { return surface_area_; }
   [[nodiscard]] double uv_area() const { return uv_area_; }
+  // Where the unit square lies in the mesh's own texture coordinates: its corner and side. (0, 0) and 1
+  // unless the mesh's layout went beyond the unit square and was fitted into it.
+  [[nodiscard]] glm::vec2 uv_origin() const { return uv_origin_; }
+  [[nodiscard]] float uv_side() const { return uv_side_; }
+  [[nodiscard]] bool uv_fitted() const { return uv_side_ != 1.0f || uv_origin_ != glm::vec2(0.0f); }
   // The 3D image of a UV direction at a triangle (d/du, d/dv applied to it), not normalised.
   [[nodiscard]] glm::vec3 uv_to_3d(std::uint32_t tri, const glm::vec2& d) const;
   // The UV direction whose 3D image is the tangential part of d (least squares), not normalised.
@@ -73,14 +80,17 @@ class Surface {
 
  private:
   Surface() = default;
-  void build();  // everything derived from corners_, uv_ and pos_
+  void fit_uvs();  // a layout beyond the unit square into it (uv_origin_, uv_side_)
+  void build();    // everything derived from corners_, uv_ and pos_
   void build_adjacency();
   void build_uv_grid();
   [[nodiscard]] bool is_seam(std::uint32_t tri, int edge) const;
 
   std::vector<glm::vec3> pos_;                // welded positions
   std::vector<glm::uvec3> corners_;           // into pos_
-  std::vector<std::array<glm::vec2, 3>> uv_;  // per triangle corner
+  std::vector<std::array<glm::vec2, 3>> uv_;  // per triangle corner, in the unit square
+  glm::vec2 uv_origin_{0.0f};                 // the mesh's texture coordinates = uv_origin_ + uv_side_ * uv_
+  float uv_side_ = 1.0f;
   std::vector<glm::vec3> normal_;
   std::vector<float> ratio_;
   // Across edge k of triangle t (from corner k to corner k+1): the neighbour and its edge, or -1.

@@ -235,6 +235,7 @@ class Vines final : public GrowthAlgorithm {
       params_->set("influence", fmt::format("{}", cfg_.influence));
     }
     warnings_.clear();
+    warn_of_fitted_uvs();
     warn_of_rootless_tags();
     iteration_ = 0;
     last_kill_ = 0;
@@ -337,7 +338,13 @@ class Vines final : public GrowthAlgorithm {
     plant_.decals.clear();
     if (mesh_ != kNone) {
       surface_ = std::make_unique<vines::Surface>(scene_->meshes[static_cast<std::size_t>(mesh_)]);
-      plant_.decals.push_back({"texture.png", mesh_, {}, {}, {}});
+      if (surface_->uv_fitted()) {  // the texture spans the fitted square of the mesh's coordinates
+        const glm::vec2 o = surface_->uv_origin();
+        const float side = surface_->uv_side();
+        plant_.decals.push_back({"texture.png", mesh_, {o.x, o.y, 0.0f}, {side, 0.0f, 0.0f}, {0.0f, side, 0.0f}});
+      } else {
+        plant_.decals.push_back({"texture.png", mesh_, {}, {}, {}});
+      }
     } else {
       canvas_ = canvas_of(*scene_);
       climbable_ = scene_->has_climbable();
@@ -420,6 +427,18 @@ class Vines final : public GrowthAlgorithm {
 
   // A tag no root carries leaves the attractors only it may take out of reach: the vines stop short of
   // them, which looks like a stall. Said, with how many.
+  // Says which layout the texture follows when the mesh's coordinates went beyond the unit square.
+  void warn_of_fitted_uvs() {
+    if (mesh_ == kNone || !surface_->uv_fitted()) return;
+    const glm::vec2 o = surface_->uv_origin();
+    const float side = surface_->uv_side();
+    warnings_.push_back(fmt::format(
+        "scene mesh '{}' has texture coordinates beyond the unit square; the vines grow on them fitted into it, and "
+        "texture.png covers u in [{:.4g}, {:.4g}], v in [{:.4g}, {:.4g}] of the mesh's coordinates (one image over "
+        "the whole layout, not a tile repeated)",
+        scene_->meshes[static_cast<std::size_t>(mesh_)].name, o.x, o.x + side, o.y, o.y + side));
+  }
+
   void warn_of_rootless_tags() {
     std::uint32_t rooted = 0;
     for (const auto t : tag_) rooted |= 1u << t;

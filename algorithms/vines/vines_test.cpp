@@ -520,6 +520,39 @@ TEST(Vines, MeasuredOnTheSurfaceAChartsUvScaleDoesNotChangeTheVine) {
   EXPECT_LT(uv_count[0] / uv_count[1], 0.5);
 }
 
+// Texture coordinates beyond the unit square (a tiled or UDIM-like layout, here tripled and moved to
+// u in [1, 4], v in [-2, 1]) are fitted into it: the vine grows as it does on the same layout inside the
+// unit square, the decal spans the layout's square, and a warning says so.
+TEST(Vines, ALayoutBeyondTheUnitSquareIsFittedIntoIt) {
+  Scene moved = cube();
+  for (glm::vec2& uv : moved.meshes[0].uvs) uv = 3.0f * uv + glm::vec2(1.0f, -2.0f);
+  const SceneQuery query(moved);
+  const std::vector<std::string> sets = {"space=uv", "resolution=64"};
+  const Grown inside = grow_vines(cube(), cube_query(), sets);
+  const Grown beyond = grow_vines(moved, query, sets);
+  glm::vec2 lo(1e9f), hi(-1e9f);
+  for (const glm::vec2& uv : cube().meshes[0].uvs) {
+    lo = glm::min(lo, uv);
+    hi = glm::max(hi, uv);
+  }
+  ASSERT_EQ(beyond.plant.decals.size(), 1u);
+  const SurfaceDecal& d = beyond.plant.decals[0];
+  EXPECT_NEAR(d.origin.x, 3.0f * lo.x + 1.0f, 1e-5f);
+  EXPECT_NEAR(d.origin.y, 3.0f * lo.y - 2.0f, 1e-5f);
+  EXPECT_NEAR(d.u_axis.x, 3.0f * std::max(hi.x - lo.x, hi.y - lo.y), 1e-5f);
+  EXPECT_EQ(d.u_axis.x, d.v_axis.y);
+  EXPECT_EQ(inside.plant.decals[0].u_axis, glm::vec3(0.0f)) << "inside the unit square the decal is as before";
+  // The cube's own layout fills the unit square, so the fitted one is the same up to rounding.
+  ASSERT_GT(inside.plant.nodes.size(), 400u);
+  EXPECT_NEAR(static_cast<double>(beyond.plant.nodes.size()) / static_cast<double>(inside.plant.nodes.size()), 1.0,
+              0.05);
+  ASSERT_EQ(beyond.warnings.size(), 1u);
+  EXPECT_NE(beyond.warnings[0].find("scene mesh '" + moved.meshes[0].name + "' has texture coordinates beyond"),
+            std::string::npos)
+      << beyond.warnings[0];
+  EXPECT_TRUE(inside.warnings.empty());
+}
+
 // ---------- determinism ----------
 
 TEST(Vines, ThePlantAndTheTextureAreTheSameForOneAndTwoThreads) {

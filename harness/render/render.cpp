@@ -349,8 +349,12 @@ constexpr const char* kDecalFinish = "finish { GB_DecalFinish }";
 // uv_mapping modifies the pigment: on the texture it would make a patterned texture, which POV-Ray
 // refuses as a layer.
 void write_uv_decal_layer(Out out, const SurfaceDecal& d) {
-  fmt::format_to(out, "  texture {{ pigment {{ uv_mapping image_map {{ png \"{}\" once interpolate 2 }} }} {} }}\n",
-                 d.image, kDecalFinish);
+  std::string rect;  // the image moved from the unit square onto its rectangle of the mesh's coordinates
+  if (d.mesh >= 0 && d.u_axis.x > 0.0f && d.v_axis.y > 0.0f)
+    rect = fmt::format(" scale <{:.9g},{:.9g},1> translate <{:.9g},{:.9g},0>", d.u_axis.x, d.v_axis.y, d.origin.x,
+                       d.origin.y);
+  fmt::format_to(out, "  texture {{ pigment {{ uv_mapping image_map {{ png \"{}\" once interpolate 2 }}{} }} {} }}\n",
+                 d.image, rect, kDecalFinish);
 }
 
 // A planar decal: image_map's projection of the unit square in x-y along z, carried by the matrix to

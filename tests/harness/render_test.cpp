@@ -497,6 +497,27 @@ TEST(PovWriter, StudioBackdropReplacesSkyAndGroundAndKeepsWhatThePlantClimbs) {
   EXPECT_EQ(count_of(studio, "\n  cone {"), tiny_plant().nodes.size() - 1);  // the plant is all there
 }
 
+// A decal whose mesh's layout went beyond the unit square spans its rectangle of the mesh's coordinates:
+// the image is scaled and moved in UV space.
+TEST(PovWriter, AUvDecalSpansItsRectangleOfTheMeshsCoordinates) {
+  const auto dir = test::temp_dir("pov_uvrect");
+  TriangleMesh quad = geom::make_box("quad", {-1.0f, 0.0f, -0.1f}, {1.0f, 2.0f, 0.0f});
+  quad.uvs.assign(quad.vertices.size(), glm::vec2(2.0f, -1.0f));
+  for (const auto& t : quad.triangles) quad.uv_triangles.push_back(t);
+  const Scene scene = test::scene_with(quad);
+  Plant plant = tiny_plant();
+  plant.decals = {{"texture.png", 0, {1.0f, -2.0f, 0.0f}, {3.0f, 0.0f, 0.0f}, {0.0f, 3.0f, 0.0f}}};
+  RenderOptions o;
+  write_pov((dir / "s.pov").string(), scene, plant, o);
+  EXPECT_NE(read_file(dir / "s.pov")
+                .find("image_map { png \"texture.png\" once interpolate 2 } scale <3,3,1> "
+                      "translate <1,-2,0> }"),
+            std::string::npos);
+  plant.decals[0] = {"texture.png", 0, {}, {}, {}};  // the unit square: as before
+  write_pov((dir / "u.pov").string(), scene, plant, o);
+  EXPECT_NE(read_file(dir / "u.pov").find("image_map { png \"texture.png\" once interpolate 2 } }"), std::string::npos);
+}
+
 // A collision-only mesh (visible: false) is in neither the render nor the exported scene, with any backdrop.
 TEST(PovWriter, ACollisionOnlyMeshIsNotDrawn) {
   const auto dir = test::temp_dir("pov_hidden");
