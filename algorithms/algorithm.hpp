@@ -93,7 +93,8 @@ class GrowthAlgorithm {
   [[nodiscard]] virtual OwnVerdict own_verdict() const { return {}; }
   // Files only this algorithm makes, for the plant as it is now (the vines' texture, its normal map and
   // its skeleton as SVG). The image of each of plant().decals must be among them, named prefix + image.
-  // Called in the export phase (timed there) and, for each growth frame, with frame set.
+  // Called in the outputs phase (timed there, apart from the mesh exports) and, for each growth frame,
+  // with frame set.
   [[nodiscard]] virtual std::vector<OutputFile> write_outputs(const OutputRequest& /*request*/) const { return {}; }
 
  private:

@@ -215,6 +215,14 @@ class Vines final : public GrowthAlgorithm {
  public:
   const AlgorithmInfo& describe() const override { return kInfo; }
 
+  // The mask is decoded here, in the harness's scene_load phase, so growth times growing only; start()
+  // decodes it itself when this was not called (tests that call start() directly).
+  void load_inputs(const Params& p) override {
+    loaded_mask_.reset();
+    loaded_mask_path_ = p.text("mask");
+    if (!loaded_mask_path_.empty()) loaded_mask_ = vines::Mask::read(loaded_mask_path_, "mask");
+  }
+
   void start(const Scene& scene, const SceneQuery& query, const Params& p, std::uint64_t seed) override {
     scene_ = &scene;
     query_ = &query;
@@ -225,7 +233,11 @@ class Vines final : public GrowthAlgorithm {
     if (!leaf_texture_.empty()) check_png(leaf_texture_, "leaf_texture");
     std::optional<vines::Mask> mask;
     mask_path_ = p.text("mask");
-    if (!mask_path_.empty()) mask = vines::Mask::read(mask_path_, "mask");
+    if (loaded_mask_ && loaded_mask_path_ == mask_path_)
+      mask = std::move(loaded_mask_);
+    else if (!mask_path_.empty())
+      mask = vines::Mask::read(mask_path_, "mask");
+    loaded_mask_.reset();
     make_surface();
     place_attractors(mask ? &*mask : nullptr);
     place_roots(p.text("roots"), mask ? &*mask : nullptr);
@@ -599,6 +611,8 @@ class Vines final : public GrowthAlgorithm {
   std::string leaf_texture_, mask_path_;
   std::optional<Params> params_;  // as given, with the influence radius the default became
   std::vector<std::string> warnings_;
+  std::optional<vines::Mask> loaded_mask_;  // decoded by load_inputs, taken by start
+  std::string loaded_mask_path_;
   std::int32_t mesh_ = kNone;
   Canvas canvas_;
   bool climbable_ = true;  // the canvas projects onto climbable meshes; without any it stands free

@@ -265,6 +265,30 @@ void check_mask(const std::string& mode) {
   }
 }
 
+// The harness calls load_inputs in its scene_load phase: the mask is decoded there, so growth does not
+// time it. start() then uses the decoded mask: here its file is gone by then, and the vine is the one
+// grown from the file.
+TEST(Vines, TheMaskIsDecodedWithTheInputsNotInGrowth) {
+  const fs::path d = test::temp_dir("vines_mask_inputs");
+  const std::string path = write_mask(d / "m.png", 32, 32, [](int x, int) { return x < 16 ? kRed : kWhite; });
+  const std::vector<std::string> sets = {"space=canvas", "resolution=48", "mask=" + path};
+  const std::string hash = grow_vines(wall(), wall_query(), sets).plant.geometry_hash();
+  const AlgorithmEntry& e = find_algorithm("vines");
+  Params p = default_params(e);
+  for (const auto& s : sets) p.set_assignment(s);
+  auto algo = e.make();
+  algo->load_inputs(p);
+  fs::remove(path);
+  algo->start(wall(), wall_query(), p, 1);
+  for (int i = 0; i < 20000 && algo->step(); ++i) {
+  }
+  algo->finish();
+  EXPECT_EQ(algo->plant().geometry_hash(), hash);
+  // Without load_inputs, start() reads the file itself, and names it when it is missing.
+  auto again = e.make();
+  EXPECT_THROW(again->start(wall(), wall_query(), p, 1), InputError);
+}
+
 TEST(Vines, AnInclusionMaskKeepsTheVinesInsideItsRedZone) {
   check_mask("include");
 }

@@ -122,14 +122,16 @@ constexpr std::string_view schema_name_of() {
 // ---------------------------------------------------------------- phases
 
 // The phases of a trial, in pipeline order: the order every list of them follows.
-enum class Phase : std::uint8_t { scene_load, query_build, growth, organs, meshing, exporting, metrics };
-inline constexpr std::size_t kPhaseCount = 7;
+// `outputs` is the algorithm's own files (GrowthAlgorithm::write_outputs, e.g. the vines' textures drawn
+// and written), apart from `export`, the plant's mesh and skeleton files every algorithm writes.
+enum class Phase : std::uint8_t { scene_load, query_build, growth, organs, meshing, exporting, outputs, metrics };
+inline constexpr std::size_t kPhaseCount = 8;
 // Their JSON names ("export" is a C++ keyword, hence `exporting`).
 inline constexpr std::array<std::string_view, kPhaseCount> kPhaseNames = {
-    "scene_load", "query_build", "growth", "organs", "meshing", "export", "metrics"};
+    "scene_load", "query_build", "growth", "organs", "meshing", "export", "outputs", "metrics"};
 inline constexpr std::array<Phase, kPhaseCount> kPhases = {Phase::scene_load, Phase::query_build, Phase::growth,
                                                            Phase::organs,     Phase::meshing,     Phase::exporting,
-                                                           Phase::metrics};
+                                                           Phase::outputs,    Phase::metrics};
 
 constexpr std::string_view phase_name(Phase p) {
   return kPhaseNames[static_cast<std::size_t>(p)];

@@ -528,9 +528,14 @@ void mesh_export_measure(const TrialSpec& spec, const MesherOptions& mesher, Tri
     b.glb_plain = spec.glb == GlbLayout::Plain ? *b.glb : plain_glb_bytes(st.mesh);
     b.skeleton_obj = write_skeleton_obj((d / "skeleton.obj").string(), plant);
     b.skeleton_ply = write_skeleton_ply((d / "skeleton.ply").string(), plant);
-    for (const auto& f : algorithm_outputs(*st.algo, plant, {d.string(), "", false}))
-      b.algorithm_files[f.name] = f.bytes;
   });
+  if (!spec.out_dir.empty()) {
+    timer.run(Phase::outputs, rec.phases, [&] {
+      for (const auto& f : algorithm_outputs(*st.algo, plant, {spec.out_dir, "", false}))
+        out.output_bytes.algorithm_files[f.name] = f.bytes;
+    });
+    if (out.output_bytes.algorithm_files.empty()) rec.phases[Phase::outputs].reset();  // it wrote nothing
+  }
   if (spec.metrics) {
     MetricOptions metric_options;
     metric_options.custom_leaf = mesher.leaf;

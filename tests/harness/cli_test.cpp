@@ -186,8 +186,24 @@ TEST(Cli, RunWritesMeshesSkeletonAndRecord) {
     EXPECT_TRUE(rec["phases"].contains(ph)) << ph;
     EXPECT_GE(rec["phases"][ph]["wall_s"].get<double>(), 0.0);
   }
+  EXPECT_FALSE(rec["phases"].contains("outputs")) << "spacecol writes no files of its own";
   EXPECT_GT(rec["counts"]["nodes"].get<int>(), 50);
   EXPECT_EQ(rec["geometry_hash"].get<std::string>().size(), 16u);
+}
+
+// The vines' own files (texture, normal map, SVG) are drawn and written in their own phase, `outputs`,
+// apart from the mesh exports, so drawing time can be plotted against resolution.
+TEST(Cli, AnAlgorithmsOwnFilesAreTimedInTheOutputsPhase) {
+  const auto dir = test::temp_dir("cli_outputs");
+  const auto r = growbench("run -q -a vines -s wall --set resolution=48 --threads 1 -o " + dir.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::ifstream in(dir / "record.json");
+  const auto rec = nlohmann::json::parse(in);
+  ASSERT_TRUE(rec["phases"].contains("outputs"));
+  EXPECT_GT(rec["phases"]["outputs"]["wall_s"].get<double>(), 0.0);
+  EXPECT_TRUE(rec["phases"].contains("export"));
+  EXPECT_EQ(rec["output_bytes"]["algorithm_files"]["texture.png"].get<std::uintmax_t>(),
+            std::filesystem::file_size(dir / "texture.png"));
 }
 
 TEST(Cli, CustomLeafObjForHadrich) {
