@@ -303,7 +303,10 @@ class SpaceColonization final : public PortableGrowthAlgorithm {
       sample_accepted(
           count,
           [&](std::size_t i) {
-            Rng rng(seed_, 0xE1u, 4 * i);
+            // With center_density a candidate may take many tries, so it draws from a stream of its own
+            // (overlapping slots gave neighbouring candidates the same point); the uniform case keeps the
+            // stream it always had, so its plants are unchanged.
+            Rng rng = cfg_.center_density > 0.0f ? Rng(seed_, (0xE2ull << 40) | i, 0) : Rng(seed_, 0xE1u, 4 * i);
             for (int tries = 0; tries < (cfg_.center_density > 0.0f ? 1024 : 64); ++tries) {
               glm::vec3 q;
               if (env.kind == Shape::Kind::Sphere)
