@@ -63,6 +63,9 @@ class Surface {
   [[nodiscard]] glm::vec2 uv_origin() const { return uv_origin_; }
   [[nodiscard]] float uv_side() const { return uv_side_; }
   [[nodiscard]] bool uv_fitted() const { return uv_side_ != 1.0f || uv_origin_ != glm::vec2(0.0f); }
+  // A point of the unit square in the mesh's own texture coordinates, and back (identities unless fitted).
+  [[nodiscard]] glm::vec2 mesh_uv(const glm::vec2& uv) const { return uv_origin_ + uv_side_ * uv; }
+  [[nodiscard]] glm::vec2 square_uv(const glm::vec2& mesh) const { return (mesh - uv_origin_) / uv_side_; }
   // The 3D image of a UV direction at a triangle (d/du, d/dv applied to it), not normalised.
   [[nodiscard]] glm::vec3 uv_to_3d(std::uint32_t tri, const glm::vec2& d) const;
   // The UV direction whose 3D image is the tangential part of d (least squares), not normalised.

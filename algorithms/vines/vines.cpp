@@ -82,9 +82,9 @@ const AlgorithmInfo kInfo = {
             param::integer("stall_iterations", 10)
                 .range(1, 100000)
                 .doc("growth stops when no attractor has been killed for this many iterations"),
-            param::text("roots").doc(
-                "root growers: 'u,v[,tag];...' in UV, or 'random' (root_count of them); empty: the mask's green "
-                "dots, else the scene's seeds"),
+            param::text("roots").doc("root growers: 'u,v[,tag];...' in the mesh's UV, or 'random' (root_count of "
+                                     "them); empty: the mask's green "
+                                     "dots, else the scene's seeds"),
             param::integer("root_count", 3).range(1, 10000).doc("number of random roots (roots=random)"),
             param::text("mask").doc("inclusion/exclusion map, a PNG: red marks the zone, green dots mark roots"),
             param::choice("mask_mode", "include", {"include", "exclude"})
@@ -428,7 +428,7 @@ class Vines final : public GrowthAlgorithm {
     if (cfg_.metric == Metric::Surface)  // as many attractors per surface area in a squeezed chart as elsewhere
       weight = surface_->area_ratio(l->tri) / surface_->mean_area_ratio();
     if (chance >= cfg_.density * weight) return std::nullopt;
-    if (mask && mask->zone(uv) != cfg_.mask_include) return std::nullopt;
+    if (mask && mask->zone(surface_->mesh_uv(uv)) != cfg_.mask_include) return std::nullopt;
     const Placed at = place(*l);
     if (!at.on_scene || !colonization::zones_allow(*scene_, query_->host_queries(), at.position)) return std::nullopt;
     return l;
@@ -767,13 +767,15 @@ std::vector<std::pair<Location, int>> Vines::parse_roots(const std::string& text
       ok = ok && n < 3 && part.find_first_not_of(" \t", used) == std::string::npos && std::isfinite(v[n]);
       ++n;
     }
+    // In the mesh's own texture coordinates, as a mask is painted: the texture's square of them.
+    const glm::vec2 lo = surface_->mesh_uv(glm::vec2(0.0f)), hi = surface_->mesh_uv(glm::vec2(1.0f));
     const bool tag_ok = n != 3 || (v[2] >= 0 && v[2] < cfg_.tags && v[2] == std::floor(v[2]));
-    if (!ok || n < 2 || !tag_ok || v[0] < 0 || v[0] > 1 || v[1] < 0 || v[1] > 1)
-      throw InputError(
-          fmt::format("algorithm 'vines': roots entry {} ('{}'): expected u,v or u,v,tag with u and v "
-                      "in [0, 1] and tag an integer in [0, {}], entries separated by ';'",
-                      index, item, cfg_.tags - 1));
-    const auto l = surface_->locate({static_cast<float>(v[0]), static_cast<float>(v[1])});
+    if (!ok || n < 2 || !tag_ok || v[0] < lo.x || v[0] > hi.x || v[1] < lo.y || v[1] > hi.y)
+      throw InputError(fmt::format(
+          "algorithm 'vines': roots entry {} ('{}'): expected u,v or u,v,tag with u in [{:.4g}, {:.4g}], v in "
+          "[{:.4g}, {:.4g}] and tag an integer in [0, {}], entries separated by ';'",
+          index, item, lo.x, hi.x, lo.y, hi.y, cfg_.tags - 1));
+    const auto l = surface_->locate(surface_->square_uv({static_cast<float>(v[0]), static_cast<float>(v[1])}));
     if (!l)
       throw InputError(fmt::format("algorithm 'vines': roots entry {} ({}, {}) lies outside the texture's charts",
                                    index, v[0], v[1]));
@@ -791,14 +793,14 @@ void Vines::place_roots(const std::string& text, const vines::Mask* mask) {
     for (int tries = 0; roots.size() < static_cast<std::size_t>(cfg_.root_count) && tries < 100000; ++tries) {
       const glm::vec2 uv(static_cast<float>(rng.uniform()), static_cast<float>(rng.uniform()));
       const auto l = surface_->locate(uv);
-      if (l && (!mask || mask->zone(uv) == cfg_.mask_include) && place(*l).on_scene)
+      if (l && (!mask || mask->zone(surface_->mesh_uv(uv)) == cfg_.mask_include) && place(*l).on_scene)
         roots.emplace_back(*l, tag_of(roots.size()));
     }
   } else if (!text.empty()) {
     roots = parse_roots(text);
   } else if (mask && !mask->roots().empty()) {
     for (const glm::vec2& uv : mask->roots()) {
-      const auto l = surface_->locate(uv);
+      const auto l = surface_->locate(surface_->square_uv(uv));
       if (!l)
         throw InputError(
             fmt::format("algorithm 'vines': mask={}: the green dot at UV ({:.4f}, {:.4f}) lies outside the "

@@ -577,6 +577,35 @@ TEST(Vines, ALayoutBeyondTheUnitSquareIsFittedIntoIt) {
   EXPECT_TRUE(inside.warnings.empty());
 }
 
+// spot's layout reaches a little past the unit square, so it is fitted; its body mask, painted over the
+// mesh's own unit square, still lines up: each root sits at one of the mask's green dots in the mesh's
+// coordinates.
+TEST(Vines, AMaskIsPaintedInTheMeshsOwnCoordinatesWhenTheLayoutIsFitted) {
+  const Scene scene = load_scene("mesh:spot");
+  const SceneQuery query(scene);
+  const Surface s(scene.meshes[0]);
+  ASSERT_TRUE(s.uv_fitted());
+  const std::string mask = std::string(GROWBENCH_SOURCE_DIR) + "/algorithms/vines/examples/spot-body.png";
+  const Grown g = grow_vines(scene, query, {"space=uv", "resolution=96", "mask=" + mask});
+  ASSERT_GT(g.plant.nodes.size(), 100u);
+  const vines::Mask m = vines::Mask::read(mask, "mask");
+  ASSERT_FALSE(m.roots().empty());
+  std::size_t roots = 0;
+  for (std::size_t i = 0; i < g.plant.nodes.size(); ++i) {
+    if (g.plant.nodes[i].parent != kNoParent) continue;
+    const glm::vec2 at = s.mesh_uv(uv_of(g.plant, i));
+    float nearest = 1e9f;
+    for (const glm::vec2& dot : m.roots()) nearest = std::min(nearest, glm::distance(at, dot));
+    EXPECT_LT(nearest, 1e-4f) << "root " << roots;
+    ++roots;
+  }
+  EXPECT_EQ(roots, m.roots().size());
+  // Every attractor the vine consumed lay in the red zone: each node is within a few cells of it.
+  std::size_t outside = 0;
+  for (std::size_t i = 0; i < g.plant.nodes.size(); ++i) outside += m.zone(s.mesh_uv(uv_of(g.plant, i))) ? 0 : 1;
+  EXPECT_LT(outside, g.plant.nodes.size() / 20) << outside << " of " << g.plant.nodes.size() << " nodes off the body";
+}
+
 // ---------- determinism ----------
 
 TEST(Vines, ThePlantAndTheTextureAreTheSameForOneAndTwoThreads) {

@@ -350,7 +350,8 @@ constexpr const char* kDecalFinish = "finish { GB_DecalFinish }";
 // refuses as a layer.
 void write_uv_decal_layer(Out out, const SurfaceDecal& d) {
   std::string rect;  // the image moved from the unit square onto its rectangle of the mesh's coordinates
-  if (d.mesh >= 0 && d.u_axis.x > 0.0f && d.v_axis.y > 0.0f)
+  const bool unit = d.origin.x == 0.0f && d.origin.y == 0.0f && d.u_axis.x == 1.0f && d.v_axis.y == 1.0f;
+  if (d.mesh >= 0 && d.u_axis.x > 0.0f && d.v_axis.y > 0.0f && !unit)
     rect = fmt::format(" scale <{:.9g},{:.9g},1> translate <{:.9g},{:.9g},0>", d.u_axis.x, d.v_axis.y, d.origin.x,
                        d.origin.y);
   fmt::format_to(out, "  texture {{ pigment {{ uv_mapping image_map {{ png \"{}\" once interpolate 2 }}{} }} {} }}\n",
