@@ -12,8 +12,8 @@
 //    the attraction range), so the ground, which is not climbable, does not capture the shoots.
 //  * Phototropism turns toward the light: rotated about v_f x v_l (with the restated axis v_l x v_f a
 //    positive angle would turn away from it) by (1 - O) eta dt, never past the light direction.
-//    O is the fraction of `light_rays` rays in a cone toward the light that the scene blocks (the
-//    paper's shadow map also counted the plant's own leaves; here only the scene occludes).
+//    O is the fraction of `light_rays` rays in a cone toward the light that the scene blocks; with
+//    leaf_shadow, the light the plant's own leaves let through (a leaf density grid) multiplies 1 - O.
 //  * Growth rate: growth_speed x (shade_growth + (1 - shade_growth)(1 - O)).
 //  * Anchors: a tip that touches a surface while growing anchors where it is when it matures (a
 //    growing tip moves forward, so an anchor on it would hold it back); released past anchor_release.
@@ -94,6 +94,11 @@ const AlgorithmInfo kInfo = {
                 .unit("1/s")
                 .doc("eta: turn toward the light by (1 - O) eta dt"),
             param::integer("light_rays", 4).range(0, 256).doc("rays per tip to estimate occlusion O (0: O = 0)"),
+            param::real("leaf_shadow", 0.0)
+                .range(0, 10)
+                .doc("how much the plant's own leaves shade its tips (the paper's shadow map counted them): light "
+                     "through the leaves falls as exp(-0.5 x this x leaf area density x path), Beer-Lambert for "
+                     "randomly turned leaves at 1; 0: only the scene shades"),
             param::real("light_spread", 5.0)
                 .range(0, 60)
                 .unit("deg")
@@ -177,6 +182,7 @@ constexpr std::uint64_t kNoiseStream = 0x4ad71c00ull << 32;
 constexpr std::uint64_t kBranchStream = 0x4ad7b400ull << 32;
 constexpr std::uint64_t kLeafStream = 0x4ad71e00ull << 32;
 constexpr std::uint64_t kGapStream = 0x4ad79a00ull << 32;
+constexpr float kLeafShadowCells = 64.0f;  // how far toward the light the leaf shade is summed, in cells
 constexpr std::uint64_t kLightStream = 0x4ad7119bull << 32;
 constexpr std::uint64_t kWindStream = 0x4ad7714dull << 32;
 constexpr glm::vec3 kZ{0.0f, 0.0f, 1.0f};
@@ -310,6 +316,7 @@ Setup make_setup(const Params& p) {
       .phototropism = f("phototropism"),
       .light_rays = i("light_rays"),
       .light_spread = f("light_spread") * kDeg,
+      .leaf_shadow = f("leaf_shadow"),
       .direction_noise = f("direction_noise") * kDeg,
       .zone_rate = f("zone_rate"),
       .max_laterals = i("max_laterals"),
@@ -460,6 +467,37 @@ float Simulator::occlusion(std::size_t i, const glm::vec3& at) const {
   return static_cast<float>(blocked) / static_cast<float>(cfg_.light_rays);
 }
 
+// The leaf area density grid for leaf_shadow, rebuilt each step from the leaves in order (a fixed sum
+// order: the same grid for any thread count). A cell is twice the leaf size, so a leaf lies in about one.
+void Simulator::build_leaf_grid() {
+  leaf_area_.clear();
+  leaf_cell_ = std::max(2.0f * cfg_.leaf_size, 1e-3f);
+  const float volume = leaf_cell_ * leaf_cell_ * leaf_cell_;
+  for (const Leaf& l : leaves_) {
+    const auto i = static_cast<std::size_t>(l.particle);
+    leaf_area_[leaf_key(p_.x[i] + forward(i) * p_.half[i])] += 0.5f * l.size * l.size / volume;
+  }
+}
+
+std::uint64_t Simulator::leaf_key(const glm::vec3& p) const {
+  const glm::ivec3 c = glm::ivec3(glm::floor(p / leaf_cell_)) + glm::ivec3(1 << 20);
+  return (static_cast<std::uint64_t>(c.x & 0x1FFFFF) << 42) | (static_cast<std::uint64_t>(c.y & 0x1FFFFF) << 21) |
+         static_cast<std::uint64_t>(c.z & 0x1FFFFF);
+}
+
+// The share of light the plant's own leaves let through to `at`: a march toward the light through the
+// leaf grid, from the next cell on (a tip's own leaf does not shade it), up to kLeafShadowCells cells.
+float Simulator::leaf_transmission(const glm::vec3& at) const {
+  if (cfg_.leaf_shadow <= 0.0f || leaf_area_.empty()) return 1.0f;
+  const glm::vec3 l = scene_.light.towards(at);
+  const float reach = std::min(scene_.light.distance(at), kLeafShadowCells * leaf_cell_);
+  float depth = 0.0f;
+  for (float s = leaf_cell_; s < reach; s += 0.5f * leaf_cell_)
+    if (const auto it = leaf_area_.find(leaf_key(at + s * l)); it != leaf_area_.end())
+      depth += it->second * 0.5f * leaf_cell_;
+  return std::exp(-0.5f * cfg_.leaf_shadow * depth);
+}
+
 glm::vec3 Simulator::wind(std::size_t i) const {
   if (cfg_.wind_strength <= 0.0f) return glm::vec3(0.0f);
   // Smooth value noise in time, one sequence per shoot, from counter-based random values.
@@ -511,7 +549,7 @@ void Simulator::grow_tips() {
       // angle to the surface and takes the light's direction within the surface's tangent plane (a
       // climber does not peel off its support toward the sun; adaptation alone decides how it meets
       // the surface). Blended in over the outer half of the attraction range.
-      const float lit = 1.0f - occlusion(i, tip);
+      const float lit = (1.0f - occlusion(i, tip)) * leaf_transmission(tip);
       p_.light[i] = lit;
       if (cfg_.phototropism > 0.0f) {
         const glm::vec3 f1 = turn * f;
@@ -886,6 +924,7 @@ bool Simulator::step() {
   for (const Cut& c : cuts_)
     if (c.step == step_) prune(c.point, c.radius);
   if (!tips_.empty()) {
+    if (cfg_.leaf_shadow > 0.0f) build_leaf_grid();
     grow_tips();
     spawn();
   }

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -43,7 +44,7 @@ struct Config {
   float adaptation, attraction_range, approach_angle;
   float phototropism;
   int light_rays;
-  float light_spread, direction_noise, zone_rate;
+  float light_spread, leaf_shadow, direction_noise, zone_rate;
   // branching and leaves
   int max_laterals, max_order, leaf_step;
   float shoot_density, branch_variance;
@@ -149,6 +150,9 @@ class Simulator {
   [[nodiscard]] glm::vec3 wind(std::size_t i) const;
   [[nodiscard]] float max_radius(std::uint16_t order) const;
   [[nodiscard]] float surface_gap(std::size_t i) const;
+  void build_leaf_grid();
+  [[nodiscard]] std::uint64_t leaf_key(const glm::vec3& p) const;
+  [[nodiscard]] float leaf_transmission(const glm::vec3& at) const;
   [[nodiscard]] Organ flower(const Leaf& fl, std::int32_t node) const;
   // A child's centre at rest, in its parent's frame: its tail on the parent's head.
   [[nodiscard]] glm::vec3 rest_offset(std::size_t parent, std::size_t child) const;
@@ -161,8 +165,10 @@ class Simulator {
   glm::vec2 gap_offset_{0.0f};  // where this seed reads the surface-gap noise
   Particles p_;
   std::vector<Leaf> leaves_;
-  std::vector<Leaf> flowers_;       // azimuth: where its stalk leaves the stem; size: its diameter
-  std::vector<std::int32_t> tips_;  // growing particles, ascending
+  std::vector<Leaf> flowers_;
+  std::unordered_map<std::uint64_t, float> leaf_area_;  // leaf area density per cell (leaf_shadow), m^2/m^3
+  float leaf_cell_ = 1.0f;                              // azimuth: where its stalk leaves the stem; size: its diameter
+  std::vector<std::int32_t> tips_;                      // growing particles, ascending
   std::vector<std::uint8_t> seed_started_;
   int step_ = 0;
   std::size_t active_ = 0, roots_ = 0, live_leaves_ = 0;

@@ -368,7 +368,8 @@ TEST(Hadrich, StableOverTenThousandSteps) {
 TEST(Hadrich, SamePlantForAnyThreadCountAndRun) {
   const Scene s = load_scene("corner");
   SceneQuery q(s);
-  const std::vector<std::string> sets = {"max_particles=3000", "wind_strength=2", "break_sensitivity=1"};
+  const std::vector<std::string> sets = {"max_particles=3000", "wind_strength=2", "break_sensitivity=1",
+                                         "leaf_shadow=1"};
   const Plant one = test::grow("hadrich", s, q, sets, 1, 5);
   const Plant two = test::grow("hadrich", s, q, sets, 2, 5);
   const Plant again = test::grow("hadrich", s, q, sets, 2, 5);
@@ -376,6 +377,37 @@ TEST(Hadrich, SamePlantForAnyThreadCountAndRun) {
   EXPECT_EQ(two.geometry_hash(), again.geometry_hash());
   EXPECT_GT(one.nodes.size(), 2000u);
   EXPECT_NE(one.geometry_hash(), test::grow("hadrich", s, q, sets, 2, 6).geometry_hash());
+}
+
+// With leaf_shadow, a plant's own leaves shade its tips: in open space under an overhead sun, where the
+// scene shades nothing, some tips see less than full light, and those tips are the ones with leaves
+// above them. Without it every tip sees full light.
+TEST(Hadrich, LeafShadowShadesTipsBelowTheLeaves) {
+  Scene s;
+  s.name = "test-open";
+  s.meshes.push_back(geom::make_box("far", {10.0f, -0.1f, 10.0f}, {10.1f, 0.0f, 10.1f}));
+  s.seeds.push_back({{0.0f, 0.0f, 0.0f}, {0, 1, 0}, 0});
+  s.light.direction = {0.0f, 1.0f, 0.0f};
+  SceneQuery q(s);
+  auto tip_light = [&](const std::string& shadow) {
+    Simulator sim(s, q, setup({"max_particles=1500", "gravity=0", "shoot_density=0.3", "leaf_shadow=" + shadow}), 1);
+    for (int i = 0; i < 2000 && sim.step(); ++i) {
+    }
+    std::vector<float> light;
+    const Particles& p = sim.particles();
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (p.has(i, Particles::Growing)) light.push_back(p.light[i]);
+    return light;
+  };
+  for (const float l : tip_light("0")) EXPECT_EQ(l, 1.0f);
+  const std::vector<float> shaded = tip_light("2");
+  ASSERT_FALSE(shaded.empty());
+  const auto dim = std::count_if(shaded.begin(), shaded.end(), [](float l) { return l < 0.9f; });
+  EXPECT_GT(dim, 0) << "no tip was shaded by the leaves above it";
+  for (const float l : shaded) {
+    EXPECT_GT(l, 0.0f);
+    EXPECT_LE(l, 1.0f);
+  }
 }
 
 // The leaves sit on their particles, face the light (the sun is in front of the wall) or away from
