@@ -34,6 +34,17 @@ Scene wall_scene(float gap) {
   return s;
 }
 
+// Open space: one seed at the origin growing up, the sun in direction `light`, and only a small box far
+// away (a scene needs a mesh).
+Scene open_space(const glm::vec3& light) {
+  Scene s;
+  s.name = "test-open";
+  s.meshes.push_back(geom::make_box("far", {10.0f, -0.1f, 10.0f}, {10.1f, 0.0f, 10.1f}));
+  s.seeds.push_back({{0.0f, 0.0f, 0.0f}, {0, 1, 0}, 0});
+  s.light.direction = light;
+  return s;
+}
+
 // Distance from each particle of shoot 0 to the wall's front face, in growth order.
 std::vector<float> main_shoot_gaps(const Simulator& sim) {
   std::vector<float> gaps;
@@ -118,11 +129,7 @@ TEST(Hadrich, SurfaceVariabilityKeepsShootsFartherFromTheWall) {
 // The Houdini tool's starting velocity of new particles. In open space with the light overhead and no
 // noise, the shoot grows straight up; a velocity along +z carries it toward +z, along -z toward -z.
 TEST(Hadrich, StartVelocityCarriesTheShoot) {
-  Scene s;
-  s.name = "test-open";
-  s.meshes.push_back(geom::make_box("far", {10.0f, -0.1f, 10.0f}, {10.1f, 0.0f, 10.1f}));
-  s.seeds.push_back({{0.0f, 0.0f, 0.0f}, {0, 1, 0}, 0});
-  s.light.direction = {0.0f, 1.0f, 0.0f};
+  const Scene s = open_space({0.0f, 1.0f, 0.0f});
   SceneQuery q(s);
   auto mean_z = [&](const std::string& set) {
     Simulator sim(s, q, setup({"max_laterals=0", "max_particles=60", "direction_noise=0", "gravity=0", set}), 1);
@@ -140,11 +147,7 @@ TEST(Hadrich, StartVelocityCarriesTheShoot) {
 // In open space with the sun to the side (+x, up), the shoot turns toward it; with phototropism off it
 // keeps growing straight up.
 TEST(Hadrich, PhototropismTurnsTowardTheLight) {
-  Scene s;
-  s.name = "test-open";
-  s.meshes.push_back(geom::make_box("far", {10.0f, -0.1f, 10.0f}, {10.1f, 0.0f, 10.1f}));
-  s.seeds.push_back({{0.0f, 0.0f, 0.0f}, {0, 1, 0}, 0});
-  s.light.direction = {1.0f, 0.2f, 0.0f};
+  const Scene s = open_space({1.0f, 0.2f, 0.0f});
   SceneQuery q(s);
   auto tip_direction = [&](const std::vector<std::string>& sets) {
     auto sets2 = sets;
@@ -383,11 +386,7 @@ TEST(Hadrich, SamePlantForAnyThreadCountAndRun) {
 // scene shades nothing, some tips see less than full light, and those tips are the ones with leaves
 // above them. Without it every tip sees full light.
 TEST(Hadrich, LeafShadowShadesTipsBelowTheLeaves) {
-  Scene s;
-  s.name = "test-open";
-  s.meshes.push_back(geom::make_box("far", {10.0f, -0.1f, 10.0f}, {10.1f, 0.0f, 10.1f}));
-  s.seeds.push_back({{0.0f, 0.0f, 0.0f}, {0, 1, 0}, 0});
-  s.light.direction = {0.0f, 1.0f, 0.0f};
+  const Scene s = open_space({0.0f, 1.0f, 0.0f});
   SceneQuery q(s);
   auto tip_light = [&](const std::string& shadow) {
     Simulator sim(s, q, setup({"max_particles=1500", "gravity=0", "shoot_density=0.3", "leaf_shadow=" + shadow}), 1);
