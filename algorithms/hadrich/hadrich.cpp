@@ -130,7 +130,7 @@ const AlgorithmInfo kInfo = {
                 .doc("how far a leaf turns its upper side from its phyllotactic pose to face the light"),
             param::real("flower_density", 0.0)
                 .range(0, 1)
-                .doc("probability of a flower at each phyllotaxis site, beside its leaf, facing the light"),
+                .doc("probability of a flower at each phyllotaxis site, opposite its leaf, facing the light"),
             param::real("flower_size", 0.04).range(0, 10).unit("m").doc("flower diameter"),
             // physics
             param::real("dt", 0.025).range(1e-4, 1).unit("s").doc("time step (the paper: 25 ms)"),
@@ -182,7 +182,9 @@ constexpr std::uint64_t kNoiseStream = 0x4ad71c00ull << 32;
 constexpr std::uint64_t kBranchStream = 0x4ad7b400ull << 32;
 constexpr std::uint64_t kLeafStream = 0x4ad71e00ull << 32;
 constexpr std::uint64_t kGapStream = 0x4ad79a00ull << 32;
-constexpr float kLeafShadowCells = 64.0f;  // how far toward the light the leaf shade is summed, in cells
+constexpr float kLeafShadowCells = 64.0f;
+constexpr float kBandUse = 0.9f;  // the share of the distance field's band surface_variability may use  // how far
+                                  // toward the light the leaf shade is summed, in cells
 constexpr std::uint64_t kLightStream = 0x4ad7119bull << 32;
 constexpr std::uint64_t kWindStream = 0x4ad7714dull << 32;
 constexpr glm::vec3 kZ{0.0f, 0.0f, 1.0f};
@@ -792,7 +794,9 @@ void Simulator::contact_pass() {
       // Pushed out to its longest semi-axis from the surface, plus its own share of the variability.
       const float body = std::max(p_.half[i], p_.radius[i]);
       float reach = body;
-      if (cfg_.surface_variability > 0.0f) reach = std::max(body, std::min(body + surface_gap(i), query_.band_width()));
+      // Kept inside the band: at its edge a particle would flip between pushed and free.
+      if (cfg_.surface_variability > 0.0f)
+        reach = std::max(body, std::min(body + surface_gap(i), kBandUse * query_.band_width()));
       SceneQuery::BandSample s = query_.band_sample(xp);
       if (!s.in_band && s.distance < 0.0f) {  // deep inside (beyond the band): exact distance and direction
         s.distance = query_.signed_distance(xp);

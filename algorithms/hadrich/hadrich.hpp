@@ -165,9 +165,9 @@ class Simulator {
   glm::vec2 gap_offset_{0.0f};  // where this seed reads the surface-gap noise
   Particles p_;
   std::vector<Leaf> leaves_;
-  std::vector<Leaf> flowers_;
+  std::vector<Leaf> flowers_;                           // azimuth: where its stalk leaves the stem; size: its diameter
   std::unordered_map<std::uint64_t, float> leaf_area_;  // leaf area density per cell (leaf_shadow), m^2/m^3
-  float leaf_cell_ = 1.0f;                              // azimuth: where its stalk leaves the stem; size: its diameter
+  float leaf_cell_ = 1.0f;                              // the side of a leaf_area_ cell
   std::vector<std::int32_t> tips_;                      // growing particles, ascending
   std::vector<std::uint8_t> seed_started_;
   int step_ = 0;

@@ -383,8 +383,8 @@ TEST(Hadrich, SamePlantForAnyThreadCountAndRun) {
 }
 
 // With leaf_shadow, a plant's own leaves shade its tips: in open space under an overhead sun, where the
-// scene shades nothing, some tips see less than full light, and those tips are the ones with leaves
-// above them. Without it every tip sees full light.
+// scene shades nothing, some tips see less than full light, and none sees none. Without it every tip
+// sees full light.
 TEST(Hadrich, LeafShadowShadesTipsBelowTheLeaves) {
   const Scene s = open_space({0.0f, 1.0f, 0.0f});
   SceneQuery q(s);

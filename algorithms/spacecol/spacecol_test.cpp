@@ -114,7 +114,8 @@ TEST(SpaceColonization, PositionNoiseBendsSmoothlyRandomNoiseJitters) {
   EXPECT_LT(glm::distance(smooth.nodes.back().position, glm::vec3(1, 0, 0)), 0.05f) << "and it still arrives";
   EXPECT_LT(mean_turn(smooth), 0.25 * mean_turn(jitter)) << mean_turn(smooth) << " vs " << mean_turn(jitter);
   EXPECT_GT(mean_turn(jitter), 0.2);
-  EXPECT_NE(grow("spacecol", s, q, exact(one, {"noise=0.5"}), 1, 2).geometry_hash(), smooth.geometry_hash())
+  EXPECT_NE(grow("spacecol", s, q, exact(one, {"noise=0.5", "noise_scale=0.5"}), 1, 2).geometry_hash(),
+            smooth.geometry_hash())
       << "each seed reads its own part of the field";
 }
 
@@ -133,8 +134,6 @@ TEST(SpaceColonization, CenterDensityDrawsTheVeinsInward) {
   const Plant dense = grow("spacecol", s, q, {"point_count=3000", "leaves=none", "center_density=4"});
   ASSERT_EQ(env.kind, Shape::Kind::Sphere);
   EXPECT_LT(mean_depth(dense), 0.9 * mean_depth(flat)) << mean_depth(dense) << " vs " << mean_depth(flat);
-  EXPECT_EQ(grow("spacecol", s, q, {"point_count=3000", "leaves=none", "center_density=0"}).geometry_hash(),
-            flat.geometry_hash());
 }
 
 TEST(SpaceColonization, OpenAndClosedVenationDiffer) {

@@ -437,8 +437,6 @@ class Vines final : public GrowthAlgorithm {
   void place_attractors(const vines::Mask* mask);
   void place_roots(const std::string& roots, const vines::Mask* mask);
 
-  // A tag no root carries leaves the attractors only it may take out of reach: the vines stop short of
-  // them, which looks like a stall. Said, with how many.
   // Says which layout the texture follows when the mesh's coordinates went beyond the unit square.
   void warn_of_fitted_uvs() {
     if (mesh_ == kNone || !surface_->uv_fitted()) return;
@@ -451,6 +449,8 @@ class Vines final : public GrowthAlgorithm {
         scene_->meshes[static_cast<std::size_t>(mesh_)].name, o.x, o.x + side, o.y, o.y + side));
   }
 
+  // A tag no root carries leaves the attractors only it may take out of reach: the vines stop short of
+  // them, which looks like a stall. Said, with how many.
   void warn_of_rootless_tags() {
     std::uint32_t rooted = 0;
     for (const auto t : tag_) rooted |= 1u << t;

@@ -505,7 +505,7 @@ void grow(const TrialSpec& spec, const Params& params, TrialState& st, PhaseTime
   rec.results.curve = std::move(curve.curve);
 }
 
-// The meshing, export and metrics phases, then what the plant and its mesh hold.
+// The meshing, export, outputs and metrics phases, then what the plant and its mesh hold.
 void mesh_export_measure(const TrialSpec& spec, const MesherOptions& mesher, TrialState& st, PhaseTimer& timer,
                          TrialRecord& rec) {
   const Plant& plant = st.styled ? *st.styled : st.algo->plant();
